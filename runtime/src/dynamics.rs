@@ -1,0 +1,194 @@
+//! The contract between a model (generated, or the numeric reference) and the runtime.
+//!
+//! Everything is expressed in the paper's form (13)–(14):
+//! `M(q) q̈ + F(q, q̇) + Q(q, q̇, t) + Jᵀ λ = 0`, with one scalar constraint
+//! `h(q) = f2(q) − f3(f1(q)) = 0` per cam contact (3) and its acceleration form
+//! `J q̈ + c(q, q̇) = 0` (7, 8). Matrices are dense row-major slices so that generated code
+//! can write them without allocation.
+
+/// Kind of a generalised coordinate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CoordinateKind {
+    /// Angle of a revolute joint (rad).
+    Revolute,
+    /// Displacement of a prismatic joint (m).
+    Prismatic,
+}
+
+/// Description of one generalised coordinate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoordinateInfo {
+    /// Name from the model file, e.g. `q3`.
+    pub name: String,
+    /// Revolute or prismatic.
+    pub kind: CoordinateKind,
+    /// True when the joint's motion is prescribed (a driven joint).
+    pub driven: bool,
+}
+
+/// Integrator choice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum IntegratorKind {
+    /// Classical fixed-step Runge–Kutta 4 (step `dt`).
+    Rk4,
+    /// Adaptive embedded Dormand–Prince 5(4) with error control on (u, u̇).
+    Dopri5,
+}
+
+/// Simulation settings (the model file's defaults, overridable by the caller).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimSettings {
+    /// End time (s).
+    pub t_end: f64,
+    /// Output interval (s).
+    pub dt_out: f64,
+    /// Integrator.
+    pub integrator: IntegratorKind,
+    /// Fixed step of RK4, initial step of adaptive integrators (s).
+    pub dt: f64,
+    /// Relative tolerance (adaptive integrators).
+    pub rtol: f64,
+    /// Absolute tolerance (adaptive integrators).
+    pub atol: f64,
+}
+
+/// Initial guess and which coordinates assembly must keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialGuess {
+    /// Guessed coordinates.
+    pub q: Vec<f64>,
+    /// Guessed velocities.
+    pub qd: Vec<f64>,
+    /// `hold[i]`: assembly keeps coordinate i at its guess.
+    pub hold: Vec<bool>,
+}
+
+/// Static description of a model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelInfo {
+    /// Model name, e.g. `paper_concave`.
+    pub name: String,
+    /// Free text from the model file.
+    pub description: String,
+    /// The generalised coordinates, in order.
+    pub coordinates: Vec<CoordinateInfo>,
+    /// Contact names (the marker names), in order.
+    pub contacts: Vec<String>,
+    /// False for a planar model (contact z coordinates are always 0 and not reported).
+    pub spatial: bool,
+    /// Initial guess.
+    pub initial: InitialGuess,
+    /// Default settings.
+    pub defaults: SimSettings,
+}
+
+impl ModelInfo {
+    /// Number of generalised coordinates.
+    pub fn n(&self) -> usize {
+        self.coordinates.len()
+    }
+
+    /// Number of cam contacts (= number of scalar constraints).
+    pub fn n_contacts(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// Index of a coordinate by name.
+    pub fn coordinate_index(&self, name: &str) -> Option<usize> {
+        self.coordinates.iter().position(|c| c.name == name)
+    }
+}
+
+/// Where a contact point is, in ground and cam coordinates, and the profile there.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactGeometry {
+    /// Contact point (the marker) in ground coordinates.
+    pub position: [f64; 3],
+    /// f1(q): the point's x in the cam plane (1).
+    pub x: f64,
+    /// f2(q): the point's y in the cam plane (1).
+    pub y: f64,
+    /// f3'(f1(q)): slope of the profile under the point.
+    pub slope: f64,
+    /// f3''(f1(q)).
+    pub curvature: f64,
+}
+
+/// Full first- and second-order kinematics of one contact point (diagnostics and tests).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ContactKinematics {
+    /// Geometry at q.
+    pub geometry: ContactGeometry,
+    /// J1 = ∂f1/∂q.
+    pub j1: Vec<f64>,
+    /// J2 = ∂f2/∂q.
+    pub j2: Vec<f64>,
+    /// (J1 q̇)_q q̇: convective part of the point's cam-x acceleration.
+    pub conv1: f64,
+    /// (J2 q̇)_q q̇: convective part of the point's cam-y acceleration.
+    pub conv2: f64,
+}
+
+/// Mechanical energy split by origin.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Energy {
+    /// ½ Σ (m v·v + ω·I ω), summed from the body velocities.
+    pub kinetic: f64,
+    /// −Σ m g·p_com.
+    pub gravity: f64,
+    /// Σ ½ k (q − rest)².
+    pub spring: f64,
+}
+
+impl Energy {
+    /// Kinetic + potential.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.gravity + self.spring
+    }
+}
+
+/// The functions a model provides to the runtime.
+///
+/// Implemented by every generated model (`camchain::models::*::Model`) and by the numeric
+/// reference [`crate::reference::NumericModel`], so both run through the same integrators.
+/// Slices have the lengths given by [`ModelInfo`]: `n` coordinates, `nc` contacts.
+pub trait Dynamics {
+    /// Static description.
+    fn info(&self) -> &ModelInfo;
+
+    /// M(q), eq. (13): row-major n×n into `m`.
+    fn mass_matrix(&self, q: &[f64], m: &mut [f64]);
+
+    /// F(q, q̇), eq. (13): the velocity-dependent inertial terms, into `f` (length n).
+    fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]);
+
+    /// Q(q, q̇, t), eq. (13): gravity, springs and dampers with the sign of the equation
+    /// `M q̈ + F + Q = joint drive loads` (so a spring contributes `+k (q − rest)`).
+    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
+
+    /// h(q), eq. (3), one entry per contact.
+    fn constraint(&self, q: &[f64], h: &mut [f64]);
+
+    /// J(q) = J2 − f3'(f1) J1, eq. (5b): row-major nc×n into `j`.
+    fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]);
+
+    /// c(q, q̇) = (J2 q̇)_q q̇ − f3' (J1 q̇)_q q̇ − f3'' (J1 q̇)², eqs. (7, 8), so that the
+    /// acceleration-level constraint reads `J q̈ + c = 0`. One entry per contact.
+    fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]);
+
+    /// Geometry of every contact point at q (length nc).
+    fn contact_geometry(&self, q: &[f64], out: &mut [ContactGeometry]);
+
+    /// f1, f2, J1, J2 and the convective terms of contact `k` (diagnostics, tests).
+    fn contact_kinematics(&self, q: &[f64], qd: &[f64], k: usize) -> ContactKinematics;
+
+    /// Prescribed motion at time t: for every driven coordinate i, writes q[i], qd[i] and
+    /// qdd[i]; other entries are left untouched.
+    fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]);
+
+    /// Kinetic energy from the body velocities, and the potential energies.
+    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy;
+
+    /// Power dissipated by the joint dampers, Σ c q̇² (W, >= 0).
+    fn damper_power(&self, qd: &[f64]) -> f64;
+}
