@@ -5,16 +5,54 @@
 //! - [`model`]: the validated model.
 //! - [`profile`]: one-variable expressions (cam profiles, drives) parsed with `syn`.
 //! - [`expr`]: the hash-consed symbolic expression DAG: folding, differentiation,
-//!   interpretation and emission as `let` bindings.
-//! - [`kinematics`]: forward recursion of rotations, positions, velocities, accelerations;
-//!   contact point f1, f2, J1, J2 and convective terms (eqs. 1–8).
-//! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (eqs. 9–13).
+//!   interpretation and operation counts.
+//! - [`kinematics`]: forward recursion of rotations, positions, velocities, accelerations (9).
+//! - [`constraint`]: contact point f1, f2, J1, J2, convective terms and h, J, c (1–8).
+//! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (10–13), and energies.
+//! - [`derive`]: the whole derivation of a model in one graph.
 //! - [`emit`]: the generated Rust module.
 
+pub mod assembly;
+pub mod constraint;
+pub mod derive;
+pub mod dynamics;
+pub mod emit;
 pub mod error;
+pub mod expr;
+pub mod kinematics;
 pub mod model;
 pub mod profile;
 pub mod schema;
 
+pub use derive::Derivation;
 pub use error::ModelError;
 pub use model::Model;
+
+use std::path::Path;
+
+/// Reads, validates and checks a model file and generates its Rust module.
+///
+/// `display` is the path shown in messages and in the generated header (e.g.
+/// `models/paper_concave.ron`). Every failure is a [`ModelError`] naming the file, line,
+/// column and field.
+pub fn generate_file(path: &Path, display: &Path) -> Result<emit::Generated, ModelError> {
+    let source = std::fs::read_to_string(path).map_err(|e| ModelError {
+        file: display.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message: format!("cannot read the file: {e}"),
+    })?;
+    let model = schema::parse_model(&source, display)?;
+    let derivation = Derivation::new(&model);
+    assembly::assemble(&model, &derivation)
+        .map_err(|message| schema::field_error(display, &source, "initial", message))?;
+    let shown = display.to_string_lossy().replace('\\', "/");
+    emit::generate(&model, &shown).map_err(|message| ModelError {
+        file: display.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message,
+    })
+}

@@ -172,7 +172,10 @@ impl Model {
 
     /// Coordinate names in order.
     pub fn coordinate_names(&self) -> Vec<&str> {
-        self.bodies.iter().map(|b| b.joint.coordinate.as_str()).collect()
+        self.bodies
+            .iter()
+            .map(|b| b.joint.coordinate.as_str())
+            .collect()
     }
 
     /// True when every joint axis is along z and every anchor, centre of mass, marker and

@@ -27,3 +27,19 @@ pub fn parse_model(_source: &str, file: &Path) -> Result<Model, ModelError> {
         message: "not implemented yet".into(),
     })
 }
+
+/// Error at a dotted field path (stub: no location yet).
+pub fn field_error(
+    file: &Path,
+    _source: &str,
+    field: &str,
+    message: impl Into<String>,
+) -> ModelError {
+    ModelError {
+        file: file.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: field.into(),
+        message: message.into(),
+    }
+}

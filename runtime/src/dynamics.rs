@@ -191,4 +191,27 @@ pub trait Dynamics {
 
     /// Power dissipated by the joint dampers, Σ c q̇² (W, >= 0).
     fn damper_power(&self, qd: &[f64]) -> f64;
+
+    /// M, F and Q in one call. Generated models override it so that the kinematics shared by
+    /// the three (sines, cosines, body velocities) are computed once.
+    fn equations(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        m: &mut [f64],
+        f: &mut [f64],
+        applied: &mut [f64],
+    ) {
+        self.mass_matrix(q, m);
+        self.inertial_forces(q, qd, f);
+        self.applied_forces(t, q, qd, applied);
+    }
+
+    /// J and c in one call (the velocity and acceleration levels of the constraint, 5b, 8).
+    /// Generated models override it to share the contact kinematics.
+    fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
+        self.constraint_jacobian(q, j);
+        self.constraint_bias(q, qd, c);
+    }
 }

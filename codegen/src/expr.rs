@@ -1,0 +1,824 @@
+//! The symbolic engine: a hash-consed expression DAG.
+//!
+//! Every node is stored once ([`Graph`] interns nodes by structure, as `egg` does), so a
+//! common subexpression built twice is the same [`Id`] and is computed once in the emitted
+//! code. Construction folds constants and removes structurally zero and unit terms
+//! (`0·x → 0`, `1·x → x`, `x + 0 → x`, `x − x → 0`, `−(−x) → x`), so they never reach the
+//! emitted code. Ids grow with construction, so id order is a topological order: children
+//! always have smaller ids than their parents.
+//!
+//! The same graph can be differentiated ([`Graph::diff`]), have a variable substituted
+//! ([`Graph::substitute`]) and be evaluated numerically ([`Graph::eval`]), so tests can check
+//! expressions without compiling them.
+
+use crate::profile::Func;
+use std::collections::HashMap;
+
+/// Handle of a node in a [`Graph`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Id(u32);
+
+impl Id {
+    /// Position of the node in the graph (also its topological rank).
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// One node of the expression language. Subtraction is `Add(a, Neg(b))`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// A constant, stored by its bits (never −0.0, never NaN).
+    Const(u64),
+    /// A named input variable, by index into the graph's variable table.
+    Var(u32),
+    /// a + b, operands ordered by id.
+    Add(Id, Id),
+    /// a · b, a constant operand first, otherwise ordered by id.
+    Mul(Id, Id),
+    /// −a
+    Neg(Id),
+    /// a / b
+    Div(Id, Id),
+    /// aⁿ for an integer n ∉ {0, 1}
+    Powi(Id, i32),
+    /// a^b
+    Powf(Id, Id),
+    /// an elementary function of a
+    Call(Func, Id),
+}
+
+/// Operation counts of a set of expressions, each shared node counted once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct OpCount {
+    /// Additions and subtractions (and negations not absorbed into a subtraction).
+    pub add_sub: usize,
+    /// Multiplications.
+    pub mul: usize,
+    /// Divisions.
+    pub div: usize,
+    /// sin and cos.
+    pub sin_cos: usize,
+    /// Square roots.
+    pub sqrt: usize,
+    /// Everything else (powi, powf, tan, exp, ln, hyperbolic, atan).
+    pub other: usize,
+}
+
+impl OpCount {
+    /// Sum of all operations.
+    pub fn total(&self) -> usize {
+        self.add_sub + self.mul + self.div + self.sin_cos + self.sqrt + self.other
+    }
+
+    /// Adds the counts of `other` to these.
+    pub fn accumulate(&mut self, other: &OpCount) {
+        self.add_sub += other.add_sub;
+        self.mul += other.mul;
+        self.div += other.div;
+        self.sin_cos += other.sin_cos;
+        self.sqrt += other.sqrt;
+        self.other += other.other;
+    }
+}
+
+impl std::fmt::Display for OpCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} add/sub, {} mul, {} div, {} sin/cos, {} sqrt, {} other ({} total)",
+            self.add_sub,
+            self.mul,
+            self.div,
+            self.sin_cos,
+            self.sqrt,
+            self.other,
+            self.total()
+        )
+    }
+}
+
+/// A hash-consed expression DAG with named variables.
+#[derive(Debug, Default, Clone)]
+pub struct Graph {
+    nodes: Vec<Node>,
+    index: HashMap<Node, Id>,
+    vars: Vec<String>,
+    var_ids: HashMap<String, Id>,
+    labels: HashMap<Id, String>,
+    sections: Vec<u32>,
+    section_names: Vec<String>,
+}
+
+fn const_bits(value: f64) -> u64 {
+    // −0.0 and 0.0 are the same constant for our purposes.
+    if value == 0.0 {
+        0.0f64.to_bits()
+    } else {
+        value.to_bits()
+    }
+}
+
+impl Graph {
+    /// An empty graph.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// True when the graph has no node.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The id of the node at `index` (ids are dense indices).
+    pub fn id_from_index(&self, index: usize) -> Id {
+        Id(index as u32)
+    }
+
+    /// The node behind an id.
+    pub fn node(&self, id: Id) -> Node {
+        self.nodes[id.index()]
+    }
+
+    fn intern(&mut self, node: Node) -> Id {
+        if let Some(&id) = self.index.get(&node) {
+            return id;
+        }
+        let id = Id(self.nodes.len() as u32);
+        self.nodes.push(node);
+        self.sections
+            .push(self.section_names.len().saturating_sub(1) as u32);
+        self.index.insert(node, id);
+        id
+    }
+
+    /// A constant. NaN is not representable and becomes an explicit NaN node only through
+    /// folding of invalid operations, which the derivation never produces.
+    pub fn constant(&mut self, value: f64) -> Id {
+        self.intern(Node::Const(const_bits(value)))
+    }
+
+    /// The constant 0.
+    pub fn zero(&mut self) -> Id {
+        self.constant(0.0)
+    }
+
+    /// The constant 1.
+    pub fn one(&mut self) -> Id {
+        self.constant(1.0)
+    }
+
+    /// The variable called `name` (created on first use).
+    pub fn var(&mut self, name: &str) -> Id {
+        if let Some(&id) = self.var_ids.get(name) {
+            return id;
+        }
+        let index = self.vars.len() as u32;
+        self.vars.push(name.to_string());
+        let id = self.intern(Node::Var(index));
+        self.var_ids.insert(name.to_string(), id);
+        id
+    }
+
+    /// Names of the variables, by variable index.
+    pub fn var_names(&self) -> &[String] {
+        &self.vars
+    }
+
+    /// Index of a variable in [`Graph::var_names`], if it exists.
+    pub fn var_index(&self, name: &str) -> Option<usize> {
+        self.vars.iter().position(|v| v == name)
+    }
+
+    /// The value of a constant node.
+    pub fn as_const(&self, id: Id) -> Option<f64> {
+        match self.node(id) {
+            Node::Const(bits) => Some(f64::from_bits(bits)),
+            _ => None,
+        }
+    }
+
+    /// True when `id` is the constant 0 (a structural zero).
+    pub fn is_zero(&self, id: Id) -> bool {
+        self.as_const(id) == Some(0.0)
+    }
+
+    /// Starts a section: nodes created from now on are listed under this heading in the
+    /// emitted code (e.g. `body2: velocities and accelerations`).
+    pub fn set_section(&mut self, name: impl Into<String>) {
+        self.section_names.push(name.into());
+    }
+
+    /// The section a node was created in.
+    pub fn section_of(&self, id: Id) -> Option<&str> {
+        let k = *self.sections.get(id.index())? as usize;
+        self.section_names.get(k).map(String::as_str)
+    }
+
+    /// Gives a node a readable name for the emitted code (first label wins).
+    pub fn label(&mut self, id: Id, name: impl Into<String>) {
+        if matches!(self.node(id), Node::Const(_) | Node::Var(_)) {
+            return;
+        }
+        self.labels.entry(id).or_insert_with(|| name.into());
+    }
+
+    /// The label given to a node, if any.
+    pub fn label_of(&self, id: Id) -> Option<&str> {
+        self.labels.get(&id).map(String::as_str)
+    }
+
+    /// a + b with folding.
+    pub fn add(&mut self, a: Id, b: Id) -> Id {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x + y),
+            (Some(x), _) if x == 0.0 => return b,
+            (_, Some(y)) if y == 0.0 => return a,
+            _ => {}
+        }
+        if self.node(b) == Node::Neg(a) || self.node(a) == Node::Neg(b) {
+            return self.zero();
+        }
+        if self.is_sin2_plus_cos2(a, b) {
+            return self.one();
+        }
+        if a == b {
+            let two = self.constant(2.0);
+            return self.mul(two, a);
+        }
+        if let (Node::Neg(x), Node::Neg(y)) = (self.node(a), self.node(b)) {
+            let sum = self.add(x, y);
+            return self.neg(sum);
+        }
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        self.intern(Node::Add(a, b))
+    }
+
+    /// True for cos²x + sin²x in either order (written as products), which is exactly 1.
+    fn is_sin2_plus_cos2(&self, a: Id, b: Id) -> bool {
+        let square_of = |id: Id| match self.node(id) {
+            Node::Mul(x, y) if x == y => match self.node(x) {
+                Node::Call(f @ (Func::Sin | Func::Cos), arg) => Some((f, arg)),
+                _ => None,
+            },
+            _ => None,
+        };
+        match (square_of(a), square_of(b)) {
+            (Some((f, x)), Some((g, y))) => x == y && f != g,
+            _ => false,
+        }
+    }
+
+    /// a − b with folding.
+    pub fn sub(&mut self, a: Id, b: Id) -> Id {
+        let nb = self.neg(b);
+        self.add(a, nb)
+    }
+
+    /// −a with folding.
+    pub fn neg(&mut self, a: Id) -> Id {
+        match self.node(a) {
+            Node::Const(bits) => self.constant(-f64::from_bits(bits)),
+            Node::Neg(x) => x,
+            _ => self.intern(Node::Neg(a)),
+        }
+    }
+
+    /// a · b with folding: zeros and ones vanish, signs are pulled out, constants merge.
+    pub fn mul(&mut self, a: Id, b: Id) -> Id {
+        let (a, b) = match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => return self.constant(x * y),
+            (None, Some(_)) => (b, a),
+            _ => (a, b),
+        };
+        if let Some(c) = self.as_const(a) {
+            return self.scale(c, b);
+        }
+        if let Node::Neg(x) = self.node(a) {
+            let p = self.mul(x, b);
+            return self.neg(p);
+        }
+        if let Node::Neg(y) = self.node(b) {
+            let p = self.mul(a, y);
+            return self.neg(p);
+        }
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        self.intern(Node::Mul(a, b))
+    }
+
+    /// c · b for a constant c; constant factors are kept positive (the sign goes to a
+    /// negation, which the printer turns into a subtraction).
+    fn scale(&mut self, c: f64, b: Id) -> Id {
+        if c == 0.0 {
+            return self.zero();
+        }
+        if c == 1.0 {
+            return b;
+        }
+        if c < 0.0 {
+            let p = self.scale(-c, b);
+            return self.neg(p);
+        }
+        match self.node(b) {
+            Node::Neg(x) => {
+                let p = self.scale(c, x);
+                self.neg(p)
+            }
+            Node::Mul(x, y) if self.as_const(x).is_some() => {
+                let d = self.as_const(x).unwrap_or(1.0);
+                self.scale(c * d, y)
+            }
+            _ => {
+                let cid = self.constant(c);
+                self.intern(Node::Mul(cid, b))
+            }
+        }
+    }
+
+    /// a / b with folding; division by a constant becomes a multiplication.
+    pub fn div(&mut self, a: Id, b: Id) -> Id {
+        if self.is_zero(a) {
+            return self.zero();
+        }
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => self.constant(x / y),
+            (_, Some(y)) if y != 0.0 => self.scale(1.0 / y, a),
+            _ => self.intern(Node::Div(a, b)),
+        }
+    }
+
+    /// aⁿ with folding.
+    pub fn powi(&mut self, a: Id, n: i32) -> Id {
+        match n {
+            0 => self.one(),
+            1 => a,
+            _ => match self.as_const(a) {
+                Some(x) => self.constant(x.powi(n)),
+                None => self.intern(Node::Powi(a, n)),
+            },
+        }
+    }
+
+    /// a^b with folding.
+    pub fn powf(&mut self, a: Id, b: Id) -> Id {
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => self.constant(x.powf(y)),
+            (_, Some(y)) if y == 1.0 => a,
+            (_, Some(y)) if y == 0.0 => self.one(),
+            (_, Some(y)) if y.fract() == 0.0 && y.abs() < 64.0 => self.powi(a, y as i32),
+            _ => self.intern(Node::Powf(a, b)),
+        }
+    }
+
+    /// f(a) with folding of constants and odd/even symmetry of sin and cos.
+    pub fn call(&mut self, f: Func, a: Id) -> Id {
+        if let Some(x) = self.as_const(a) {
+            return self.constant(apply(f, x));
+        }
+        if let Node::Neg(x) = self.node(a) {
+            match f {
+                Func::Cos | Func::Cosh => return self.call(f, x),
+                Func::Sin | Func::Tan | Func::Sinh | Func::Tanh | Func::Atan => {
+                    let v = self.call(f, x);
+                    return self.neg(v);
+                }
+                _ => {}
+            }
+        }
+        self.intern(Node::Call(f, a))
+    }
+
+    /// sin a
+    pub fn sin(&mut self, a: Id) -> Id {
+        self.call(Func::Sin, a)
+    }
+
+    /// cos a
+    pub fn cos(&mut self, a: Id) -> Id {
+        self.call(Func::Cos, a)
+    }
+
+    /// √a
+    pub fn sqrt(&mut self, a: Id) -> Id {
+        self.call(Func::Sqrt, a)
+    }
+
+    /// Σ of the items (0 for none).
+    pub fn sum(&mut self, items: impl IntoIterator<Item = Id>) -> Id {
+        let mut acc = self.zero();
+        for item in items {
+            acc = self.add(acc, item);
+        }
+        acc
+    }
+
+    /// ∂e/∂x for a variable node `x`, memoised within the call.
+    pub fn diff(&mut self, e: Id, x: Id) -> Id {
+        let mut memo = HashMap::new();
+        self.diff_memo(e, x, &mut memo)
+    }
+
+    /// ∂e/∂x for many expressions sharing one memo table (cheaper for Jacobians).
+    pub fn diff_many(&mut self, es: &[Id], x: Id) -> Vec<Id> {
+        let mut memo = HashMap::new();
+        es.iter()
+            .map(|&e| self.diff_memo(e, x, &mut memo))
+            .collect()
+    }
+
+    fn diff_memo(&mut self, e: Id, x: Id, memo: &mut HashMap<Id, Id>) -> Id {
+        if let Some(&d) = memo.get(&e) {
+            return d;
+        }
+        let d = self.diff_node(e, x, memo);
+        memo.insert(e, d);
+        d
+    }
+
+    fn diff_node(&mut self, e: Id, x: Id, memo: &mut HashMap<Id, Id>) -> Id {
+        match self.node(e) {
+            Node::Const(_) => self.zero(),
+            Node::Var(_) => {
+                if e == x {
+                    self.one()
+                } else {
+                    self.zero()
+                }
+            }
+            Node::Add(a, b) => {
+                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
+                self.add(da, db)
+            }
+            Node::Mul(a, b) => {
+                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
+                let t1 = self.mul(da, b);
+                let t2 = self.mul(a, db);
+                self.add(t1, t2)
+            }
+            Node::Neg(a) => {
+                let da = self.diff_memo(a, x, memo);
+                self.neg(da)
+            }
+            Node::Div(a, b) => {
+                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
+                let t1 = self.div(da, b);
+                let q = self.div(e, b);
+                let t2 = self.mul(q, db);
+                self.sub(t1, t2)
+            }
+            Node::Powi(a, n) => {
+                let da = self.diff_memo(a, x, memo);
+                let p = self.powi(a, n - 1);
+                let np = self.scale(f64::from(n), p);
+                self.mul(np, da)
+            }
+            Node::Powf(a, b) => {
+                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
+                let ln_a = self.call(Func::Ln, a);
+                let t1 = self.mul(db, ln_a);
+                let ba = self.div(b, a);
+                let t2 = self.mul(ba, da);
+                let inner = self.add(t1, t2);
+                self.mul(e, inner)
+            }
+            Node::Call(f, a) => {
+                let da = self.diff_memo(a, x, memo);
+                if self.is_zero(da) {
+                    return self.zero();
+                }
+                let outer = self.derivative_of_call(f, a, e);
+                self.mul(outer, da)
+            }
+        }
+    }
+
+    /// f'(a) for the node e = f(a).
+    fn derivative_of_call(&mut self, f: Func, a: Id, e: Id) -> Id {
+        let one = self.one();
+        match f {
+            Func::Sin => self.cos(a),
+            Func::Cos => {
+                let s = self.sin(a);
+                self.neg(s)
+            }
+            Func::Tan => {
+                let t2 = self.powi(e, 2);
+                self.add(one, t2)
+            }
+            Func::Exp => e,
+            Func::Ln => self.div(one, a),
+            Func::Sqrt => {
+                let two_e = self.scale(2.0, e);
+                self.div(one, two_e)
+            }
+            Func::Sinh => self.call(Func::Cosh, a),
+            Func::Cosh => self.call(Func::Sinh, a),
+            Func::Tanh => {
+                let t2 = self.powi(e, 2);
+                self.sub(one, t2)
+            }
+            Func::Atan => {
+                let a2 = self.powi(a, 2);
+                let den = self.add(one, a2);
+                self.div(one, den)
+            }
+        }
+    }
+
+    /// e with the variable `x` replaced by the expression `by`.
+    pub fn substitute(&mut self, e: Id, x: Id, by: Id) -> Id {
+        let mut memo = HashMap::new();
+        self.subst_memo(e, x, by, &mut memo)
+    }
+
+    fn subst_memo(&mut self, e: Id, x: Id, by: Id, memo: &mut HashMap<Id, Id>) -> Id {
+        if e == x {
+            return by;
+        }
+        if let Some(&r) = memo.get(&e) {
+            return r;
+        }
+        let r = match self.node(e) {
+            Node::Const(_) | Node::Var(_) => e,
+            Node::Add(a, b) => {
+                let (a, b) = (
+                    self.subst_memo(a, x, by, memo),
+                    self.subst_memo(b, x, by, memo),
+                );
+                self.add(a, b)
+            }
+            Node::Mul(a, b) => {
+                let (a, b) = (
+                    self.subst_memo(a, x, by, memo),
+                    self.subst_memo(b, x, by, memo),
+                );
+                self.mul(a, b)
+            }
+            Node::Neg(a) => {
+                let a = self.subst_memo(a, x, by, memo);
+                self.neg(a)
+            }
+            Node::Div(a, b) => {
+                let (a, b) = (
+                    self.subst_memo(a, x, by, memo),
+                    self.subst_memo(b, x, by, memo),
+                );
+                self.div(a, b)
+            }
+            Node::Powi(a, n) => {
+                let a = self.subst_memo(a, x, by, memo);
+                self.powi(a, n)
+            }
+            Node::Powf(a, b) => {
+                let (a, b) = (
+                    self.subst_memo(a, x, by, memo),
+                    self.subst_memo(b, x, by, memo),
+                );
+                self.powf(a, b)
+            }
+            Node::Call(f, a) => {
+                let a = self.subst_memo(a, x, by, memo);
+                self.call(f, a)
+            }
+        };
+        memo.insert(e, r);
+        r
+    }
+
+    /// Evaluates the given roots with `vars[i]` the value of variable i (the interpreter).
+    ///
+    /// Only nodes up to the largest root are computed, in id (= topological) order.
+    pub fn eval(&self, roots: &[Id], vars: &[f64]) -> Vec<f64> {
+        let last = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
+        let mut values: Vec<f64> = Vec::with_capacity(last);
+        for node in &self.nodes[..last] {
+            let v = |id: &Id| values[id.index()];
+            let value: f64 = match node {
+                Node::Const(bits) => f64::from_bits(*bits),
+                Node::Var(i) => vars.get(*i as usize).copied().unwrap_or(f64::NAN),
+                Node::Add(a, b) => v(a) + v(b),
+                Node::Mul(a, b) => v(a) * v(b),
+                Node::Neg(a) => -v(a),
+                Node::Div(a, b) => v(a) / v(b),
+                Node::Powi(a, n) => v(a).powi(*n),
+                Node::Powf(a, b) => v(a).powf(v(b)),
+                Node::Call(f, a) => apply(*f, v(a)),
+            };
+            values.push(value);
+        }
+        roots.iter().map(|r| values[r.index()]).collect()
+    }
+
+    /// Direct children of a node.
+    pub fn children(&self, id: Id) -> Vec<Id> {
+        match self.node(id) {
+            Node::Const(_) | Node::Var(_) => vec![],
+            Node::Add(a, b) | Node::Mul(a, b) | Node::Div(a, b) | Node::Powf(a, b) => vec![a, b],
+            Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) => vec![a],
+        }
+    }
+
+    /// Operation count of everything the roots need, shared nodes counted once.
+    pub fn op_count(&self, roots: &[Id]) -> OpCount {
+        let reachable = self.reachable(roots);
+        let mut count = OpCount::default();
+        for (i, node) in self.nodes.iter().enumerate() {
+            if !reachable[i] {
+                continue;
+            }
+            match node {
+                Node::Const(_) | Node::Var(_) => {}
+                Node::Add(..) => count.add_sub += 1,
+                Node::Neg(_) => {
+                    if !self.neg_absorbed(Id(i as u32), &reachable) {
+                        count.add_sub += 1
+                    }
+                }
+                Node::Mul(..) => count.mul += 1,
+                Node::Div(..) => count.div += 1,
+                Node::Call(Func::Sin | Func::Cos, _) => count.sin_cos += 1,
+                Node::Call(Func::Sqrt, _) => count.sqrt += 1,
+                Node::Powi(..) | Node::Powf(..) | Node::Call(..) => count.other += 1,
+            }
+        }
+        count
+    }
+
+    /// True when every use of the negation `id` is as an operand of an addition (where the
+    /// emitted code writes a subtraction instead).
+    fn neg_absorbed(&self, id: Id, reachable: &[bool]) -> bool {
+        let mut used = false;
+        for (i, node) in self.nodes.iter().enumerate().skip(id.index() + 1) {
+            if !reachable[i] {
+                continue;
+            }
+            let uses = self.children(Id(i as u32)).contains(&id);
+            if uses {
+                used = true;
+                if !matches!(node, Node::Add(..)) {
+                    return false;
+                }
+            }
+        }
+        used
+    }
+
+    /// Marks the nodes the roots depend on.
+    pub fn reachable(&self, roots: &[Id]) -> Vec<bool> {
+        let mut mark = vec![false; self.nodes.len()];
+        let mut stack: Vec<Id> = roots.to_vec();
+        while let Some(id) = stack.pop() {
+            if mark[id.index()] {
+                continue;
+            }
+            mark[id.index()] = true;
+            stack.extend(self.children(id));
+        }
+        mark
+    }
+}
+
+/// Numeric value of an elementary function.
+pub fn apply(f: Func, x: f64) -> f64 {
+    match f {
+        Func::Sin => x.sin(),
+        Func::Cos => x.cos(),
+        Func::Tan => x.tan(),
+        Func::Exp => x.exp(),
+        Func::Ln => x.ln(),
+        Func::Sqrt => x.sqrt(),
+        Func::Sinh => x.sinh(),
+        Func::Cosh => x.cosh(),
+        Func::Tanh => x.tanh(),
+        Func::Atan => x.atan(),
+    }
+}
+
+/// Method name of an elementary function in Rust.
+pub fn method_name(f: Func) -> &'static str {
+    match f {
+        Func::Sin => "sin",
+        Func::Cos => "cos",
+        Func::Tan => "tan",
+        Func::Exp => "exp",
+        Func::Ln => "ln",
+        Func::Sqrt => "sqrt",
+        Func::Sinh => "sinh",
+        Func::Cosh => "cosh",
+        Func::Tanh => "tanh",
+        Func::Atan => "atan",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn structural_zeros_and_units_vanish() {
+        let mut g = Graph::new();
+        let x = g.var("x");
+        let zero = g.zero();
+        let one = g.one();
+        assert_eq!(g.mul(zero, x), zero);
+        assert_eq!(g.mul(one, x), x);
+        assert_eq!(g.add(x, zero), x);
+        assert_eq!(g.sub(x, x), zero);
+        let nx = g.neg(x);
+        assert_eq!(g.neg(nx), x);
+        let before = g.len();
+        let s = g.sin(x);
+        let s2 = g.sin(x);
+        assert_eq!(s, s2, "hash-consing returns the same node");
+        assert_eq!(g.len(), before + 1);
+    }
+
+    #[test]
+    fn commutative_operands_are_shared() {
+        let mut g = Graph::new();
+        let (x, y) = (g.var("x"), g.var("y"));
+        assert_eq!(g.add(x, y), g.add(y, x));
+        assert_eq!(g.mul(x, y), g.mul(y, x));
+        let c2 = g.constant(2.0);
+        let c3 = g.constant(3.0);
+        let a = g.mul(c2, x);
+        let b = g.mul(c3, a);
+        let six = g.constant(6.0);
+        assert_eq!(b, g.mul(six, x), "constant factors merge");
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let mut g = Graph::new();
+        let x = g.var("x");
+        // e = sin(x)·x³ / (1 + x²) + exp(0.3x)·√x + atan(x)·tanh(x) + x^x
+        let s = g.sin(x);
+        let x3 = g.powi(x, 3);
+        let num = g.mul(s, x3);
+        let one = g.one();
+        let x2 = g.powi(x, 2);
+        let den = g.add(one, x2);
+        let t1 = g.div(num, den);
+        let c = g.constant(0.3);
+        let cx = g.mul(c, x);
+        let ex = g.call(Func::Exp, cx);
+        let sq = g.sqrt(x);
+        let t2 = g.mul(ex, sq);
+        let at = g.call(Func::Atan, x);
+        let th = g.call(Func::Tanh, x);
+        let t3 = g.mul(at, th);
+        let xx = g.powf(x, x);
+        let e = g.sum([t1, t2, t3, xx]);
+        let d = g.diff(e, x);
+        let d2 = g.diff(d, x);
+        for &x0 in &[0.4, 1.1, 2.3] {
+            let h = 1e-5;
+            let f = |v: f64| g.eval(&[e], &[v])[0];
+            let fd1 = (f(x0 + h) - f(x0 - h)) / (2.0 * h);
+            let fd2 = (f(x0 + h) - 2.0 * f(x0) + f(x0 - h)) / (h * h);
+            let [d1v, d2v] = [g.eval(&[d], &[x0])[0], g.eval(&[d2], &[x0])[0]];
+            // Central differences: truncation O(h²)≈1e-10 relative for the first derivative;
+            // the second difference loses ~eps/h² ≈ 2e-6 to rounding.
+            assert!(
+                (d1v - fd1).abs() < 1e-8 * (1.0 + fd1.abs()),
+                "{d1v} vs {fd1}"
+            );
+            assert!(
+                (d2v - fd2).abs() < 1e-4 * (1.0 + fd2.abs()),
+                "{d2v} vs {fd2}"
+            );
+        }
+    }
+
+    #[test]
+    fn substitution_composes() {
+        let mut g = Graph::new();
+        let (x, y) = (g.var("x"), g.var("y"));
+        let x2 = g.powi(x, 2);
+        let sy = g.sin(y);
+        let e = g.substitute(x2, x, sy);
+        let v = g.eval(&[e], &[0.0, 0.7])[0];
+        assert_eq!(v, 0.7f64.sin().powi(2));
+    }
+
+    #[test]
+    fn op_count_counts_shared_nodes_once() {
+        let mut g = Graph::new();
+        let (x, y) = (g.var("x"), g.var("y"));
+        let s = g.sin(x);
+        let p = g.mul(s, y);
+        let d = g.sub(p, s);
+        let count = g.op_count(&[d, p]);
+        assert_eq!(count.sin_cos, 1);
+        assert_eq!(count.mul, 1);
+        assert_eq!(
+            count.add_sub, 1,
+            "the negation is absorbed into a subtraction"
+        );
+    }
+}
