@@ -3,7 +3,7 @@
 //!
 //! They are parsed with `syn` into the small tree [`Scalar`], which the symbolic engine
 //! converts to its DAG (to differentiate and emit) and which the numeric reference evaluates
-//! with second-order forward-mode differentiation ([`Scalar::eval_jet`]), an independent route
+//! with second-order forward-mode differentiation (`camchain_runtime::jet::eval_jet`), an independent route
 //! to f, f' and f''.
 
 /// An elementary function allowed in a profile or drive expression.
