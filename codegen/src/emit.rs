@@ -942,23 +942,40 @@ fn id_at(g: &Graph, i: usize) -> Id {
     g.id_from_index(i)
 }
 
-/// Turns the section marker statements back into comments after formatting.
+/// Turns the section marker statements back into comments after formatting (prettyplease
+/// may have wrapped a long marker over several lines).
 fn restore_comments(code: &str) -> String {
-    let marker = format!("{SECTION_MACRO}!(\"");
+    let marker = format!("{SECTION_MACRO}!(");
     let mut out = String::with_capacity(code.len());
+    let mut pending: Option<(String, String)> = None;
     for line in code.lines() {
         let trimmed = line.trim_start();
+        if let Some((indent, mut text)) = pending.take() {
+            text.push_str(trimmed);
+            if trimmed.ends_with(");") {
+                push_comment(&mut out, &indent, &text);
+            } else {
+                pending = Some((indent, text));
+            }
+            continue;
+        }
         if let Some(rest) = trimmed.strip_prefix(&marker) {
-            let indent = &line[..line.len() - trimmed.len()];
-            let text = rest
-                .trim_end_matches(';')
-                .trim_end_matches(')')
-                .trim_end_matches('"');
-            let _ = writeln!(out, "{indent}// {text}");
+            let indent = line[..line.len() - trimmed.len()].to_string();
+            if rest.ends_with(");") {
+                push_comment(&mut out, &indent, rest);
+            } else {
+                pending = Some((indent, rest.to_string()));
+            }
         } else {
             out.push_str(line);
             out.push('\n');
         }
     }
     out
+}
+
+/// Writes `// text` for a marker's argument `"text");`.
+fn push_comment(out: &mut String, indent: &str, argument: &str) {
+    let text = argument.trim_end_matches(';').trim_end_matches(')').trim().trim_matches('"');
+    let _ = writeln!(out, "{indent}// {text}");
 }
