@@ -976,6 +976,10 @@ fn restore_comments(code: &str) -> String {
 
 /// Writes `// text` for a marker's argument `"text");`.
 fn push_comment(out: &mut String, indent: &str, argument: &str) {
-    let text = argument.trim_end_matches(';').trim_end_matches(')').trim().trim_matches('"');
+    let text = argument
+        .trim_end_matches(';')
+        .trim_end_matches(')')
+        .trim()
+        .trim_matches('"');
     let _ = writeln!(out, "{indent}// {text}");
 }

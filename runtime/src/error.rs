@@ -1,1 +1,154 @@
-//! (Being written.)
+//! Simulation errors. Every variant that can occur during a run carries the time and, where
+//! it helps to diagnose the failure, the generalised coordinates at which it happened.
+
+use std::fmt;
+
+/// Why assembly, a step or a simulation could not continue.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// Newton's method on the dependent coordinates, eq. (15), did not converge: the
+    /// contact point cannot reach the cam for the current independent (and driven)
+    /// coordinates, or the iteration started too far from the solution.
+    #[error(
+        "at t = {t} s the contact point cannot reach the cam: Newton on the dependent \
+         coordinates (15) stopped after {iterations} iterations with |h|∞ = {residual:.3e} \
+         at q = {}",
+        Compact(.q)
+    )]
+    NewtonFailed {
+        /// Time (s).
+        t: f64,
+        /// Coordinates at the last Newton iterate.
+        q: Vec<f64>,
+        /// max_k |h_k(q)| at the last iterate (m).
+        residual: f64,
+        /// Newton corrections performed.
+        iterations: usize,
+    },
+
+    /// The constraint Jacobian J (5b) has no usable column: no set of eligible coordinates
+    /// gives an invertible J_v, so the dependent coordinates cannot be chosen or solved.
+    #[error(
+        "at t = {t} s the constraint Jacobian J (5b) has no usable column for the dependent \
+         coordinates (J_v singular) at q = {}",
+        Compact(.q)
+    )]
+    SingularConstraint {
+        /// Time (s).
+        t: f64,
+        /// Coordinates.
+        q: Vec<f64>,
+    },
+
+    /// The reduced mass matrix M* of eq. (18) is not positive definite (an invalid model:
+    /// zero or negative inertia along some admissible motion).
+    #[error(
+        "at t = {t} s the reduced mass matrix M* (18) is not positive definite at q = {}",
+        Compact(.q)
+    )]
+    NotPositiveDefinite {
+        /// Time (s).
+        t: f64,
+        /// Coordinates.
+        q: Vec<f64>,
+    },
+
+    /// A computed quantity is NaN or infinite.
+    #[error(
+        "at t = {t} s {quantity} is not finite; q = {}, q̇ = {}",
+        Compact(.q),
+        Compact(.qd)
+    )]
+    NonFinite {
+        /// Time (s).
+        t: f64,
+        /// Which quantity, e.g. `"q̈"`, `"λ"`, `"h"`.
+        quantity: &'static str,
+        /// Coordinates.
+        q: Vec<f64>,
+        /// Velocities.
+        qd: Vec<f64>,
+    },
+
+    /// The adaptive integrator needed a step below its floor to meet the tolerances.
+    #[error(
+        "at t = {t} s the step size fell to {h:.3e} s, below the floor: the tolerances \
+         cannot be met (stiff or non-smooth motion?)"
+    )]
+    StepSizeTooSmall {
+        /// Time (s).
+        t: f64,
+        /// The rejected step size (s).
+        h: f64,
+    },
+
+    /// The step budget of one call was exhausted.
+    #[error("at t = {t} s the step budget of one call was exhausted")]
+    TooManySteps {
+        /// Time (s).
+        t: f64,
+    },
+
+    /// Settings, initial data or a requested partition are invalid.
+    #[error("invalid settings: {message}")]
+    InvalidSettings {
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Compact display of a vector: `[0.1, -1.570796, 2.5e-7]` (7 significant digits at most,
+/// trailing zeros dropped).
+pub(crate) struct Compact<'a>(pub(crate) &'a [f64]);
+
+impl fmt::Display for Compact<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("[")?;
+        for (i, &x) in self.0.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            write_compact(f, x)?;
+        }
+        f.write_str("]")
+    }
+}
+
+fn write_compact(f: &mut fmt::Formatter<'_>, x: f64) -> fmt::Result {
+    let magnitude = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        write!(f, "{x}")
+    } else if (1e-4..1e6).contains(&magnitude) {
+        let fixed = format!("{x:.6}");
+        let trimmed = fixed.trim_end_matches('0').trim_end_matches('.');
+        f.write_str(trimmed)
+    } else {
+        write!(f, "{x:.3e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_print_compactly() {
+        let text = Compact(&[0.0, -1.2345678901, 2.5e-7, 3.0, f64::NAN]).to_string();
+        assert_eq!(text, "[0, -1.234568, 2.500e-7, 3, NaN]");
+    }
+
+    #[test]
+    fn newton_failure_names_time_state_and_cause() {
+        let error = SimError::NewtonFailed {
+            t: 1.25,
+            q: vec![0.5, -2.0],
+            residual: 0.125,
+            iterations: 25,
+        };
+        let text = error.to_string();
+        assert!(text.contains("t = 1.25 s"), "{text}");
+        assert!(text.contains("cannot reach the cam"), "{text}");
+        assert!(text.contains("[0.5, -2]"), "{text}");
+        assert!(text.contains("25 iterations"), "{text}");
+    }
+}

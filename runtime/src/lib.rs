@@ -20,5 +20,5 @@ pub mod reference;
 pub mod simulate;
 
 pub use dynamics::*;
-// pub use error::SimError;
-// pub use simulate::{Sample, Simulate, State, Stats, Trajectory};
+pub use error::SimError;
+pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};

@@ -1,1 +1,1133 @@
-//! (Being written.)
+//! Generalised coordinate partitioning (Haug & Yen) and the reduced dynamics, eqs. (15)–(18).
+//!
+//! The coordinates are split into driven ones d (prescribed functions of time), independent
+//! ones u (integrated) and dependent ones v (one per contact, recovered from the
+//! constraints). With the constraint `h(q) = 0` (3), its Jacobian J (5b) and the bias c of
+//! `J q̈ + c = 0` (7, 8):
+//!
+//! - positions (15): v solves h(q_d, u, v) = 0 (Newton on v);
+//! - velocities (16): v̇ = −J_v⁻¹ (J_u u̇ + J_d q̇_d);
+//! - accelerations (16): q̈ = T ü + g, with T (n × nu) = identity on the u rows,
+//!   B = −J_v⁻¹ J_u on the v rows, 0 on the d rows, and g = 0 on u, b = −J_v⁻¹ (c + J_d q̈_d)
+//!   on v, q̈_d on d;
+//! - dynamics (17, 18): premultiplying `M q̈ + F + Q + Jᵀλ = τ` (14) by Tᵀ removes λ (since
+//!   J T = J_u + J_v B = 0) and the drive loads τ (zero on the u and v rows, where Tᵀ
+//!   reads):  (Tᵀ M T) ü = −Tᵀ (M g + F + Q).
+//!
+//! Everything works in a preallocated [`Workspace`]; no step allocates.
+
+use crate::dynamics::Dynamics;
+use crate::error::SimError;
+
+/// Re-partition threshold on [`conditioning`]: the dependent coordinates are re-chosen after
+/// a step when the ratio falls below it.
+///
+/// Why 0.2: the entries of B = −J_v⁻¹ J_u (one contact) are bounded by ‖J‖/|J_v| = 1/ratio,
+/// so 0.2 keeps the amplification of u̇ into v̇ (16), and of Newton's start error (15), below
+/// 5. On the other side, for one contact the greedy choice always yields |J_v| ≥ ‖J‖/√n_e
+/// (the largest of n_e entries is at least their RMS), i.e. a ratio ≥ 0.2 for up to 25
+/// eligible coordinates: a fresh partition does not immediately fall below the threshold
+/// again, so the switch has hysteresis and cannot chatter (and a switch is made only when
+/// it improves the ratio). Waiting until the ratio is much smaller would let Newton (15)
+/// lose accuracy and the step size drop near J_v = 0.
+pub const REPARTITION_RATIO: f64 = 0.2;
+
+/// Newton (15) converges when max_k |h_k| is at most this (m, or rad for angular
+/// constraints): 1e-12 is ~10⁴ times the round-off of h for coordinates of order 1.
+pub const NEWTON_RESIDUAL_TOLERANCE: f64 = 1e-12;
+
+/// Newton (15) also requires its last correction to be at most this times (1 + ‖v‖∞).
+pub const NEWTON_STEP_TOLERANCE: f64 = 1e-12;
+
+/// Newton (15) gives up after this many corrections.
+pub const NEWTON_MAX_ITERATIONS: usize = 25;
+
+/// Damped Newton (assembly fallback) gives up after this many corrections.
+const DAMPED_MAX_ITERATIONS: usize = 200;
+
+/// Smallest step fraction tried by the damped Newton's backtracking.
+const DAMPED_MIN_FRACTION: f64 = 1e-10;
+
+/// Pivots below this fraction of max |J_ij| count as zero when choosing the dependent
+/// coordinates: such a column would amplify round-off by more than 10¹².
+const NEGLIGIBLE_PIVOT: f64 = 1e-12;
+
+/// Chooses the dependent coordinates: nc column indices of the row-major nc×n Jacobian `j`,
+/// among the `eligible` ones, such that J_v is well conditioned.
+///
+/// For one contact, the eligible column with the largest |J_i|; for several, greedy
+/// Gaussian elimination with complete pivoting restricted to the eligible columns (each
+/// pivot is the largest remaining entry; its column becomes dependent). Returns the indices
+/// in increasing order, or `None` when no eligible set gives an invertible J_v (a pivot is
+/// zero, negligible, or J is not finite).
+pub fn choose_dependent(j: &[f64], nc: usize, n: usize, eligible: &[bool]) -> Option<Vec<usize>> {
+    let scale = j.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if !scale.is_finite() || j.iter().any(|x| x.is_nan()) {
+        return None;
+    }
+    let mut a = j.to_vec();
+    let mut row_done = vec![false; nc];
+    let mut column_used = vec![false; n];
+    let mut chosen = Vec::with_capacity(nc);
+    for _ in 0..nc {
+        let (row, column, pivot) = largest_entry(&a, n, &row_done, &column_used, eligible)?;
+        if pivot.abs() <= NEGLIGIBLE_PIVOT * scale {
+            return None;
+        }
+        eliminate_column(&mut a, n, row, column, &row_done);
+        row_done[row] = true;
+        column_used[column] = true;
+        chosen.push(column);
+    }
+    chosen.sort_unstable();
+    Some(chosen)
+}
+
+/// Largest |a_rc| over rows not done and eligible, unused columns (first one on ties).
+fn largest_entry(
+    a: &[f64],
+    n: usize,
+    row_done: &[bool],
+    column_used: &[bool],
+    eligible: &[bool],
+) -> Option<(usize, usize, f64)> {
+    let mut best: Option<(usize, usize, f64)> = None;
+    for (r, _) in row_done.iter().enumerate().filter(|(_, done)| !**done) {
+        for c in (0..n).filter(|&c| eligible[c] && !column_used[c]) {
+            let value = a[r * n + c];
+            if best.is_none_or(|(_, _, b)| value.abs() > b.abs()) {
+                best = Some((r, c, value));
+            }
+        }
+    }
+    best
+}
+
+/// Subtracts multiples of the pivot row from the other open rows to zero the pivot column.
+fn eliminate_column(a: &mut [f64], n: usize, pivot_row: usize, column: usize, row_done: &[bool]) {
+    let pivot = a[pivot_row * n + column];
+    for r in (0..row_done.len()).filter(|&r| r != pivot_row && !row_done[r]) {
+        let factor = a[r * n + column] / pivot;
+        for c in 0..n {
+            a[r * n + c] -= factor * a[pivot_row * n + c];
+        }
+    }
+}
+
+/// Conditioning of a partition, in [0, 1]: for one contact |J_v| / ‖J_eligible‖₂; for
+/// several the Hadamard ratio |det J_v| / Π_k ‖(row k of J)_eligible‖₂. 1 means J_v carries
+/// the whole constraint gradient; 0 means J_v is singular. Returns 1 without contacts.
+pub fn conditioning(j: &[f64], nc: usize, n: usize, dependent: &[usize], eligible: &[bool]) -> f64 {
+    if nc == 0 {
+        return 1.0;
+    }
+    let mut row_norms = 1.0;
+    for row in (0..nc).map(|k| &j[k * n..(k + 1) * n]) {
+        let squares: f64 = (0..n)
+            .filter(|&i| eligible[i])
+            .map(|i| row[i] * row[i])
+            .sum();
+        row_norms *= squares.sqrt();
+    }
+    let ratio = dependent_determinant(j, nc, n, dependent).abs() / row_norms;
+    if ratio.is_finite() { ratio } else { 0.0 }
+}
+
+/// det J_v (nc ≤ 4 without allocating).
+fn dependent_determinant(j: &[f64], nc: usize, n: usize, dependent: &[usize]) -> f64 {
+    if nc == 1 {
+        return j[dependent[0]];
+    }
+    let mut stack = [0.0; 16];
+    let mut pivots_stack = [0; 4];
+    let mut heap = Vec::new();
+    let mut heap_pivots = Vec::new();
+    let (a, pivots) = if nc <= 4 {
+        (&mut stack[..nc * nc], &mut pivots_stack[..nc])
+    } else {
+        heap.resize(nc * nc, 0.0);
+        heap_pivots.resize(nc, 0);
+        (&mut heap[..], &mut heap_pivots[..])
+    };
+    gather_columns(j, n, dependent, a);
+    if lu_factor(a, pivots, nc) {
+        lu_determinant(a, pivots, nc)
+    } else {
+        0.0
+    }
+}
+
+/// `out` (nc×nc, row-major) = the columns `columns` of the nc×n matrix `j`.
+fn gather_columns(j: &[f64], n: usize, columns: &[usize], out: &mut [f64]) {
+    let nc = columns.len();
+    for k in 0..nc {
+        for (l, &column) in columns.iter().enumerate() {
+            out[k * nc + l] = j[k * n + column];
+        }
+    }
+}
+
+/// Contact normal force from the multiplier λ_k and the profile slope f3' under the point.
+///
+/// The constraint's generalised force enters (14) as +Jᵀλ on the left, i.e. the cam applies
+/// −Jᵀλ. With J = ∇_p h · J_A, where J_A = [J1; J2] is the point's Jacobian and
+/// ∇_p h = (−f3', 1) the gradient of h = y − f3(x) w.r.t. the point position, −Jᵀλ = J_Aᵀ P
+/// with the Cartesian contact force P = −λ ∇_p h = −λ √(1 + f3'²) n̂, where
+/// n̂ = (−f3', 1)/√(1 + f3'²) is the unit normal of the profile pointing to +y. Hence
+/// N = P·n̂ = −λ √(1 + f3'²), positive when the cam pushes the point towards +y.
+pub fn normal_force(lambda: f64, slope: f64) -> f64 {
+    -lambda * (1.0 + slope * slope).sqrt()
+}
+
+/// The split of the coordinates into driven, independent and dependent sets.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Partition {
+    contacts: usize,
+    driven: Vec<usize>,
+    independent: Vec<usize>,
+    dependent: Vec<usize>,
+    eligible: Vec<bool>,
+}
+
+impl Partition {
+    /// Partition with `driven_flags[i]` true for the driven coordinates and the given
+    /// dependent ones; every other coordinate is independent (in increasing order, which is
+    /// the order of u in the integrated state).
+    pub fn new(driven_flags: &[bool], dependent: &[usize]) -> Result<Self, SimError> {
+        let mut partition = Self {
+            contacts: dependent.len(),
+            driven: (0..driven_flags.len())
+                .filter(|&i| driven_flags[i])
+                .collect(),
+            independent: Vec::with_capacity(driven_flags.len()),
+            dependent: Vec::with_capacity(dependent.len()),
+            eligible: driven_flags.iter().map(|d| !d).collect(),
+        };
+        partition.set_dependent(dependent)?;
+        Ok(partition)
+    }
+
+    /// Replaces the dependent set (same size: one per contact); the independent set follows.
+    /// Fails when an index is out of range, repeated or driven.
+    pub fn set_dependent(&mut self, dependent: &[usize]) -> Result<(), SimError> {
+        self.validate_dependent(dependent)?;
+        self.dependent.clear();
+        self.dependent.extend_from_slice(dependent);
+        self.independent.clear();
+        let n = self.eligible.len();
+        let is_free = |i: &usize| self.eligible[*i] && !dependent.contains(i);
+        self.independent.extend((0..n).filter(is_free));
+        Ok(())
+    }
+
+    fn validate_dependent(&self, dependent: &[usize]) -> Result<(), SimError> {
+        let n = self.eligible.len();
+        let invalid = |message: String| Err(SimError::InvalidSettings { message });
+        if dependent.len() != self.contacts {
+            return invalid(format!(
+                "{} dependent coordinates given, the model has {} contacts",
+                dependent.len(),
+                self.contacts
+            ));
+        }
+        for (k, &i) in dependent.iter().enumerate() {
+            if i >= n || !self.eligible[i] || dependent[..k].contains(&i) {
+                return invalid(format!(
+                    "dependent coordinate {i} is out of range, driven or repeated"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of coordinates.
+    pub fn n(&self) -> usize {
+        self.eligible.len()
+    }
+
+    /// Driven coordinates d (increasing).
+    pub fn driven(&self) -> &[usize] {
+        &self.driven
+    }
+
+    /// Independent coordinates u (increasing): the integrated ones.
+    pub fn independent(&self) -> &[usize] {
+        &self.independent
+    }
+
+    /// Dependent coordinates v, one per contact: recovered by (15), (16).
+    pub fn dependent(&self) -> &[usize] {
+        &self.dependent
+    }
+
+    /// `eligible()[i]`: coordinate i may be dependent (it is not driven).
+    pub fn eligible(&self) -> &[bool] {
+        &self.eligible
+    }
+}
+
+/// Preallocated buffers for the partitioned dynamics of one model (n coordinates, nc
+/// contacts, nu independent coordinates). The kernels below read and write the full state
+/// `q`, `q̇`, `q̈` held here.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    n: usize,
+    nc: usize,
+    nu: usize,
+    pub(crate) q: Vec<f64>,
+    pub(crate) qd: Vec<f64>,
+    pub(crate) qdd: Vec<f64>,
+    /// v at the last accepted step: Newton's restart point.
+    pub(crate) v_anchor: Vec<f64>,
+    mass: Vec<f64>,
+    inertial: Vec<f64>,
+    applied: Vec<f64>,
+    residual: Vec<f64>,
+    pub(crate) jacobian: Vec<f64>,
+    bias: Vec<f64>,
+    pub(crate) h: Vec<f64>,
+    jv_lu: Vec<f64>,
+    pivots: Vec<usize>,
+    scratch: Vec<f64>,
+    saved_v: Vec<f64>,
+    b_matrix: Vec<f64>,
+    b_vector: Vec<f64>,
+    mass_t: Vec<f64>,
+    reduced_mass: Vec<f64>,
+    udd: Vec<f64>,
+    pub(crate) lambda: Vec<f64>,
+    pub(crate) drive: Vec<f64>,
+}
+
+impl Workspace {
+    /// Buffers for n coordinates, nc contacts and nu independent coordinates.
+    pub fn new(n: usize, nc: usize, nu: usize) -> Self {
+        Self {
+            n,
+            nc,
+            nu,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            v_anchor: vec![0.0; nc],
+            mass: vec![0.0; n * n],
+            inertial: vec![0.0; n],
+            applied: vec![0.0; n],
+            residual: vec![0.0; n],
+            jacobian: vec![0.0; nc * n],
+            bias: vec![0.0; nc],
+            h: vec![0.0; nc],
+            jv_lu: vec![0.0; nc * nc],
+            pivots: vec![0; nc],
+            scratch: vec![0.0; nc],
+            saved_v: vec![0.0; nc],
+            b_matrix: vec![0.0; nc * nu],
+            b_vector: vec![0.0; nc],
+            mass_t: vec![0.0; n * nu],
+            reduced_mass: vec![0.0; nu * nu],
+            udd: vec![0.0; nu],
+            lambda: vec![0.0; nc],
+            drive: vec![0.0; n],
+        }
+    }
+
+    /// Coordinates q.
+    pub fn q(&self) -> &[f64] {
+        &self.q
+    }
+
+    /// Velocities q̇.
+    pub fn qd(&self) -> &[f64] {
+        &self.qd
+    }
+
+    /// Accelerations q̈ (after [`Self::solve_accelerations`]).
+    pub fn qdd(&self) -> &[f64] {
+        &self.qdd
+    }
+
+    /// Multipliers λ (after [`Self::solve_multipliers`]).
+    pub fn lambda(&self) -> &[f64] {
+        &self.lambda
+    }
+
+    /// Drive loads τ, zero on free coordinates (after [`Self::solve_multipliers`]).
+    pub fn drive(&self) -> &[f64] {
+        &self.drive
+    }
+
+    /// Sets q and q̇ (e.g. before the kernels, with consistent values).
+    pub fn set_state(&mut self, q: &[f64], qd: &[f64]) {
+        self.q.copy_from_slice(q);
+        self.qd.copy_from_slice(qd);
+    }
+
+    /// Eq. (15): Newton on the dependent coordinates, v ← v − J_v⁻¹ h(q), from the v held
+    /// in `q`. Converged when max |h| ≤ [`NEWTON_RESIDUAL_TOLERANCE`] and the last
+    /// correction ≤ [`NEWTON_STEP_TOLERANCE`]·(1 + ‖v‖∞); at most
+    /// [`NEWTON_MAX_ITERATIONS`] corrections. Returns the number of corrections.
+    pub fn solve_positions<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        dependent: &[usize],
+        t: f64,
+    ) -> Result<usize, SimError> {
+        let mut last_correction = 0.0;
+        let mut iterations = 0;
+        loop {
+            let residual = self.constraint_residual(model, t)?;
+            if self.converged(residual, last_correction, dependent) {
+                return Ok(iterations);
+            }
+            if iterations == NEWTON_MAX_ITERATIONS {
+                return Err(self.newton_failure(t, residual, iterations));
+            }
+            self.factor_jacobian_for_newton(model, dependent, t, residual, iterations)?;
+            last_correction = self.newton_correction(dependent);
+            iterations += 1;
+        }
+    }
+
+    /// Assembly fallback for (15): Newton with backtracking on ‖h‖₂ (Armijo condition),
+    /// for starting points where plain Newton overshoots.
+    pub fn solve_positions_damped<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        dependent: &[usize],
+        t: f64,
+    ) -> Result<usize, SimError> {
+        let mut last_correction = 0.0;
+        let mut iterations = 0;
+        loop {
+            let residual = self.constraint_residual(model, t)?;
+            if self.converged(residual, last_correction, dependent) {
+                return Ok(iterations);
+            }
+            if iterations == DAMPED_MAX_ITERATIONS {
+                return Err(self.newton_failure(t, residual, iterations));
+            }
+            self.factor_jacobian_for_newton(model, dependent, t, residual, iterations)?;
+            last_correction = self.backtracking_step(model, dependent, t, residual, iterations)?;
+            iterations += 1;
+        }
+    }
+
+    /// One damped Newton step v ← v − α J_v⁻¹ h, halving α from 1 until ‖h‖₂ decreases
+    /// (Armijo) or |h| meets the tolerance; returns the size of the correction made.
+    fn backtracking_step<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        dependent: &[usize],
+        t: f64,
+        residual: f64,
+        iterations: usize,
+    ) -> Result<f64, SimError> {
+        let norm = euclidean(&self.h);
+        self.scratch.copy_from_slice(&self.h);
+        lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        for (saved, &v) in self.saved_v.iter_mut().zip(dependent) {
+            *saved = self.q[v];
+        }
+        let mut fraction = 1.0;
+        while fraction >= DAMPED_MIN_FRACTION {
+            for ((&saved, &dv), &v) in self.saved_v.iter().zip(&self.scratch).zip(dependent) {
+                self.q[v] = saved - fraction * dv;
+            }
+            model.constraint(&self.q, &mut self.h);
+            let trial = euclidean(&self.h);
+            let small = max_abs(&self.h) <= NEWTON_RESIDUAL_TOLERANCE;
+            if trial.is_finite() && (small || trial < (1.0 - 1e-4 * fraction) * norm) {
+                return Ok(fraction * max_abs(&self.scratch));
+            }
+            fraction *= 0.5;
+        }
+        for (&saved, &v) in self.saved_v.iter().zip(dependent) {
+            self.q[v] = saved;
+        }
+        Err(self.newton_failure(t, residual, iterations))
+    }
+
+    /// [`Self::factor_jacobian`] inside Newton: a singular J_v at an iterate means that
+    /// Newton cannot go on (typically the point has been asked to go where the cam is
+    /// not), reported as [`SimError::NewtonFailed`].
+    fn factor_jacobian_for_newton<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        dependent: &[usize],
+        t: f64,
+        residual: f64,
+        iterations: usize,
+    ) -> Result<(), SimError> {
+        match self.factor_jacobian(model, dependent, t) {
+            Err(SimError::SingularConstraint { .. }) => {
+                Err(self.newton_failure(t, residual, iterations))
+            }
+            other => other,
+        }
+    }
+
+    /// Evaluates h at q; returns max |h|.
+    fn constraint_residual<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        t: f64,
+    ) -> Result<f64, SimError> {
+        model.constraint(&self.q, &mut self.h);
+        let residual = max_abs(&self.h);
+        if residual.is_finite() {
+            Ok(residual)
+        } else {
+            Err(self.non_finite(t, "h"))
+        }
+    }
+
+    fn converged(&self, residual: f64, last_correction: f64, dependent: &[usize]) -> bool {
+        let v_size = dependent
+            .iter()
+            .fold(0.0_f64, |m, &v| m.max(self.q[v].abs()));
+        residual <= NEWTON_RESIDUAL_TOLERANCE
+            && last_correction <= NEWTON_STEP_TOLERANCE * (1.0 + v_size)
+    }
+
+    /// v ← v − J_v⁻¹ h (J_v factored, h evaluated); returns the correction's size.
+    fn newton_correction(&mut self, dependent: &[usize]) -> f64 {
+        self.scratch.copy_from_slice(&self.h);
+        lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        for (&dv, &v) in self.scratch.iter().zip(dependent) {
+            self.q[v] -= dv;
+        }
+        max_abs(&self.scratch)
+    }
+
+    fn newton_failure(&self, t: f64, residual: f64, iterations: usize) -> SimError {
+        SimError::NewtonFailed {
+            t,
+            q: self.q.clone(),
+            residual,
+            iterations,
+        }
+    }
+
+    pub(crate) fn non_finite(&self, t: f64, quantity: &'static str) -> SimError {
+        SimError::NonFinite {
+            t,
+            quantity,
+            q: self.q.clone(),
+            qd: self.qd.clone(),
+        }
+    }
+
+    /// Evaluates J(q) (5b) and factors J_v (the `dependent` columns).
+    pub fn factor_jacobian<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        dependent: &[usize],
+        t: f64,
+    ) -> Result<(), SimError> {
+        model.constraint_jacobian(&self.q, &mut self.jacobian);
+        if self.jacobian.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "J"));
+        }
+        gather_columns(&self.jacobian, self.n, dependent, &mut self.jv_lu);
+        if lu_factor(&mut self.jv_lu, &mut self.pivots, self.nc) {
+            Ok(())
+        } else {
+            Err(SimError::SingularConstraint {
+                t,
+                q: self.q.clone(),
+            })
+        }
+    }
+
+    /// Eq. (16), velocity level: v̇ = −J_v⁻¹ (J_u u̇ + J_d q̇_d), i.e. the v̇ making J q̇ = 0.
+    /// Needs [`Self::factor_jacobian`] at the current q.
+    pub fn solve_velocities(&mut self, dependent: &[usize]) {
+        for &v in dependent {
+            self.qd[v] = 0.0;
+        }
+        for k in 0..self.nc {
+            let row = &self.jacobian[k * self.n..(k + 1) * self.n];
+            self.scratch[k] = -dot(row, &self.qd);
+        }
+        lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        for (&vd, &v) in self.scratch.iter().zip(dependent) {
+            self.qd[v] = vd;
+        }
+    }
+
+    /// Eqs. (16)–(18): evaluates M, F, Q and c at (t, q, q̇) and solves the reduced dynamics
+    /// for ü; writes q̈ = T ü + g. Needs [`Self::factor_jacobian`] at the current q and q̈_d
+    /// in the driven entries of q̈ (from [`Dynamics::prescribed`]).
+    pub fn solve_accelerations<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        partition: &Partition,
+        t: f64,
+    ) -> Result<(), SimError> {
+        model.mass_matrix(&self.q, &mut self.mass);
+        model.inertial_forces(&self.q, &self.qd, &mut self.inertial);
+        model.applied_forces(t, &self.q, &self.qd, &mut self.applied);
+        model.constraint_bias(&self.q, &self.qd, &mut self.bias);
+        self.reduce_and_solve(partition, t)
+    }
+
+    /// The linear algebra of (16)–(18) on M, F, Q, J, c already in the workspace.
+    fn reduce_and_solve(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
+        self.eliminate_dependent(partition);
+        self.set_particular_acceleration(partition);
+        self.project_dynamics(partition);
+        if !cholesky_factor(&mut self.reduced_mass, self.nu) {
+            return Err(self.not_positive_definite(t));
+        }
+        cholesky_solve(&self.reduced_mass, self.nu, &mut self.udd);
+        self.expand_accelerations(partition);
+        if self.qdd.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "q̈"));
+        }
+        Ok(())
+    }
+
+    fn not_positive_definite(&self, t: f64) -> SimError {
+        if self.reduced_mass.iter().any(|x| !x.is_finite()) {
+            self.non_finite(t, "M")
+        } else {
+            SimError::NotPositiveDefinite {
+                t,
+                q: self.q.clone(),
+            }
+        }
+    }
+
+    /// B = −J_v⁻¹ J_u (nc×nu, row-major) and b = −J_v⁻¹ (c + J_d q̈_d), eq. (16).
+    fn eliminate_dependent(&mut self, partition: &Partition) {
+        let (n, nc, nu) = (self.n, self.nc, self.nu);
+        for k in 0..nc {
+            let row = &self.jacobian[k * n..(k + 1) * n];
+            let driven: f64 = partition
+                .driven()
+                .iter()
+                .map(|&d| row[d] * self.qdd[d])
+                .sum();
+            self.b_vector[k] = -(self.bias[k] + driven);
+        }
+        lu_solve(&self.jv_lu, &self.pivots, nc, &mut self.b_vector);
+        for (a, &u) in partition.independent().iter().enumerate() {
+            for k in 0..nc {
+                self.scratch[k] = -self.jacobian[k * n + u];
+            }
+            lu_solve(&self.jv_lu, &self.pivots, nc, &mut self.scratch);
+            for k in 0..nc {
+                self.b_matrix[k * nu + a] = self.scratch[k];
+            }
+        }
+    }
+
+    /// q̈ ← g: 0 on u, b on v; q̈_d stays on d.
+    fn set_particular_acceleration(&mut self, partition: &Partition) {
+        for &u in partition.independent() {
+            self.qdd[u] = 0.0;
+        }
+        for (&b, &v) in self.b_vector.iter().zip(partition.dependent()) {
+            self.qdd[v] = b;
+        }
+    }
+
+    /// Reduced mass Tᵀ M T (lower triangle, into `reduced_mass`) and right-hand side
+    /// −Tᵀ (M g + F + Q) (into `udd`).
+    ///
+    /// This is the paper's (18): with T = [I; B] on (u, v) and g = [0; b] (no driven
+    /// coordinates), Tᵀ M T = M_uu + M_uv B + Bᵀ M_vu + Bᵀ M_vv B = M*, and
+    /// Tᵀ (M g + F + Q) = F_u + M_uv b + Bᵀ (F_v + M_vv b) + Q_u + Bᵀ Q_v = F* + Q*, so the
+    /// system reads M* ü + F* + Q* = 0 (checked against the explicit formulas in a test).
+    /// Driven coordinates only add M_·d q̈_d to g's contribution and J_d q̈_d to b.
+    fn project_dynamics(&mut self, partition: &Partition) {
+        residual_into(
+            &mut self.residual,
+            &self.mass,
+            &self.qdd,
+            &self.inertial,
+            &self.applied,
+        );
+        self.multiply_mass_by_t(partition);
+        self.project_on_t(partition);
+    }
+
+    /// `mass_t` = M T (n×nu): column a is M[:, u_a] + Σ_k M[:, v_k] B[k, a].
+    fn multiply_mass_by_t(&mut self, partition: &Partition) {
+        let (n, nu) = (self.n, self.nu);
+        for i in 0..n {
+            let row = &self.mass[i * n..(i + 1) * n];
+            for (a, &u) in partition.independent().iter().enumerate() {
+                let coupling: f64 = (partition.dependent().iter().enumerate())
+                    .map(|(k, &v)| row[v] * self.b_matrix[k * nu + a])
+                    .sum();
+                self.mass_t[i * nu + a] = row[u] + coupling;
+            }
+        }
+    }
+
+    /// Lower triangle of Tᵀ (M T) into `reduced_mass`, −Tᵀ (M g + F + Q) into `udd`.
+    fn project_on_t(&mut self, partition: &Partition) {
+        let nu = self.nu;
+        let dependent = partition.dependent();
+        for (a, &u) in partition.independent().iter().enumerate() {
+            let b_column = |k: usize| self.b_matrix[k * nu + a];
+            for b in 0..=a {
+                let coupling: f64 = (dependent.iter().enumerate())
+                    .map(|(k, &v)| b_column(k) * self.mass_t[v * nu + b])
+                    .sum();
+                self.reduced_mass[a * nu + b] = self.mass_t[u * nu + b] + coupling;
+            }
+            let coupling: f64 = (dependent.iter().enumerate())
+                .map(|(k, &v)| b_column(k) * self.residual[v])
+                .sum();
+            self.udd[a] = -(self.residual[u] + coupling);
+        }
+    }
+
+    /// q̈ = T ü + g.
+    fn expand_accelerations(&mut self, partition: &Partition) {
+        let nu = self.nu;
+        for (&udd, &u) in self.udd.iter().zip(partition.independent()) {
+            self.qdd[u] = udd;
+        }
+        for (k, &v) in partition.dependent().iter().enumerate() {
+            let row = &self.b_matrix[k * nu..(k + 1) * nu];
+            self.qdd[v] += dot(row, &self.udd);
+        }
+    }
+
+    /// Multipliers and drive loads from (14), after [`Self::solve_accelerations`]:
+    /// J_vᵀ λ = −(M q̈ + F + Q)_v, then τ_d = (M q̈ + F + Q + Jᵀλ)_d (zero elsewhere).
+    pub fn solve_multipliers(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
+        residual_into(
+            &mut self.residual,
+            &self.mass,
+            &self.qdd,
+            &self.inertial,
+            &self.applied,
+        );
+        for (lambda, &v) in self.lambda.iter_mut().zip(partition.dependent()) {
+            *lambda = -self.residual[v];
+        }
+        lu_solve_transposed(&self.jv_lu, &self.pivots, self.nc, &mut self.lambda);
+        if self.lambda.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "λ"));
+        }
+        self.drive.fill(0.0);
+        for &d in partition.driven() {
+            let constraint: f64 = (0..self.nc)
+                .map(|k| self.jacobian[k * self.n + d] * self.lambda[k])
+                .sum();
+            self.drive[d] = self.residual[d] + constraint;
+        }
+        if self.drive.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "drive load"));
+        }
+        Ok(())
+    }
+
+    /// Power of the drive loads Σ τ_d q̇_d (after [`Self::solve_multipliers`]).
+    pub fn drive_power(&self, partition: &Partition) -> f64 {
+        partition
+            .driven()
+            .iter()
+            .map(|&d| self.drive[d] * self.qd[d])
+            .sum()
+    }
+}
+
+/// `out = M x + F + Q`.
+fn residual_into(out: &mut [f64], mass: &[f64], x: &[f64], inertial: &[f64], applied: &[f64]) {
+    let n = out.len();
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = dot(&mass[i * n..(i + 1) * n], x) + inertial[i] + applied[i];
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(
+        0.0_f64,
+        |m, v| if v.is_nan() { f64::NAN } else { m.max(v.abs()) },
+    )
+}
+
+fn euclidean(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// In-place LU factorisation with partial pivoting of the n×n row-major `a` (P A = L U, L
+/// unit lower, both stored in `a`; `pivots[k]` is the row swapped with row k at step k).
+/// Returns false when a pivot is zero or not finite.
+fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize) -> bool {
+    for k in 0..n {
+        let p = (k..n).fold(k, |best, r| {
+            if a[r * n + k].abs() > a[best * n + k].abs() {
+                r
+            } else {
+                best
+            }
+        });
+        pivots[k] = p;
+        if p != k {
+            for c in 0..n {
+                a.swap(k * n + c, p * n + c);
+            }
+        }
+        let pivot = a[k * n + k];
+        if pivot == 0.0 || !pivot.is_finite() {
+            return false;
+        }
+        for r in k + 1..n {
+            let factor = a[r * n + k] / pivot;
+            a[r * n + k] = factor;
+            for c in k + 1..n {
+                a[r * n + c] -= factor * a[k * n + c];
+            }
+        }
+    }
+    true
+}
+
+/// Solves A x = b in place (`x` holds b on entry), A factored by [`lu_factor`].
+fn lu_solve(lu: &[f64], pivots: &[usize], n: usize, x: &mut [f64]) {
+    for (k, &p) in pivots.iter().enumerate().take(n) {
+        x.swap(k, p);
+    }
+    for r in 0..n {
+        let sum: f64 = (0..r).map(|c| lu[r * n + c] * x[c]).sum();
+        x[r] -= sum;
+    }
+    for r in (0..n).rev() {
+        let sum: f64 = (r + 1..n).map(|c| lu[r * n + c] * x[c]).sum();
+        x[r] = (x[r] - sum) / lu[r * n + r];
+    }
+}
+
+/// Solves Aᵀ x = b in place, A factored by [`lu_factor`]: Uᵀ z = b, Lᵀ w = z, x = Pᵀ w.
+fn lu_solve_transposed(lu: &[f64], pivots: &[usize], n: usize, x: &mut [f64]) {
+    for r in 0..n {
+        let sum: f64 = (0..r).map(|c| lu[c * n + r] * x[c]).sum();
+        x[r] = (x[r] - sum) / lu[r * n + r];
+    }
+    for r in (0..n).rev() {
+        let sum: f64 = (r + 1..n).map(|c| lu[c * n + r] * x[c]).sum();
+        x[r] -= sum;
+    }
+    for k in (0..n).rev() {
+        x.swap(k, pivots[k]);
+    }
+}
+
+/// det A from its LU factors.
+fn lu_determinant(lu: &[f64], pivots: &[usize], n: usize) -> f64 {
+    let swaps = (0..n).filter(|&k| pivots[k] != k).count();
+    let product: f64 = (0..n).map(|k| lu[k * n + k]).product();
+    if swaps % 2 == 0 { product } else { -product }
+}
+
+/// In-place Cholesky A = L Lᵀ of the n×n row-major `a`, reading and writing the lower
+/// triangle only. Returns false when A is not (numerically) positive definite.
+fn cholesky_factor(a: &mut [f64], n: usize) -> bool {
+    for j in 0..n {
+        let diagonal = a[j * n + j] - (0..j).map(|k| a[j * n + k] * a[j * n + k]).sum::<f64>();
+        let positive = diagonal > 0.0 && diagonal.is_finite();
+        if !positive {
+            return false;
+        }
+        let l_jj = diagonal.sqrt();
+        a[j * n + j] = l_jj;
+        for i in j + 1..n {
+            let sum: f64 = (0..j).map(|k| a[i * n + k] * a[j * n + k]).sum();
+            a[i * n + j] = (a[i * n + j] - sum) / l_jj;
+        }
+    }
+    true
+}
+
+/// Solves A x = b in place with the factor of [`cholesky_factor`].
+fn cholesky_solve(l: &[f64], n: usize, x: &mut [f64]) {
+    for i in 0..n {
+        let sum: f64 = (0..i).map(|k| l[i * n + k] * x[k]).sum();
+        x[i] = (x[i] - sum) / l[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let sum: f64 = (i + 1..n).map(|k| l[k * n + i] * x[k]).sum();
+        x[i] = (x[i] - sum) / l[i * n + i];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+
+    /// Deterministic pseudo-random numbers in [−1, 1) (xorshift64*).
+    struct Numbers(u64);
+
+    impl Numbers {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            let bits = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
+            bits as f64 / (1u64 << 52) as f64 - 1.0
+        }
+
+        fn vector(&mut self, len: usize) -> Vec<f64> {
+            (0..len).map(|_| self.next()).collect()
+        }
+
+        /// Symmetric positive definite n×n: A Aᵀ + n I.
+        fn spd(&mut self, n: usize) -> Vec<f64> {
+            let a = DMatrix::from_row_slice(n, n, &self.vector(n * n));
+            let m = &a * a.transpose() + DMatrix::identity(n, n) * n as f64;
+            m.transpose().as_slice().to_vec()
+        }
+    }
+
+    fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Round-off bound for the dense solves below on well-conditioned data of order 1
+    /// (κ ≲ 10², n ≤ 6): κ·n·ε ≈ 1e-13; 1e-11 leaves a margin of 100.
+    const SOLVE_TOLERANCE: f64 = 1e-11;
+
+    #[test]
+    fn one_contact_picks_the_largest_eligible_entry() {
+        let j = [0.5, -3.0, 2.0, 0.1];
+        assert_eq!(choose_dependent(&j, 1, 4, &[true; 4]), Some(vec![1]));
+        assert_eq!(
+            choose_dependent(&j, 1, 4, &[true, false, true, true]),
+            Some(vec![2])
+        );
+        assert_eq!(
+            choose_dependent(&j, 1, 4, &[false, true, false, false]),
+            Some(vec![1])
+        );
+        assert_eq!(
+            choose_dependent(&[0.0, 0.0, 1.0], 1, 3, &[true, true, false]),
+            None
+        );
+        assert_eq!(
+            choose_dependent(&[f64::NAN, 1.0], 1, 2, &[true, true]),
+            None
+        );
+    }
+
+    #[test]
+    fn several_contacts_use_complete_pivoting() {
+        // The largest entry, 5, makes column 0 dependent; eliminating it leaves row 1 as
+        // (0, 1.6 − 0.4·4, 1.5, 0) = (0, 0, 1.5, 0), so column 2 wins although the original
+        // |J_11| = 1.6 exceeds 1.5.
+        let j = [5.0, 4.0, 0.0, 0.0, 2.0, 1.6, 1.5, 0.0];
+        let chosen = choose_dependent(&j, 2, 4, &[true; 4]).unwrap();
+        assert_eq!(chosen, vec![0, 2]);
+        // Two identical rows: rank 1, no invertible J_v.
+        assert_eq!(
+            choose_dependent(&[1.0, 2.0, 1.0, 2.0], 2, 2, &[true, true]),
+            None
+        );
+    }
+
+    #[test]
+    fn conditioning_is_the_normalised_pivot() {
+        let j = [3.0, 4.0, 100.0];
+        let eligible = [true, true, false];
+        assert!((conditioning(&j, 1, 3, &[1], &eligible) - 0.8).abs() < 1e-15);
+        assert!((conditioning(&j, 1, 3, &[0], &eligible) - 0.6).abs() < 1e-15);
+        // Orthogonal rows and J_v = the whole of J: Hadamard ratio 1.
+        let j2 = [1.0, 1.0, -1.0, 1.0];
+        assert!((conditioning(&j2, 2, 2, &[0, 1], &[true, true]) - 1.0).abs() < 1e-15);
+        assert_eq!(conditioning(&[], 0, 3, &[], &eligible), 1.0);
+    }
+
+    #[test]
+    fn lu_and_cholesky_solve_like_nalgebra() {
+        let mut numbers = Numbers(7);
+        for n in 1..6 {
+            let a = numbers.vector(n * n);
+            let b = numbers.vector(n);
+            let matrix = DMatrix::from_row_slice(n, n, &a);
+            let expected = matrix
+                .clone()
+                .lu()
+                .solve(&DVector::from_column_slice(&b))
+                .unwrap();
+            let expected_t = matrix
+                .transpose()
+                .lu()
+                .solve(&DVector::from_column_slice(&b))
+                .unwrap();
+            let (mut lu, mut pivots) = (a.clone(), vec![0; n]);
+            assert!(lu_factor(&mut lu, &mut pivots, n));
+            let (mut x, mut x_t) = (b.clone(), b.clone());
+            lu_solve(&lu, &pivots, n, &mut x);
+            lu_solve_transposed(&lu, &pivots, n, &mut x_t);
+            let scale = 1.0 + expected.amax() + expected_t.amax();
+            assert!(max_difference(&x, expected.as_slice()) < SOLVE_TOLERANCE * scale);
+            assert!(max_difference(&x_t, expected_t.as_slice()) < SOLVE_TOLERANCE * scale);
+            let determinant = lu_determinant(&lu, &pivots, n);
+            assert!(
+                (determinant - matrix.determinant()).abs()
+                    < SOLVE_TOLERANCE * (1.0 + determinant.abs())
+            );
+
+            let mut spd = numbers.spd(n);
+            let expected = DMatrix::from_row_slice(n, n, &spd)
+                .lu()
+                .solve(&DVector::from_column_slice(&b))
+                .unwrap();
+            assert!(cholesky_factor(&mut spd, n));
+            let mut x = b.clone();
+            cholesky_solve(&spd, n, &mut x);
+            assert!(max_difference(&x, expected.as_slice()) < SOLVE_TOLERANCE);
+        }
+        assert!(!cholesky_factor(&mut [1.0, 2.0, 2.0, 1.0], 2));
+    }
+
+    /// A workspace filled with random M (SPD), F, Q, J, c and a consistent partition.
+    fn random_workspace(n: usize, nc: usize, driven: &[bool], seed: u64) -> (Workspace, Partition) {
+        let mut numbers = Numbers(seed);
+        let eligible: Vec<bool> = driven.iter().map(|d| !d).collect();
+        let nu = n - nc - driven.iter().filter(|d| **d).count();
+        let mut ws = Workspace::new(n, nc, nu);
+        ws.mass = numbers.spd(n);
+        ws.inertial = numbers.vector(n);
+        ws.applied = numbers.vector(n);
+        ws.jacobian = numbers.vector(nc * n);
+        ws.bias = numbers.vector(nc);
+        ws.qdd = numbers.vector(n);
+        let dependent = choose_dependent(&ws.jacobian, nc, n, &eligible).unwrap();
+        gather_columns(&ws.jacobian, n, &dependent, &mut ws.jv_lu);
+        assert!(lu_factor(&mut ws.jv_lu, &mut ws.pivots, nc));
+        (ws, Partition::new(driven, &dependent).unwrap())
+    }
+
+    fn submatrix(m: &DMatrix<f64>, rows: &[usize], columns: &[usize]) -> DMatrix<f64> {
+        DMatrix::from_fn(rows.len(), columns.len(), |r, c| m[(rows[r], columns[c])])
+    }
+
+    fn subvector(x: &[f64], rows: &[usize]) -> DVector<f64> {
+        DVector::from_fn(rows.len(), |r, _| x[rows[r]])
+    }
+
+    #[test]
+    fn reduced_dynamics_equal_the_explicit_formulas_18() {
+        for (n, nc, seed) in [(4, 1, 1), (5, 2, 2), (6, 3, 3), (2, 1, 4)] {
+            let (mut ws, partition) = random_workspace(n, nc, &vec![false; n], seed);
+            ws.reduce_and_solve(&partition, 0.0).unwrap();
+
+            let (u, v) = (partition.independent(), partition.dependent());
+            let mass = DMatrix::from_row_slice(n, n, &ws.mass);
+            let jacobian = DMatrix::from_row_slice(nc, n, &ws.jacobian);
+            let jv_inverse = submatrix(&jacobian, &(0..nc).collect::<Vec<_>>(), v)
+                .try_inverse()
+                .unwrap();
+            let ju = submatrix(&jacobian, &(0..nc).collect::<Vec<_>>(), u);
+            let b_matrix = -&jv_inverse * ju;
+            let b_vector = -&jv_inverse * DVector::from_column_slice(&ws.bias);
+            let (m_uu, m_uv) = (submatrix(&mass, u, u), submatrix(&mass, u, v));
+            let (m_vu, m_vv) = (submatrix(&mass, v, u), submatrix(&mass, v, v));
+            let (f_u, f_v) = (subvector(&ws.inertial, u), subvector(&ws.inertial, v));
+            let (q_u, q_v) = (subvector(&ws.applied, u), subvector(&ws.applied, v));
+            let bt = b_matrix.transpose();
+            let m_star = &m_uu + &m_uv * &b_matrix + &bt * &m_vu + &bt * &m_vv * &b_matrix;
+            let f_star = &f_u + &m_uv * &b_vector + &bt * (&f_v + &m_vv * &b_vector);
+            let q_star = &q_u + &bt * &q_v;
+            let udd = m_star.lu().solve(&(-(f_star + q_star))).unwrap();
+            let vdd = &b_matrix * &udd + &b_vector;
+
+            let scale = 1.0 + udd.amax() + vdd.amax();
+            assert!(
+                max_difference(subvector(&ws.qdd, u).as_slice(), udd.as_slice())
+                    < SOLVE_TOLERANCE * scale
+            );
+            assert!(
+                max_difference(subvector(&ws.qdd, v).as_slice(), vdd.as_slice())
+                    < SOLVE_TOLERANCE * scale
+            );
+        }
+    }
+
+    #[test]
+    fn partitioned_solution_solves_the_augmented_system_with_drives() {
+        // [M  Jᵀ  −E_d] [q̈ ]   [−F − Q]
+        // [J  0    0  ] [λ ] = [−c    ]
+        // [E_dᵀ 0  0  ] [τ_d]  [q̈_d   ]
+        let cases: [(usize, usize, Vec<bool>, u64); 3] = [
+            (4, 1, vec![true, false, false, false], 11),
+            (6, 2, vec![false, true, false, false, true, false], 12),
+            (3, 1, vec![false, false, false], 13),
+        ];
+        for (n, nc, driven, seed) in cases {
+            let (mut ws, partition) = random_workspace(n, nc, &driven, seed);
+            ws.reduce_and_solve(&partition, 0.0).unwrap();
+            ws.solve_multipliers(&partition, 0.0).unwrap();
+
+            let d = partition.driven();
+            let size = n + nc + d.len();
+            let mut system = DMatrix::zeros(size, size);
+            let mut rhs = DVector::zeros(size);
+            for i in 0..n {
+                for k in 0..n {
+                    system[(i, k)] = ws.mass[i * n + k];
+                }
+                rhs[i] = -ws.inertial[i] - ws.applied[i];
+            }
+            for k in 0..nc {
+                for i in 0..n {
+                    system[(i, n + k)] = ws.jacobian[k * n + i];
+                    system[(n + k, i)] = ws.jacobian[k * n + i];
+                }
+                rhs[n + k] = -ws.bias[k];
+            }
+            for (e, &i) in d.iter().enumerate() {
+                system[(i, n + nc + e)] = -1.0;
+                system[(n + nc + e, i)] = 1.0;
+                rhs[n + nc + e] = ws.qdd[i];
+            }
+            let solution = system.lu().solve(&rhs).unwrap();
+            let scale = 1.0 + solution.amax();
+            assert!(max_difference(&ws.qdd, &solution.as_slice()[..n]) < SOLVE_TOLERANCE * scale);
+            assert!(
+                max_difference(&ws.lambda, &solution.as_slice()[n..n + nc])
+                    < SOLVE_TOLERANCE * scale
+            );
+            for (e, &i) in d.iter().enumerate() {
+                assert!((ws.drive[i] - solution[n + nc + e]).abs() < SOLVE_TOLERANCE * scale);
+            }
+            for i in (0..n).filter(|i| !driven[*i]) {
+                assert_eq!(ws.drive[i], 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn partition_validates_and_orders_the_sets() {
+        let mut partition = Partition::new(&[false, true, false, false], &[3]).unwrap();
+        assert_eq!(partition.driven(), &[1]);
+        assert_eq!(partition.independent(), &[0, 2]);
+        partition.set_dependent(&[0]).unwrap();
+        assert_eq!(partition.independent(), &[2, 3]);
+        assert!(partition.set_dependent(&[1]).is_err());
+        assert!(partition.set_dependent(&[7]).is_err());
+        assert!(partition.set_dependent(&[0, 2]).is_err());
+        assert!(Partition::new(&[false; 3], &[0, 0]).is_err());
+    }
+
+    #[test]
+    fn normal_force_points_along_the_upward_normal() {
+        // Flat cam, point pushed up by the cam: the y row of (14) has +λ, so λ < 0.
+        assert_eq!(normal_force(-2.0, 0.0), 2.0);
+        assert!((normal_force(-1.0, 1.0) - 2f64.sqrt()).abs() < 1e-15);
+    }
+}
