@@ -99,11 +99,11 @@ fn add_child_load(g: &mut Graph, child: &BodyKinematics, load: Load, c: &Load) -
 fn collect_terms(g: &mut Graph, model: &Model, s: &Symbols, forms: &[Lin]) -> DynamicsTerms {
     let n = model.n();
     let mut mass = vec![vec![g.zero(); n]; n];
-    for i in 0..n {
-        for j in i..n {
+    for (i, form) in forms.iter().enumerate() {
+        for (j, &entry) in form.qdd.iter().enumerate().skip(i) {
             // M is symmetric; the recursion yields both triangles, the upper one is used.
-            mass[i][j] = forms[i].qdd[j];
-            mass[j][i] = forms[i].qdd[j];
+            mass[i][j] = entry;
+            mass[j][i] = entry;
         }
     }
     let inertial = forms.iter().map(|f| f.vel).collect();

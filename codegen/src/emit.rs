@@ -67,6 +67,8 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
     }
     let mut file = String::new();
     header(&mut file, model, source, &op_counts);
+    // Literals come verbatim from the model file (e.g. −π/2 written out in full).
+    file.push_str("#![allow(clippy::approx_constant, clippy::excessive_precision)]\n");
     file.push_str(&model_type(model));
     file.push_str(&info_static(model));
     let _ = write!(
@@ -146,7 +148,7 @@ fn model_type(model: &Model) -> String {
          pub fn step(&self, state: &mut ::camchain_runtime::State, dt: f64) -> Result<::camchain_runtime::Stats, ::camchain_runtime::SimError> {{\n\
          ::camchain_runtime::Simulate::step(self, state, dt)\n}}\n\
          /// Simulates from `state` with `settings`, sampling every `settings.dt_out`.\n\
-         pub fn simulate(&self, state: ::camchain_runtime::State, settings: &::camchain_runtime::SimSettings) -> Result<::camchain_runtime::Trajectory, ::camchain_runtime::SimFailure> {{\n\
+         pub fn simulate(&self, state: ::camchain_runtime::State, settings: &::camchain_runtime::SimSettings) -> Result<::camchain_runtime::Trajectory, Box<::camchain_runtime::SimFailure>> {{\n\
          ::camchain_runtime::Simulate::simulate(self, state, settings)\n}}\n\
          /// The default settings from the model file.\n\
          pub fn default_settings(&self) -> ::camchain_runtime::SimSettings {{\n\
@@ -445,6 +447,12 @@ fn energy_spec(d: &Derivation) -> FunctionSpec {
 }
 
 fn contact_kinematics_dispatch(model: &Model) -> String {
+    if model.contacts.is_empty() {
+        return "/// No contact: the default (empty) kinematics.\n\
+                fn contact_kinematics(&self, _q: &[f64], _qd: &[f64], _k: usize) -> ::camchain_runtime::ContactKinematics {\n\
+                ::camchain_runtime::ContactKinematics::default()\n}\n"
+            .to_string();
+    }
     let arms: String = (0..model.contacts.len())
         .map(|k| format!("{k} => contact_kinematics_{k}(q, qd),\n"))
         .collect();
@@ -489,9 +497,7 @@ fn contact_kinematics_helpers(
             params: vec![param("q", "&[f64]"), param("qd", "&[f64]")],
             ret: Some("::camchain_runtime::ContactKinematics"),
             outputs,
-            tail: format!(
-                "::camchain_runtime::ContactKinematics {{ geometry: ::camchain_runtime::ContactGeometry {{ position: [p0, p1, p2], x, y, slope, curvature }}, j1: j1.to_vec(), j2: j2.to_vec(), conv1, conv2 }}"
-            ),
+            tail: "::camchain_runtime::ContactKinematics { geometry: ::camchain_runtime::ContactGeometry { position: [p0, p1, p2], x, y, slope, curvature }, j1: j1.to_vec(), j2: j2.to_vec(), conv1, conv2 }".to_string(),
         };
         let (text, count) = emit_function_with_prelude(
             d,

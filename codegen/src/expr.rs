@@ -237,8 +237,8 @@ impl Graph {
     pub fn add(&mut self, a: Id, b: Id) -> Id {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => return self.constant(x + y),
-            (Some(x), _) if x == 0.0 => return b,
-            (_, Some(y)) if y == 0.0 => return a,
+            (Some(0.0), _) => return b,
+            (_, Some(0.0)) => return a,
             _ => {}
         }
         if self.node(b) == Node::Neg(a) || self.node(a) == Node::Neg(b) {
@@ -368,8 +368,8 @@ impl Graph {
     pub fn powf(&mut self, a: Id, b: Id) -> Id {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => self.constant(x.powf(y)),
-            (_, Some(y)) if y == 1.0 => a,
-            (_, Some(y)) if y == 0.0 => self.one(),
+            (_, Some(1.0)) => a,
+            (_, Some(0.0)) => self.one(),
             (_, Some(y)) if y.fract() == 0.0 && y.abs() < 64.0 => self.powi(a, y as i32),
             _ => self.intern(Node::Powf(a, b)),
         }

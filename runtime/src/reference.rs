@@ -1225,7 +1225,9 @@ mod tests {
     /// axis) are both children of 0; 3 (revolute) hangs from the slider 2 and 4 (revolute)
     /// from 1. Two contacts on oblique cam planes, markers on the two leaves.
     fn spatial_tree() -> NumericModel {
-        let specs: [(Option<usize>, JointKind, [f64; 3], [f64; 3], f64, [f64; 3]); 5] = [
+        /// (parent, kind, axis, anchor, mass, com) of each body.
+        type Spec = (Option<usize>, JointKind, [f64; 3], [f64; 3], f64, [f64; 3]);
+        let specs: [Spec; 5] = [
             (
                 None,
                 JointKind::Revolute,

@@ -269,10 +269,13 @@ pub trait Simulate: Dynamics {
 
     /// Simulates from `state` to `settings.t_end`, sampling at t0, t0 + dt_out, … and
     /// exactly at t_end. On failure, returns the error with the samples computed so far.
-    // The failure carries the partial trajectory by value (the API keeps it unboxed); it is
-    // built once, on the cold path.
-    #[allow(clippy::result_large_err)]
-    fn simulate(&self, state: State, settings: &SimSettings) -> Result<Trajectory, SimFailure> {
+    /// The failure is boxed: it carries the partial trajectory and is built once, on the
+    /// cold path.
+    fn simulate(
+        &self,
+        state: State,
+        settings: &SimSettings,
+    ) -> Result<Trajectory, Box<SimFailure>> {
         run(self, state, settings)
     }
 }
@@ -419,21 +422,20 @@ fn assemble_positions<D: Dynamics + ?Sized>(
 }
 
 /// The simulation loop of [`Simulate::simulate`].
-#[allow(clippy::result_large_err)]
 fn run<D: Dynamics + ?Sized>(
     model: &D,
     mut state: State,
     settings: &SimSettings,
-) -> Result<Trajectory, SimFailure> {
+) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
     let checks = check_belongs(model, &state)
         .and_then(|()| validate_integration(settings))
         .and_then(|()| validate_output(settings, state.t));
     if let Err(error) = checks {
-        return Err(SimFailure {
+        return Err(Box::new(SimFailure {
             error,
             partial: trajectory,
-        });
+        }));
     }
     let t0 = state.t;
     let intervals = output_intervals(t0, settings);
@@ -445,10 +447,10 @@ fn run<D: Dynamics + ?Sized>(
             Ok(sample) => trajectory.samples.push(sample),
             Err(error) => {
                 append_last_state(model, &mut state, &mut trajectory);
-                return Err(SimFailure {
+                return Err(Box::new(SimFailure {
                     error,
                     partial: trajectory,
-                });
+                }));
             }
         }
     }
