@@ -199,3 +199,57 @@ fn paper_model_terms_agree_with_finite_differences_and_lagrange() {
 fn spatial_tree_terms_agree_with_finite_differences_and_lagrange() {
     check_against_finite_differences(&common::spatial_tree(), 7);
 }
+
+#[test]
+fn every_model_file_agrees_with_finite_differences_and_lagrange() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("models/ exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 7);
+    for (k, file) in files.iter().enumerate() {
+        let model = camchain_codegen::schema::load_model(file).unwrap_or_else(|e| panic!("{e}"));
+        check_against_finite_differences(&model, 1000 + k as u64);
+    }
+}
+
+#[test]
+fn an_unreachable_initial_state_fails_with_file_line_and_field() {
+    let source = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/paper_concave.ron"),
+    )
+    .expect("readable");
+    // Hold every coordinate but q4: the tip then sweeps a 0.3 m circle around joint 4,
+    // which with q1 pointing straight up cannot reach the cam far below.
+    let broken = source
+        .replace(
+            "hold: [\"q1\", \"q2\", \"q4\"]",
+            "hold: [\"q1\", \"q2\", \"q3\"]",
+        )
+        .replace("\"q1\": -1.6707963267948966", "\"q1\": 1.5707963267948966");
+    assert_ne!(broken, source, "the fixture edit applied");
+    let dir = std::env::temp_dir().join(format!("camchain-unreachable-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("unreachable.ron");
+    std::fs::write(&path, &broken).expect("written");
+    let err =
+        camchain_codegen::generate_file(&path, std::path::Path::new("models/unreachable.ron"))
+            .expect_err("must not assemble");
+    let text = err.to_string();
+    let line = broken
+        .lines()
+        .position(|l| l.contains("initial:"))
+        .expect("has initial")
+        + 1;
+    assert!(
+        text.starts_with(&format!("models/unreachable.ron:{line}:")),
+        "{text}"
+    );
+    assert!(
+        text.contains("initial") && text.contains("cannot be assembled"),
+        "{text}"
+    );
+}
