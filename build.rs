@@ -39,12 +39,22 @@ fn generate_all(manifest: &Path, out_dir: &Path) -> Result<(), Vec<String>> {
         .map_err(|e| vec![format!("{}: {e}", module_dir.display())])?;
     let mut errors = Vec::new();
     let mut modules = Vec::new();
+    let mut sources = std::collections::HashMap::new();
     for file in &files {
         println!("cargo:rerun-if-changed={}", file.display());
         let display = file.strip_prefix(manifest).unwrap_or(file);
         match camchain_codegen::generate_file(file, display) {
             Ok(generated) => {
                 let name = generated.name.clone();
+                if let Some(first) = sources.get(&name) {
+                    errors.push(format!(
+                        "{}: model name `{name}` is already used by {first}; give this file its \
+                         own `name:` (or remove the field to use the file name)",
+                        display.display(),
+                    ));
+                    continue;
+                }
+                sources.insert(name.clone(), generated.source.clone());
                 let target = module_dir.join(format!("{name}.rs"));
                 if let Err(e) = write_if_changed(&target, &generated.code) {
                     errors.push(format!("{}: {e}", target.display()));

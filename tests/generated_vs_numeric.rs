@@ -166,3 +166,37 @@ fn generated_and_numeric_trajectories_coincide() {
         println!("{name}: generated vs numeric trajectory, largest difference in q {worst:.2e}");
     }
 }
+
+#[test]
+fn generated_mass_matrices_are_spd_and_match_the_kinetic_energy() {
+    for (name, model) in models::ALL {
+        let n = model.info().n();
+        let mut rng = Rng::new(99);
+        for _ in 0..100 {
+            let q = rng.vec(n, -1.5, 1.5);
+            let qd = rng.vec(n, -2.0, 2.0);
+            let mut m = vec![0.0; n * n];
+            model.mass_matrix(&q, &mut m);
+            let mat = nalgebra::DMatrix::from_row_slice(n, n, &m);
+            // Symmetric up to the association of sums (both triangles come from one row
+            // each of the recursion): 1e-13 relative.
+            assert!(
+                (&mat - mat.transpose()).amax() <= 1e-13 * mat.amax(),
+                "{name}: M symmetric"
+            );
+            assert!(
+                mat.clone().cholesky().is_some(),
+                "{name}: M positive definite"
+            );
+            let v = nalgebra::DVector::from_column_slice(&qd);
+            let quad = 0.5 * v.dot(&(&mat * &v));
+            let kinetic = model.energy(&q, &qd).kinetic;
+            // Body-velocity sum against the quadratic form: different sums of the same
+            // terms, 1e-12 relative.
+            assert!(
+                (quad - kinetic).abs() <= 1e-12 * kinetic.max(1.0),
+                "{name}: {quad} vs {kinetic}"
+            );
+        }
+    }
+}

@@ -37,7 +37,7 @@ impl Symbols {
     }
 }
 
-/// An expression linear in the accelerations: Σ_j qdd[j]·q̈_j + vel + grav.
+/// An expression linear in the accelerations: Σ_j `qdd[j]`·q̈_j + vel + grav.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lin {
     /// Coefficient of each q̈_j.

@@ -9,7 +9,7 @@
 //! - [`kinematics`]: forward recursion of rotations, positions, velocities, accelerations (9).
 //! - [`constraint`]: contact point f1, f2, J1, J2, convective terms and h, J, c (1–8).
 //! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (10–13), and energies.
-//! - [`derive`]: the whole derivation of a model in one graph.
+//! - [`derive`](mod@derive): the whole derivation of a model in one graph.
 //! - [`emit`]: the generated Rust module.
 
 pub mod assembly;

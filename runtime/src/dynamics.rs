@@ -182,8 +182,8 @@ pub trait Dynamics {
     /// f1, f2, J1, J2 and the convective terms of contact `k` (diagnostics, tests).
     fn contact_kinematics(&self, q: &[f64], qd: &[f64], k: usize) -> ContactKinematics;
 
-    /// Prescribed motion at time t: for every driven coordinate i, writes q[i], qd[i] and
-    /// qdd[i]; other entries are left untouched.
+    /// Prescribed motion at time t: for every driven coordinate i, writes `q[i]`, `qd[i]` and
+    /// `qdd[i]`; other entries are left untouched.
     fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]);
 
     /// Kinetic energy from the body velocities, and the potential energies.

@@ -7,7 +7,7 @@
 //! - [`partition`]: choice of the dependent coordinates and the reduced dynamics (15–18).
 //! - [`integrators`]: fixed-step RK4 and adaptive Dormand–Prince 5(4).
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
-//! - [`reference`]: the numeric recursive Newton–Euler reference (nalgebra).
+//! - [`reference`](mod@reference): the numeric recursive Newton–Euler reference (nalgebra).
 //! - [`jet`]: second-order forward-mode evaluation of profile expressions.
 //! - [`error`]: simulation errors with time and state.
 
