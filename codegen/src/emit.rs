@@ -32,7 +32,8 @@ struct FunctionSpec {
     params: Vec<Param>,
     /// Return type, if any.
     ret: Option<&'static str>,
-    /// `target = expression;` statements; a target `let x` declares a binding.
+    /// `target = expression;` statements; a target `let x` declares a binding and the
+    /// target [`RETURN`] makes the expression the function's value.
     outputs: Vec<(String, Id)>,
     /// Code after the outputs (the returned value).
     tail: String,
@@ -50,6 +51,9 @@ pub struct Generated {
     /// Operation count of every generated function, in emission order.
     pub op_counts: Vec<(String, OpCount)>,
 }
+
+/// Output target meaning "the function's value" (written last, without a semicolon).
+const RETURN: &str = "return";
 
 /// Prefix of the statements that become section comments after formatting.
 const SECTION_MACRO: &str = "__section__";
@@ -377,8 +381,8 @@ fn function_specs(model: &Model, d: &Derivation) -> Vec<FunctionSpec> {
         name: "damper_power".into(),
         params: vec![param("qd", "&[f64]")],
         ret: Some("f64"),
-        outputs: vec![("let power".into(), d.energy.damper_power)],
-        tail: "power".into(),
+        outputs: vec![(RETURN.into(), d.energy.damper_power)],
+        tail: String::new(),
     });
     specs
 }
@@ -552,7 +556,7 @@ fn emit_function_with_prelude(
     let receiver = if method { "&self, " } else { "" };
     let ret = spec.ret.map(|r| format!(" -> {r}")).unwrap_or_default();
     let mut text = format!(
-        "/// {}\n#[allow(clippy::all, unused_parens)]\nfn {}({receiver}{}){ret} {{\n",
+        "/// {}\nfn {}({receiver}{}){ret} {{\n",
         spec.doc,
         spec.name,
         params.join(", ")
@@ -563,7 +567,11 @@ fn emit_function_with_prelude(
     text.push_str(prelude);
     text.push_str(&bindings);
     for (target, id) in &spec.outputs {
-        let _ = writeln!(text, "{target} = {};", body.print(*id, 0));
+        if target == RETURN {
+            let _ = writeln!(text, "{}", body.print(*id, 0));
+        } else {
+            let _ = writeln!(text, "{target} = {};", body.print(*id, 0));
+        }
     }
     text.push_str(&spec.tail);
     text.push_str("\n}\n");
@@ -914,10 +922,15 @@ impl<'g> Emitter<'g> {
             Node::Neg(y) if !self.names.contains_key(&x) => Some(y),
             _ => None,
         };
+        let negative_const = |x: Id| self.g.as_const(x).filter(|v| *v < 0.0);
         let text = match (neg(a), neg(b)) {
             (None, Some(y)) => format!("{} - {}", self.print(a, 1), self.print(y, 2)),
             (Some(x), None) => format!("{} - {}", self.print(b, 1), self.print(x, 2)),
-            _ => format!("{} + {}", self.print(a, 1), self.print(b, 2)),
+            _ => match (negative_const(a), negative_const(b)) {
+                (None, Some(v)) => format!("{} - {}", self.print(a, 1), lit(-v)),
+                (Some(v), None) => format!("{} - {}", self.print(b, 1), lit(-v)),
+                _ => format!("{} + {}", self.print(a, 1), self.print(b, 2)),
+            },
         };
         (text, 1)
     }
