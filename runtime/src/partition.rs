@@ -564,9 +564,15 @@ impl Workspace {
         partition: &Partition,
         t: f64,
     ) -> Result<(), SimError> {
-        model.mass_matrix(&self.q, &mut self.mass);
-        model.inertial_forces(&self.q, &self.qd, &mut self.inertial);
-        model.applied_forces(t, &self.q, &self.qd, &mut self.applied);
+        // One call: generated models share the kinematics between M, F and Q.
+        model.equations(
+            t,
+            &self.q,
+            &self.qd,
+            &mut self.mass,
+            &mut self.inertial,
+            &mut self.applied,
+        );
         model.constraint_bias(&self.q, &self.qd, &mut self.bias);
         self.reduce_and_solve(partition, t)
     }
