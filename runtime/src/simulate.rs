@@ -276,7 +276,19 @@ pub trait Simulate: Dynamics {
         state: State,
         settings: &SimSettings,
     ) -> Result<Trajectory, Box<SimFailure>> {
-        run(self, state, settings)
+        run(self, state, settings, &mut |_| {})
+    }
+
+    /// [`Simulate::simulate`] that also hands the sample at every output time to `observe`
+    /// as soon as it is computed, in time order (progress reports, streaming output). The
+    /// trajectory, and every number in it, is the same as that of `simulate`.
+    fn simulate_observed(
+        &self,
+        state: State,
+        settings: &SimSettings,
+        observe: &mut dyn FnMut(&Sample),
+    ) -> Result<Trajectory, Box<SimFailure>> {
+        run(self, state, settings, observe)
     }
 }
 
@@ -426,6 +438,7 @@ fn run<D: Dynamics + ?Sized>(
     model: &D,
     mut state: State,
     settings: &SimSettings,
+    observe: &mut dyn FnMut(&Sample),
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
     let checks = check_belongs(model, &state)
@@ -444,7 +457,10 @@ fn run<D: Dynamics + ?Sized>(
         let outcome = advance(model, &mut state, target, settings, &mut trajectory.stats)
             .and_then(|()| sample_in_place(model, &mut state));
         match outcome {
-            Ok(sample) => trajectory.samples.push(sample),
+            Ok(sample) => {
+                observe(&sample);
+                trajectory.samples.push(sample);
+            }
             Err(error) => {
                 append_last_state(model, &mut state, &mut trajectory);
                 return Err(Box::new(SimFailure {
@@ -1561,6 +1577,19 @@ mod tests {
         assert!(max_difference(&a.q, &b.q) < 1e-9, "{:?} vs {:?}", a.q, b.q);
         assert_eq!(fixed.stats.rhs_evaluations, 4 * fixed.stats.steps);
         assert_eq!(fixed.stats.steps, 1000);
+    }
+
+    #[test]
+    fn observed_samples_are_the_trajectory() {
+        let arm = Arm::new(true, true).with_spring_damper(5.0, 0.3);
+        let settings = dopri(1.0, 1e-9);
+        let mut seen = Vec::new();
+        let state = arm.assemble(0.0).unwrap();
+        let observed = arm
+            .simulate_observed(state, &settings, &mut |s| seen.push(s.clone()))
+            .unwrap();
+        assert_eq!(seen, observed.samples);
+        assert_eq!(observed, run(&arm, &settings));
     }
 
     #[test]
