@@ -1,7 +1,8 @@
 //! The symbolic derivation, evaluated by its interpreter (no compilation), against the
 //! numeric recursive reference on the paper chain and a spatial tree with a branch.
 
-#[path = "models.rs"]
+// The hand-built models shared with the codegen tests (one source of truth).
+#[path = "../../codegen/tests/common/mod.rs"]
 mod models;
 
 use camchain_codegen::Derivation;
