@@ -86,6 +86,30 @@ fn compare_model(name: &str, generated: &dyn Dynamics, numeric: &NumericModel) -
             [j, c].concat()
         });
         assert_close(&a, &b, TOL, &format!("{name}: constraint_terms"), &worst);
+        // The fused pair a right-hand side calls: the velocity level reads the cache the
+        // position level filled (the numeric model's default ignores the cache).
+        let (a, b) = both(&|m| {
+            let (mut h, mut j) = (vec![0.0; nc], vec![0.0; nc * n]);
+            let mut cache = vec![f64::NAN; m.cache_len()];
+            m.position_terms(&q, &mut h, &mut j, &mut cache);
+            let (mut mm, mut f, mut qa, mut c) =
+                (vec![0.0; n * n], vec![0.0; n], vec![0.0; n], vec![0.0; nc]);
+            let out = camchain::runtime::VelocityTerms {
+                mass: &mut mm,
+                inertial: &mut f,
+                applied: &mut qa,
+                bias: &mut c,
+            };
+            m.velocity_terms(t, &q, &qd, &cache, out);
+            [h, j, mm, f, qa, c].concat()
+        });
+        assert_close(
+            &a,
+            &b,
+            TOL,
+            &format!("{name}: position_terms then velocity_terms"),
+            &worst,
+        );
         for k in 0..nc {
             let (a, b) = both(&|m| {
                 let ck = m.contact_kinematics(&q, &qd, k);

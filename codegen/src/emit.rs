@@ -69,6 +69,18 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
+    let fused = FusedTerms::new(&d);
+    for (spec, given) in fused.specs(&d) {
+        let (text, count) = emit_function_given(&d, &spec, "", true, &given);
+        functions.push_str(&text);
+        op_counts.push((spec.name.clone(), count));
+    }
+    let _ = writeln!(
+        functions,
+        "/// Entries of the cache `position_terms` fills for `velocity_terms`.\n\
+         fn cache_len(&self) -> usize {{ {} }}",
+        fused.cached.len()
+    );
     let mut file = String::new();
     header(&mut file, model, source, &op_counts);
     // Literals come verbatim from the model file (e.g. −π/2 written out in full).
@@ -187,6 +199,7 @@ fn info_static(model: &Model) -> String {
     let integrator = match s.integrator {
         IntegratorChoice::Rk4 => "Rk4",
         IntegratorChoice::Dopri5 => "Dopri5",
+        IntegratorChoice::Dop853 => "Dop853",
     };
     format!(
         "/// Static description of the model.\n\
@@ -387,6 +400,119 @@ fn function_specs(model: &Model, d: &Derivation) -> Vec<FunctionSpec> {
     specs
 }
 
+/// The two functions a right-hand side calls, position level (h, J) then velocity level
+/// (M, F, Q, c), and the q-only values the first hands to the second through `cache`.
+struct FusedTerms {
+    /// Nodes both levels need whose computation is worth a store and a load: elementary
+    /// functions (sines, cosines, profile terms), powers and divisions.
+    cached: Vec<Id>,
+    position: Vec<(String, Id)>,
+    velocity: Vec<(String, Id)>,
+}
+
+impl FusedTerms {
+    fn new(d: &Derivation) -> Self {
+        let n = d.symbols.q.len();
+        let dy = &d.dynamics;
+        let mut position = Vec::new();
+        for (k, c) in d.contacts.iter().enumerate() {
+            position.push((format!("h[{k}]"), c.h));
+        }
+        for (k, c) in d.contacts.iter().enumerate() {
+            for (i, &e) in c.jacobian.iter().enumerate() {
+                position.push((format!("j[{}]", k * n + i), e));
+            }
+        }
+        let mut velocity = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                velocity.push((format!("out.mass[{}]", i * n + j), dy.mass[i][j]));
+            }
+        }
+        for (i, &e) in dy.inertial.iter().enumerate() {
+            velocity.push((format!("out.inertial[{i}]"), e));
+        }
+        for (i, &e) in dy.applied.iter().enumerate() {
+            velocity.push((format!("out.applied[{i}]"), e));
+        }
+        for (k, c) in d.contacts.iter().enumerate() {
+            velocity.push((format!("out.bias[{k}]"), c.bias));
+        }
+        let g = &d.graph;
+        let roots = |outputs: &[(String, Id)]| -> Vec<Id> { outputs.iter().map(|o| o.1).collect() };
+        let in_position = g.reachable(&roots(&position));
+        let in_velocity = g.reachable(&roots(&velocity));
+        let cached = (0..g.len())
+            .filter(|&i| in_position[i] && in_velocity[i])
+            .map(|i| id_at(g, i))
+            .filter(|&id| matches!(g.node(id), Node::Call(..) | Node::Powf(..) | Node::Div(..)))
+            .collect();
+        FusedTerms {
+            cached,
+            position,
+            velocity,
+        }
+    }
+
+    /// The two function specifications, each with the nodes it reads from the cache.
+    fn specs(&self, d: &Derivation) -> Vec<(FunctionSpec, Vec<(Id, String)>)> {
+        let uses_cache = !self.cached.is_empty();
+        let cache_param = |ty| Param {
+            name: "cache",
+            ty,
+            always_used: uses_cache,
+        };
+        let mut position_outputs = self.position.clone();
+        for (k, &id) in self.cached.iter().enumerate() {
+            position_outputs.push((format!("cache[{k}]"), id));
+        }
+        let position = FunctionSpec {
+            doc: "h (3) and J (5b) for Newton (15) and the velocities (16), in one pass; \
+                  leaves the sines, cosines and profile values `velocity_terms` reuses in \
+                  `cache`."
+                .into(),
+            name: "position_terms".into(),
+            params: vec![
+                param("q", "&[f64]"),
+                param("h", "&mut [f64]"),
+                param("j", "&mut [f64]"),
+                cache_param("&mut [f64]"),
+            ],
+            ret: None,
+            outputs: position_outputs,
+            tail: String::new(),
+        };
+        let velocity = FunctionSpec {
+            doc: "M, F, Q (13) and c (8) in one pass, reading `cache` as `position_terms` \
+                  left it at the same q."
+                .into(),
+            name: "velocity_terms".into(),
+            params: vec![
+                param("t", "f64"),
+                param("q", "&[f64]"),
+                param("qd", "&[f64]"),
+                cache_param("&[f64]"),
+                Param {
+                    name: "out",
+                    ty: "::camchain_runtime::VelocityTerms<'_>",
+                    always_used: true,
+                },
+            ],
+            ret: None,
+            outputs: self.velocity.clone(),
+            tail: String::new(),
+        };
+        let given: Vec<(Id, String)> = self
+            .cached
+            .iter()
+            .enumerate()
+            .map(|(k, &id)| (id, format!("cache[{k}]")))
+            .collect();
+        let _ = d;
+        vec![(position, Vec::new()), (velocity, given)]
+    }
+}
+
 fn geometry_spec(d: &Derivation, _nc: usize) -> FunctionSpec {
     let mut outputs = Vec::new();
     for (k, c) in d.contacts.iter().enumerate() {
@@ -529,10 +655,23 @@ fn emit_function_with_prelude(
     prelude: &str,
     method: bool,
 ) -> (String, OpCount) {
+    emit_function_given(d, spec, prelude, method, &[])
+}
+
+/// Emits `spec`; the nodes of `given` are read from the expressions paired with them (e.g.
+/// `cache[3]`) instead of being computed.
+fn emit_function_given(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    prelude: &str,
+    method: bool,
+    given: &[(Id, String)],
+) -> (String, OpCount) {
     let g = &d.graph;
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
-    let count = g.op_count(&roots);
-    let mut body = Emitter::new(g, &roots);
+    let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
+    let count = g.op_count_until(&roots, &given_set);
+    let mut body = Emitter::new(g, &roots, given);
     let (bindings, used_vars) = body.bindings();
     let inputs = input_bindings(d, &used_vars);
     let used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
@@ -658,6 +797,7 @@ fn is_reserved(name: &str) -> bool {
         "out",
         "applied",
         "power",
+        "cache",
         "kinetic",
         "gravity",
         "spring",
@@ -755,6 +895,8 @@ fn sanitize(name: &str) -> String {
 /// Decides which nodes get `let` bindings and prints expressions.
 struct Emitter<'g> {
     g: &'g Graph,
+    /// Nodes read from an input expression instead of computed.
+    given: HashMap<Id, String>,
     reachable: Vec<bool>,
     uses: Vec<u32>,
     names: HashMap<Id, String>,
@@ -762,11 +904,13 @@ struct Emitter<'g> {
 }
 
 impl<'g> Emitter<'g> {
-    fn new(g: &'g Graph, roots: &[Id]) -> Self {
-        let reachable = g.reachable(roots);
+    fn new(g: &'g Graph, roots: &[Id], given: &[(Id, String)]) -> Self {
+        let given: HashMap<Id, String> = given.iter().cloned().collect();
+        let stop: HashSet<Id> = given.keys().copied().collect();
+        let reachable = g.reachable_until(roots, &stop);
         let mut uses = vec![0u32; g.len()];
         for (i, &r) in reachable.iter().enumerate() {
-            if r {
+            if r && !stop.contains(&id_at(g, i)) {
                 for c in g.children(id_at(g, i)) {
                     uses[c.index()] += 1;
                 }
@@ -777,6 +921,7 @@ impl<'g> Emitter<'g> {
         }
         Emitter {
             g,
+            given,
             reachable,
             uses,
             names: HashMap::new(),
@@ -785,6 +930,9 @@ impl<'g> Emitter<'g> {
     }
 
     fn wants_binding(&self, id: Id) -> bool {
+        if self.given.contains_key(&id) {
+            return true;
+        }
         match self.g.node(id) {
             Node::Const(_) | Node::Var(_) | Node::Neg(_) => false,
             Node::Call(..) | Node::Powf(..) => true,
@@ -798,7 +946,7 @@ impl<'g> Emitter<'g> {
         let mut used_vars = HashSet::new();
         let mut taken: HashSet<String> = self.vars.by_var.values().cloned().collect();
         for word in [
-            "q", "qd", "qdd", "t", "m", "f", "j", "c", "h", "out", "applied", "power",
+            "q", "qd", "qdd", "t", "m", "f", "j", "c", "h", "out", "applied", "power", "cache",
         ] {
             taken.insert(word.to_string());
         }
@@ -822,7 +970,7 @@ impl<'g> Emitter<'g> {
                 continue;
             }
             let id = id_at(self.g, i);
-            if matches!(self.g.node(id), Node::Var(_)) {
+            if matches!(self.g.node(id), Node::Var(_)) && !self.given.contains_key(&id) {
                 used_vars.insert(id);
             }
             if !self.wants_binding(id) {
@@ -836,7 +984,10 @@ impl<'g> Emitter<'g> {
                 }
                 section = this_section;
             }
-            let expr = self.render(id).0;
+            let expr = match self.given.get(&id) {
+                Some(source) => source.clone(),
+                None => self.render(id).0,
+            };
             let name = self.fresh_name(id, &mut taken);
             let _ = writeln!(text, "let {name} = {expr};");
             self.names.insert(id, name);

@@ -12,7 +12,7 @@
 //! expressions without compiling them.
 
 use crate::profile::Func;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Handle of a node in a [`Graph`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -625,10 +625,19 @@ impl Graph {
 
     /// Operation count of everything the roots need, shared nodes counted once.
     pub fn op_count(&self, roots: &[Id]) -> OpCount {
-        let reachable = self.reachable(roots);
+        self.op_count_until(roots, &HashSet::new())
+    }
+
+    /// Operation count of what the roots need when the nodes in `given` are inputs (their
+    /// own operations, and those only they need, are not counted).
+    pub fn op_count_until(&self, roots: &[Id], given: &HashSet<Id>) -> OpCount {
+        let reachable = self.reachable_until(roots, given);
         let mut count = OpCount::default();
         for (i, node) in self.nodes.iter().enumerate() {
             if !reachable[i] {
+                continue;
+            }
+            if given.contains(&Id(i as u32)) {
                 continue;
             }
             match node {
@@ -670,6 +679,11 @@ impl Graph {
 
     /// Marks the nodes the roots depend on.
     pub fn reachable(&self, roots: &[Id]) -> Vec<bool> {
+        self.reachable_until(roots, &HashSet::new())
+    }
+
+    /// [`Graph::reachable`] without descending below the nodes of `stop` (which are marked).
+    pub fn reachable_until(&self, roots: &[Id], stop: &HashSet<Id>) -> Vec<bool> {
         let mut mark = vec![false; self.nodes.len()];
         let mut stack: Vec<Id> = roots.to_vec();
         while let Some(id) = stack.pop() {
@@ -677,7 +691,9 @@ impl Graph {
                 continue;
             }
             mark[id.index()] = true;
-            stack.extend(self.children(id));
+            if !stop.contains(&id) {
+                stack.extend(self.children(id));
+            }
         }
         mark
     }

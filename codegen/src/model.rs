@@ -113,6 +113,8 @@ pub enum IntegratorChoice {
     Rk4,
     /// Adaptive embedded Dormand–Prince 5(4).
     Dopri5,
+    /// Adaptive Dormand–Prince 8(5,3) with dense output.
+    Dop853,
 }
 
 /// Default simulation settings stored with the model.

@@ -31,8 +31,19 @@ pub struct CoordinateInfo {
 pub enum IntegratorKind {
     /// Classical fixed-step Runge–Kutta 4 (step `dt`).
     Rk4,
-    /// Adaptive embedded Dormand–Prince 5(4) with error control on (u, u̇).
+    /// Adaptive embedded Dormand–Prince 5(4) with error control on (u, u̇); dense output
+    /// of order 4 between steps.
     Dopri5,
+    /// Adaptive Dormand–Prince 8(5,3) with error control on (u, u̇); dense output of
+    /// order 7 between steps. The fastest choice for tight tolerances.
+    Dop853,
+}
+
+impl IntegratorKind {
+    /// True for the adaptive integrators (tolerances, error control, dense output).
+    pub fn is_adaptive(self) -> bool {
+        matches!(self, IntegratorKind::Dopri5 | IntegratorKind::Dop853)
+    }
 }
 
 /// Simulation settings (the model file's defaults, overridable by the caller).
@@ -214,4 +225,42 @@ pub trait Dynamics {
         self.constraint_jacobian(q, j);
         self.constraint_bias(q, qd, c);
     }
+
+    /// Length of the cache that [`Dynamics::position_terms`] fills for
+    /// [`Dynamics::velocity_terms`] (0 unless overridden).
+    fn cache_len(&self) -> usize {
+        0
+    }
+
+    /// Everything a right-hand side needs at the position level, in one call: h (3) and
+    /// J (5b) at q, for Newton (15) and the velocity relation (16). Generated models also
+    /// write into `cache` the q-only quantities (sines, cosines, profile values) that
+    /// [`Dynamics::velocity_terms`] reuses at the same q, so that no sine is computed twice
+    /// per right-hand side.
+    fn position_terms(&self, q: &[f64], h: &mut [f64], j: &mut [f64], cache: &mut [f64]) {
+        let _ = cache;
+        self.constraint(q, h);
+        self.constraint_jacobian(q, j);
+    }
+
+    /// Everything a right-hand side needs at the velocity level: M, F, Q (13) and c (8) at
+    /// (t, q, q̇), reading `cache` as filled by [`Dynamics::position_terms`] at the same q.
+    fn velocity_terms(&self, t: f64, q: &[f64], qd: &[f64], cache: &[f64], out: VelocityTerms) {
+        let _ = cache;
+        self.equations(t, q, qd, out.mass, out.inertial, out.applied);
+        self.constraint_bias(q, qd, out.bias);
+    }
+}
+
+/// Output buffers of [`Dynamics::velocity_terms`]: M (n×n, row-major), F, Q (n) and c (nc).
+#[derive(Debug)]
+pub struct VelocityTerms<'a> {
+    /// M(q), eq. (13).
+    pub mass: &'a mut [f64],
+    /// F(q, q̇), eq. (13).
+    pub inertial: &'a mut [f64],
+    /// Q(q, q̇, t), eq. (13).
+    pub applied: &'a mut [f64],
+    /// c(q, q̇), eqs. (7, 8).
+    pub bias: &'a mut [f64],
 }

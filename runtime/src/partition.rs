@@ -16,7 +16,7 @@
 //!
 //! Everything works in a preallocated [`Workspace`]; no step allocates.
 
-use crate::dynamics::Dynamics;
+use crate::dynamics::{Dynamics, VelocityTerms};
 use crate::error::SimError;
 
 /// Re-partition threshold on [`conditioning`]: the dependent coordinates are re-chosen after
@@ -286,6 +286,8 @@ pub struct Workspace {
     pub(crate) jacobian: Vec<f64>,
     bias: Vec<f64>,
     pub(crate) h: Vec<f64>,
+    /// q-only values `position_terms` hands to `velocity_terms` (sines, cosines, …).
+    cache: Vec<f64>,
     jv_lu: Vec<f64>,
     pivots: Vec<usize>,
     scratch: Vec<f64>,
@@ -317,6 +319,7 @@ impl Workspace {
             jacobian: vec![0.0; nc * n],
             bias: vec![0.0; nc],
             h: vec![0.0; nc],
+            cache: Vec::new(),
             jv_lu: vec![0.0; nc * nc],
             pivots: vec![0; nc],
             scratch: vec![0.0; nc],
@@ -452,13 +455,13 @@ impl Workspace {
     /// not), reported as [`SimError::NewtonFailed`].
     fn factor_jacobian_for_newton<D: Dynamics + ?Sized>(
         &mut self,
-        model: &D,
+        _model: &D,
         dependent: &[usize],
         t: f64,
         residual: f64,
         iterations: usize,
     ) -> Result<(), SimError> {
-        match self.factor_jacobian(model, dependent, t) {
+        match self.factor_current_jacobian(dependent, t) {
             Err(SimError::SingularConstraint { .. }) => {
                 Err(self.newton_failure(t, residual, iterations))
             }
@@ -466,13 +469,14 @@ impl Workspace {
         }
     }
 
-    /// Evaluates h at q; returns max |h|.
+    /// Evaluates h and J at q (one [`Dynamics::position_terms`] call, which also fills the
+    /// cache for the velocity level); returns max |h|.
     fn constraint_residual<D: Dynamics + ?Sized>(
         &mut self,
         model: &D,
         t: f64,
     ) -> Result<f64, SimError> {
-        model.constraint(&self.q, &mut self.h);
+        self.evaluate_position_terms(model);
         let residual = max_abs(&self.h);
         if residual.is_finite() {
             Ok(residual)
@@ -517,14 +521,29 @@ impl Workspace {
         }
     }
 
-    /// Evaluates J(q) (5b) and factors J_v (the `dependent` columns).
+    /// h, J and the cache at the current q, by one [`Dynamics::position_terms`] call.
+    fn evaluate_position_terms<D: Dynamics + ?Sized>(&mut self, model: &D) {
+        let len = model.cache_len();
+        if self.cache.len() != len {
+            self.cache.resize(len, 0.0);
+        }
+        model.position_terms(&self.q, &mut self.h, &mut self.jacobian, &mut self.cache);
+    }
+
+    /// Evaluates h and J(q) (5b) and factors J_v (the `dependent` columns).
     pub fn factor_jacobian<D: Dynamics + ?Sized>(
         &mut self,
         model: &D,
         dependent: &[usize],
         t: f64,
     ) -> Result<(), SimError> {
-        model.constraint_jacobian(&self.q, &mut self.jacobian);
+        self.evaluate_position_terms(model);
+        self.factor_current_jacobian(dependent, t)
+    }
+
+    /// Factors J_v of the J last evaluated (by [`Self::solve_positions`], which always ends
+    /// with an evaluation at the returned q, or [`Self::factor_jacobian`]).
+    pub fn factor_current_jacobian(&mut self, dependent: &[usize], t: f64) -> Result<(), SimError> {
         if self.jacobian.iter().any(|x| !x.is_finite()) {
             return Err(self.non_finite(t, "J"));
         }
@@ -556,7 +575,9 @@ impl Workspace {
     }
 
     /// Eqs. (16)–(18): evaluates M, F, Q and c at (t, q, q̇) and solves the reduced dynamics
-    /// for ü; writes q̈ = T ü + g. Needs [`Self::factor_jacobian`] at the current q and q̈_d
+    /// for ü; writes q̈ = T ü + g. Needs the position level evaluated at the current q
+    /// ([`Self::factor_jacobian`], or [`Self::solve_positions`] then
+    /// [`Self::factor_current_jacobian`]: J factored and the cache filled) and q̈_d
     /// in the driven entries of q̈ (from [`Dynamics::prescribed`]).
     pub fn solve_accelerations<D: Dynamics + ?Sized>(
         &mut self,
@@ -564,16 +585,15 @@ impl Workspace {
         partition: &Partition,
         t: f64,
     ) -> Result<(), SimError> {
-        // One call: generated models share the kinematics between M, F and Q.
-        model.equations(
-            t,
-            &self.q,
-            &self.qd,
-            &mut self.mass,
-            &mut self.inertial,
-            &mut self.applied,
-        );
-        model.constraint_bias(&self.q, &self.qd, &mut self.bias);
+        // One call: generated models share the kinematics between M, F, Q and c, and take
+        // the sines and cosines from the position level.
+        let out = VelocityTerms {
+            mass: &mut self.mass,
+            inertial: &mut self.inertial,
+            applied: &mut self.applied,
+            bias: &mut self.bias,
+        };
+        model.velocity_terms(t, &self.q, &self.qd, &self.cache, out);
         self.reduce_and_solve(partition, t)
     }
 

@@ -71,6 +71,7 @@ fn integrator_kind(choice: IntegratorChoice) -> IntegratorKind {
     match choice {
         IntegratorChoice::Rk4 => IntegratorKind::Rk4,
         IntegratorChoice::Dopri5 => IntegratorKind::Dopri5,
+        IntegratorChoice::Dop853 => IntegratorKind::Dop853,
     }
 }
 

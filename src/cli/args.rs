@@ -161,6 +161,9 @@ pub enum IntegratorArg {
     Rk4,
     /// Adaptive Dormand–Prince 5(4) with error control by --rtol and --atol.
     Dopri5,
+    /// Adaptive Dormand–Prince 8(5,3) with error control by --rtol and --atol; the
+    /// fastest for tight tolerances.
+    Dop853,
 }
 
 impl IntegratorArg {
@@ -169,6 +172,7 @@ impl IntegratorArg {
         match self {
             IntegratorArg::Rk4 => IntegratorKind::Rk4,
             IntegratorArg::Dopri5 => IntegratorKind::Dopri5,
+            IntegratorArg::Dop853 => IntegratorKind::Dop853,
         }
     }
 }
@@ -178,6 +182,7 @@ pub fn integrator_name(kind: IntegratorKind) -> &'static str {
     match kind {
         IntegratorKind::Rk4 => "rk4",
         IntegratorKind::Dopri5 => "dopri5",
+        IntegratorKind::Dop853 => "dop853",
     }
 }
 

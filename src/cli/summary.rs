@@ -100,7 +100,7 @@ fn settings_text(settings: &SimSettings) -> String {
     let name = integrator_name(settings.integrator);
     match settings.integrator {
         IntegratorKind::Rk4 => format!("{name} (dt {} s)", settings.dt),
-        IntegratorKind::Dopri5 => format!(
+        IntegratorKind::Dopri5 | IntegratorKind::Dop853 => format!(
             "{name} (rtol {:e}, atol {:e})",
             settings.rtol, settings.atol
         ),

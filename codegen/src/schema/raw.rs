@@ -144,6 +144,7 @@ pub(super) struct Initial {
 pub(super) enum Integrator {
     Rk4,
     Dopri5,
+    Dop853,
 }
 
 #[derive(Debug, Deserialize)]

@@ -582,6 +582,7 @@ fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulation> {
         integrator: match s.integrator {
             raw::Integrator::Rk4 => IntegratorChoice::Rk4,
             raw::Integrator::Dopri5 => IntegratorChoice::Dopri5,
+            raw::Integrator::Dop853 => IntegratorChoice::Dop853,
         },
         dt: positive(at, &field("dt"), "dt", s.dt)?,
         rtol: positive(at, &field("rtol"), "rtol", s.rtol)?,

@@ -1,4 +1,5 @@
-//! Explicit Runge–Kutta integrators on a flat state vector.
+//! Explicit Runge–Kutta integrators on a flat state vector: RK4, Dormand–Prince 5(4) and
+//! Dormand–Prince 8(5,3) ([`Dop853`]), the last two with dense output.
 //!
 //! Both integrators own their stage buffers (allocated once in `new`), take the right-hand
 //! side as a generic closure `FnMut(t, y, dy) -> Result<(), SimError>` (monomorphised, no
@@ -10,6 +11,9 @@
 //! from the error norm.
 
 use crate::error::SimError;
+
+mod dop853;
+pub use dop853::Dop853;
 
 /// Work counters of an integrator, accumulated over its lifetime.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -120,6 +124,13 @@ const E4: f64 = 71.0 / 1920.0;
 const E5: f64 = -17253.0 / 339200.0;
 const E6: f64 = 22.0 / 525.0;
 const E7: f64 = -1.0 / 40.0;
+// Shampine's dense output (Hairer's `contd5`): fourth-order interpolant.
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
 
 /// Step-size controller: safety factor applied to the optimal step.
 const SAFETY: f64 = 0.9;
@@ -153,8 +164,15 @@ pub struct Dopri5 {
     k: [Vec<f64>; 7],
     stage: Vec<f64>,
     y_new: Vec<f64>,
+    /// State, start time and size of the last accepted step (dense output).
+    y_old: Vec<f64>,
+    t_old: f64,
+    h_old: f64,
     controlled: usize,
     fsal_valid: bool,
+    /// k7 of the last accepted step is the next step's k1 (moved when that step starts, so
+    /// that the interpolant can still be formed until then).
+    fsal_pending: bool,
     /// Work done so far.
     pub counters: Counters,
 }
@@ -167,8 +185,12 @@ impl Dopri5 {
             k: std::array::from_fn(|_| vec![0.0; dim]),
             stage: vec![0.0; dim],
             y_new: vec![0.0; dim],
+            y_old: vec![0.0; dim],
+            t_old: 0.0,
+            h_old: 0.0,
             controlled: controlled.min(dim),
             fsal_valid: false,
+            fsal_pending: false,
             counters: Counters::default(),
         }
     }
@@ -177,6 +199,34 @@ impl Dopri5 {
     /// outside this integrator, e.g. a re-partition or another integrator's step).
     pub fn invalidate_fsal(&mut self) {
         self.fsal_valid = false;
+        self.fsal_pending = false;
+    }
+
+    /// Start time and size of the last accepted step.
+    pub fn last_step(&self) -> (f64, f64) {
+        (self.t_old, self.h_old)
+    }
+
+    /// y(t) inside the last accepted step by Shampine's fourth-order continuous extension
+    /// (Hairer's `contd5`); needs no further right-hand side. Valid until the next step.
+    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let (h, s) = (self.h_old, (t - self.t_old) / self.h_old);
+        let s1 = 1.0 - s;
+        let k = &self.k;
+        for (i, o) in out.iter_mut().enumerate() {
+            let y0 = self.y_old[i];
+            let difference = self.y_new[i] - y0;
+            let r3 = h * k[0][i] - difference;
+            let r4 = difference - h * k[6][i] - r3;
+            let r5 = h
+                * (D1 * k[0][i]
+                    + D3 * k[2][i]
+                    + D4 * k[3][i]
+                    + D5 * k[4][i]
+                    + D6 * k[5][i]
+                    + D7 * k[6][i]);
+            *o = y0 + s * (difference + s1 * (r3 + s * (r4 + s1 * r5)));
+        }
     }
 
     /// One accepted step from `(t, y)` trying `h_try` first; rejected attempts are retried
@@ -196,28 +246,39 @@ impl Dopri5 {
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
     {
+        if self.fsal_pending {
+            self.k.swap(0, 6);
+            self.fsal_pending = false;
+        }
         self.ensure_first_stage(rhs, t, y)?;
         let floor = STEP_FLOOR * t.abs().max(1.0);
         let mut h = h_try;
         let mut was_rejected = false;
         let mut failed_attempts = 0;
+        let mut last_failure = None;
         loop {
             if h.is_nan() || h < floor {
-                return Err(SimError::StepSizeTooSmall { t, h });
+                // Steps shrinking onto a point where the right-hand side fails (e.g. the
+                // chain cannot follow the cam beyond it): that failure is the cause.
+                return Err(last_failure.unwrap_or(SimError::StepSizeTooSmall { t, h }));
             }
             match self.attempt(rhs, t, y, h, tolerances) {
                 Ok(error) if error <= 1.0 => {
                     let max_factor = if was_rejected { 1.0 } else { MAX_FACTOR };
                     let h_next = h * step_factor(error).min(max_factor);
-                    self.accept(y);
+                    self.accept(t, h, y);
                     return Ok(AcceptedStep { h, h_next });
                 }
-                Ok(error) => h *= step_factor(error).min(1.0),
+                Ok(error) => {
+                    last_failure = None;
+                    h *= step_factor(error).min(1.0);
+                }
                 Err(failure) => {
                     failed_attempts += 1;
                     if failed_attempts > MAX_FAILED_ATTEMPTS {
                         return Err(failure);
                     }
+                    last_failure = Some(failure);
                     h *= FAILURE_FACTOR;
                 }
             }
@@ -238,9 +299,11 @@ impl Dopri5 {
         Ok(())
     }
 
-    fn accept(&mut self, y: &mut [f64]) {
+    fn accept(&mut self, t: f64, h: f64, y: &mut [f64]) {
+        self.y_old.copy_from_slice(y);
         y.copy_from_slice(&self.y_new);
-        self.k.swap(0, 6);
+        (self.t_old, self.h_old) = (t, h);
+        self.fsal_pending = true;
         self.counters.steps += 1;
     }
 
@@ -316,6 +379,108 @@ impl Dopri5 {
         }
         let norm = (sum / self.controlled as f64).sqrt();
         if norm.is_nan() { f64::INFINITY } else { norm }
+    }
+}
+
+/// What the simulator needs of an adaptive integrator with dense output (implemented by
+/// [`Dopri5`] and [`Dop853`]).
+pub trait Adaptive {
+    /// One accepted step from `(t, y)` trying `h_try` first; `y` is overwritten with the
+    /// new state only on success.
+    fn step<F>(
+        &mut self,
+        rhs: &mut F,
+        t: f64,
+        y: &mut [f64],
+        h_try: f64,
+        tolerances: Tolerances,
+    ) -> Result<AcceptedStep, SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>;
+
+    /// Forget the derivative cached at the current point (the state changed outside).
+    fn invalidate_fsal(&mut self);
+
+    /// Makes the interpolant of the last accepted step available (may cost right-hand
+    /// sides: three for DOP853, none for Dopri5).
+    fn prepare_dense<F>(&mut self, rhs: &mut F) -> Result<(), SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>;
+
+    /// y(t) within the last accepted step (after [`Adaptive::prepare_dense`]).
+    fn interpolate(&self, t: f64, out: &mut [f64]);
+
+    /// Work done so far.
+    fn counters(&self) -> Counters;
+}
+
+impl Adaptive for Dopri5 {
+    fn step<F>(
+        &mut self,
+        rhs: &mut F,
+        t: f64,
+        y: &mut [f64],
+        h_try: f64,
+        tolerances: Tolerances,
+    ) -> Result<AcceptedStep, SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
+    {
+        Dopri5::step(self, rhs, t, y, h_try, tolerances)
+    }
+
+    fn invalidate_fsal(&mut self) {
+        Dopri5::invalidate_fsal(self);
+    }
+
+    fn prepare_dense<F>(&mut self, _rhs: &mut F) -> Result<(), SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
+    {
+        Ok(())
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        Dopri5::interpolate(self, t, out);
+    }
+
+    fn counters(&self) -> Counters {
+        self.counters
+    }
+}
+
+impl Adaptive for Dop853 {
+    fn step<F>(
+        &mut self,
+        rhs: &mut F,
+        t: f64,
+        y: &mut [f64],
+        h_try: f64,
+        tolerances: Tolerances,
+    ) -> Result<AcceptedStep, SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
+    {
+        Dop853::step(self, rhs, t, y, h_try, tolerances)
+    }
+
+    fn invalidate_fsal(&mut self) {
+        Dop853::invalidate_fsal(self);
+    }
+
+    fn prepare_dense<F>(&mut self, rhs: &mut F) -> Result<(), SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
+    {
+        Dop853::prepare_dense(self, rhs)
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        Dop853::interpolate(self, t, out);
+    }
+
+    fn counters(&self) -> Counters {
+        self.counters
     }
 }
 
