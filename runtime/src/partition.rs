@@ -626,6 +626,10 @@ impl Workspace {
 
     /// B = −J_v⁻¹ J_u (nc×nu, row-major) and b = −J_v⁻¹ (c + J_d q̈_d), eq. (16).
     fn eliminate_dependent(&mut self, partition: &Partition) {
+        if self.nc == 1 {
+            self.eliminate_single_dependent(partition);
+            return;
+        }
         let (n, nc, nu) = (self.n, self.nc, self.nu);
         for k in 0..nc {
             let row = &self.jacobian[k * n..(k + 1) * n];
@@ -648,6 +652,22 @@ impl Workspace {
         }
     }
 
+    /// [`Self::eliminate_dependent`] for one contact (the paper's case): J_v is a scalar, so
+    /// B = −J_u / J_v and b = −(c + J_d q̈_d) / J_v without the LU machinery.
+    fn eliminate_single_dependent(&mut self, partition: &Partition) {
+        let row = &self.jacobian[..self.n];
+        let inverse = 1.0 / self.jv_lu[0];
+        let driven: f64 = partition
+            .driven()
+            .iter()
+            .map(|&d| row[d] * self.qdd[d])
+            .sum();
+        self.b_vector[0] = -(self.bias[0] + driven) * inverse;
+        for (b, &u) in self.b_matrix.iter_mut().zip(partition.independent()) {
+            *b = -row[u] * inverse;
+        }
+    }
+
     /// q̈ ← g: 0 on u, b on v; q̈_d stays on d.
     fn set_particular_acceleration(&mut self, partition: &Partition) {
         for &u in partition.independent() {
@@ -667,6 +687,10 @@ impl Workspace {
     /// system reads M* ü + F* + Q* = 0 (checked against the explicit formulas in a test).
     /// Driven coordinates only add M_·d q̈_d to g's contribution and J_d q̈_d to b.
     fn project_dynamics(&mut self, partition: &Partition) {
+        if self.nc == 1 {
+            self.project_single_dependent(partition);
+            return;
+        }
         residual_into(
             &mut self.residual,
             &self.mass,
@@ -676,6 +700,40 @@ impl Workspace {
         );
         self.multiply_mass_by_t(partition);
         self.project_on_t(partition);
+    }
+
+    /// [`Self::project_dynamics`] for one contact (the paper's case), entry by entry: with
+    /// T = [I; b] on (u, v),
+    /// M*_ab = M_{u_a u_b} + M_{u_a v} B_b + B_a M_{v u_b} + B_a B_b M_vv and
+    /// −Tᵀ r = −(r_{u_a} + B_a r_v), r = M g + F + Q. Plain indexed loops: at n ≈ 4 the
+    /// general path's iterator bookkeeping costs more than its arithmetic.
+    fn project_single_dependent(&mut self, partition: &Partition) {
+        let (n, nu) = (self.n, self.nu);
+        let v = partition.dependent()[0];
+        let independent = partition.independent();
+        let mass = &self.mass;
+        for i in 0..n {
+            let row = &mass[i * n..(i + 1) * n];
+            let mut r = self.inertial[i] + self.applied[i] + row[v] * self.qdd[v];
+            for &d in partition.driven() {
+                r += row[d] * self.qdd[d];
+            }
+            self.residual[i] = r;
+        }
+        let b = &self.b_matrix[..nu];
+        let m_vv = mass[v * n + v];
+        let r_v = self.residual[v];
+        for a in 0..nu {
+            let u_a = independent[a];
+            let (b_a, m_av) = (b[a], mass[u_a * n + v]);
+            for c in 0..=a {
+                let u_c = independent[c];
+                let m_ac = mass[u_a * n + u_c];
+                let m_vc = mass[v * n + u_c];
+                self.reduced_mass[a * nu + c] = m_ac + m_av * b[c] + b_a * (m_vc + m_vv * b[c]);
+            }
+            self.udd[a] = -(self.residual[u_a] + b_a * r_v);
+        }
     }
 
     /// `mass_t` = M T (n×nu): column a is M[:, u_a] + Σ_k M[:, v_k] B[k, a].
@@ -856,34 +914,48 @@ fn lu_determinant(lu: &[f64], pivots: &[usize], n: usize) -> f64 {
     if swaps % 2 == 0 { product } else { -product }
 }
 
-/// In-place Cholesky A = L Lᵀ of the n×n row-major `a`, reading and writing the lower
-/// triangle only. Returns false when A is not (numerically) positive definite.
+/// In-place square-root-free Cholesky A = L D Lᵀ of the n×n row-major `a` (L unit lower),
+/// reading and writing the lower triangle only: L below the diagonal, D on it. No square
+/// root and one division per column (square roots and chained divisions form the critical
+/// path of these tiny systems). Returns false when A is not (numerically) positive
+/// definite (some D_jj ≤ 0).
 fn cholesky_factor(a: &mut [f64], n: usize) -> bool {
     for j in 0..n {
-        let diagonal = a[j * n + j] - (0..j).map(|k| a[j * n + k] * a[j * n + k]).sum::<f64>();
+        let mut diagonal = a[j * n + j];
+        for k in 0..j {
+            let l_jk = a[j * n + k];
+            diagonal -= l_jk * l_jk * a[k * n + k];
+        }
         let positive = diagonal > 0.0 && diagonal.is_finite();
         if !positive {
             return false;
         }
-        let l_jj = diagonal.sqrt();
-        a[j * n + j] = l_jj;
+        a[j * n + j] = diagonal;
+        let inverse = 1.0 / diagonal;
         for i in j + 1..n {
-            let sum: f64 = (0..j).map(|k| a[i * n + k] * a[j * n + k]).sum();
-            a[i * n + j] = (a[i * n + j] - sum) / l_jj;
+            let mut sum = a[i * n + j];
+            for k in 0..j {
+                sum -= a[i * n + k] * a[j * n + k] * a[k * n + k];
+            }
+            a[i * n + j] = sum * inverse;
         }
     }
     true
 }
 
-/// Solves A x = b in place with the factor of [`cholesky_factor`].
+/// Solves A x = b in place with the factor of [`cholesky_factor`]: L y = b, D z = y,
+/// Lᵀ x = z (the n divisions are independent of each other).
 fn cholesky_solve(l: &[f64], n: usize, x: &mut [f64]) {
     for i in 0..n {
         let sum: f64 = (0..i).map(|k| l[i * n + k] * x[k]).sum();
-        x[i] = (x[i] - sum) / l[i * n + i];
+        x[i] -= sum;
+    }
+    for (i, xi) in x.iter_mut().enumerate().take(n) {
+        *xi /= l[i * n + i];
     }
     for i in (0..n).rev() {
         let sum: f64 = (i + 1..n).map(|k| l[k * n + i] * x[k]).sum();
-        x[i] = (x[i] - sum) / l[i * n + i];
+        x[i] -= sum;
     }
 }
 

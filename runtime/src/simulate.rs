@@ -93,6 +93,11 @@ impl State {
         state
     }
 
+    /// Length of the integrated vector y = (u, u̇, dissipated, driven work, v, v̇).
+    pub fn integrated_len(&self) -> usize {
+        integrated_len(&self.partition)
+    }
+
     /// Dependent coordinates v of the current partition (one per contact).
     pub fn dependent(&self) -> &[usize] {
         self.partition.dependent()
@@ -264,6 +269,26 @@ pub trait Simulate: Dynamics {
         let mut stats = Stats::default();
         advance(self, state, state.t + dt, settings, &mut stats)?;
         Ok(stats)
+    }
+
+    /// One reduced right-hand side at the state (Newton (15), velocities (16), reduced
+    /// dynamics (17, 18)): writes the derivative of the integrated vector
+    /// y = (u, u̇, dissipated, driven work, v, v̇) into `dy` (length
+    /// [`State::integrated_len`]). For custom integrators and benchmarks.
+    fn derivative(&self, state: &mut State, dy: &mut [f64]) -> Result<(), SimError> {
+        check_belongs(self, state)?;
+        if dy.len() != state.integrated_len() {
+            return Err(invalid(format!(
+                "dy has {} entries, the integrated vector {}",
+                dy.len(),
+                state.integrated_len()
+            )));
+        }
+        if state.modified_since_last_step() {
+            state.load_integrated_state();
+        }
+        let Engine { ws, y, .. } = &mut state.engine;
+        evaluate_rhs(self, &state.partition, ws, state.t, y, dy)
     }
 
     /// All outputs at the state: accelerations, multipliers, normal and drive loads,

@@ -57,6 +57,37 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// List the built-in models with their coordinates, contacts and default settings.
     List,
+    /// Measure: run time against error of every integrator, and generated code against
+    /// the numeric recursion; writes the sections of BENCHMARKS.md.
+    Bench(BenchArgs),
+}
+
+/// Options of `bench`.
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// Which benchmark [default: all]
+    #[arg(value_enum, default_value = "all")]
+    pub what: BenchWhat,
+    /// Fewer models, rungs and repeats (a smoke run, not for the report)
+    #[arg(long)]
+    pub quick: bool,
+    /// The report whose sections are rewritten
+    #[arg(long, value_name = "FILE", default_value = "BENCHMARKS.md")]
+    pub report: PathBuf,
+    /// Directory of the figures
+    #[arg(long, value_name = "DIR", default_value = "docs")]
+    pub figures: PathBuf,
+}
+
+/// The benchmarks of `bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BenchWhat {
+    /// Both.
+    All,
+    /// Run time against error over a ladder of steps and tolerances, every integrator.
+    WorkPrecision,
+    /// One evaluation of each term, generated against numeric, side by side.
+    Evaluations,
 }
 
 /// Options of `simulate`.

@@ -12,6 +12,7 @@
 //! model file missing or invalid, a failed run, a file that could not be written).
 
 mod args;
+mod bench;
 mod csv;
 mod figures;
 mod kinematics;
@@ -66,6 +67,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         None => simulate::run(&cli.simulate),
         Some(Command::Simulate(args)) => simulate::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::List) => {
             // A closed pipe (`camchain list | head`) is not an error worth a panic.
             let _ = std::io::stdout().write_all(list::render().as_bytes());

@@ -1,0 +1,34 @@
+//! `camchain bench`: the measurements behind `BENCHMARKS.md`, each taken side by side in one
+//! run on this machine.
+//!
+//! - `work-precision`: run time against error for every integrator over a ladder of steps
+//!   and tolerances, on the reference models, against a checked reference solution;
+//! - `evaluations`: one evaluation of M+F+Q, the constraint terms, the reduced right-hand
+//!   side and one RK4 step, generated code against the numeric recursion, on the same states.
+//!
+//! Timings are medians over batches, generated and numeric batches interleaved so that
+//! machine noise hits both alike. No timing is asserted anywhere (see the tests).
+
+mod evaluations;
+mod markdown;
+mod timing;
+mod work_precision;
+
+use super::CliError;
+use super::args::{BenchArgs, BenchWhat};
+
+/// Runs the benchmarks `args` asks for and updates their sections of the report.
+pub fn run(args: &BenchArgs) -> Result<(), CliError> {
+    let report = &args.report;
+    if matches!(args.what, BenchWhat::Evaluations | BenchWhat::All) {
+        let section = evaluations::run(args.quick)?;
+        markdown::replace_section(report, "evaluations", &section)?;
+        println!("updated {} (section evaluations)", report.display());
+    }
+    if matches!(args.what, BenchWhat::WorkPrecision | BenchWhat::All) {
+        let section = work_precision::run(args.quick, &args.figures)?;
+        markdown::replace_section(report, "work-precision", &section)?;
+        println!("updated {} (section work-precision)", report.display());
+    }
+    Ok(())
+}
