@@ -12,6 +12,7 @@
 
 use crate::dynamics::{ContactGeometry, Dynamics, Energy, IntegratorKind, SimSettings};
 use crate::error::SimError;
+use crate::events::{ContactEvent, EVENT_TIME_TOLERANCE, EventKind, changes_sign, locate_root};
 use crate::integrators::{Adaptive, Counters, Dop853, Dopri5, Rk4, Tolerances};
 use crate::partition::{
     Partition, REPARTITION_RATIO, Workspace, choose_dependent, conditioning, normal_force,
@@ -116,6 +117,14 @@ impl State {
     /// Work done by the drives since assembly, ∫ Σ τ_d q̇_d dt (J).
     pub fn driven_work(&self) -> f64 {
         self.driven_work
+    }
+
+    /// Sets the dissipated energy and driven work carried by the state (a new phase of a
+    /// unilateral run continues the balance of the previous one).
+    pub(crate) fn set_quadratures(&mut self, (dissipated, driven_work): (f64, f64)) {
+        self.dissipated = dissipated;
+        self.driven_work = driven_work;
+        self.engine.synced_t = f64::NAN;
     }
 
     /// Imposes the dependent coordinates (one per contact, not driven). The partition is
@@ -224,6 +233,9 @@ pub struct Sample {
 pub struct Trajectory {
     /// Samples in time order.
     pub samples: Vec<Sample>,
+    /// Contact events in time order: sign changes of the normal forces (runs of the
+    /// adaptive integrators with full samples), lift-offs and impacts (unilateral runs).
+    pub events: Vec<ContactEvent>,
     /// Work counters of the whole run.
     pub stats: Stats,
 }
@@ -249,6 +261,15 @@ pub trait Simulate: Dynamics {
     /// among all non-driven coordinates.
     fn assemble(&self, t0: f64) -> Result<State, SimError> {
         assemble_state(self, t0)
+    }
+
+    /// A state at time `t` from given coordinates and velocities (e.g. to restart from a
+    /// saved configuration): driven coordinates take their prescribed motion, the dependent
+    /// ones are re-solved by Newton (15) from the given values (which should be on the cam)
+    /// and their velocities from (16); the others are kept.
+    fn state_at(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<State, SimError> {
+        let hold = vec![false; self.info().n()];
+        assemble_from(self, t, (q, qd), &hold)
     }
 
     /// Advances `state` by `dt` with the model's default settings.
@@ -321,6 +342,19 @@ pub trait Simulate: Dynamics {
         settings: &SimSettings,
     ) -> Result<Trajectory, Box<SimFailure>> {
         run(self, state, settings, SampleLevel::State, &mut |_| {})
+    }
+
+    /// [`Simulate::simulate`] with one-sided contact: the follower lifts off where the
+    /// normal force reaches zero, flies, and lands with Newton's coefficient of restitution
+    /// `restitution` (see [`crate::unilateral`]). Lift-offs and impacts are in the
+    /// trajectory's events. One cam contact, adaptive integrator.
+    fn simulate_unilateral(
+        &self,
+        state: State,
+        settings: &SimSettings,
+        restitution: f64,
+    ) -> Result<Trajectory, Box<SimFailure>> {
+        crate::unilateral::simulate_unilateral(self, state, settings, restitution)
     }
 
     /// [`Simulate::simulate`] that also hands the sample at every output time to `observe`
@@ -406,18 +440,33 @@ fn check_belongs<D: Dynamics + ?Sized>(model: &D, state: &State) -> Result<(), S
 }
 
 fn assemble_state<D: Dynamics + ?Sized>(model: &D, t0: f64) -> Result<State, SimError> {
+    let initial = &model.info().initial;
+    assemble_from(model, t0, (&initial.q, &initial.qd), &initial.hold)
+}
+
+/// A consistent state at t0 from (q, q̇): held and driven coordinates keep their values, the
+/// dependent ones are solved by Newton (15) and (16).
+pub(crate) fn assemble_from<D: Dynamics + ?Sized>(
+    model: &D,
+    t0: f64,
+    (q, qd): (&[f64], &[f64]),
+    hold: &[bool],
+) -> Result<State, SimError> {
     let info = model.info();
     let (n, nc) = (info.n(), info.n_contacts());
     let driven: Vec<bool> = info.coordinates.iter().map(|c| c.driven).collect();
     validate_model(model, &driven, t0)?;
+    if q.len() != n || qd.len() != n || hold.len() != n {
+        return Err(invalid(format!("{} needs {n} coordinates", info.name)));
+    }
     let nu = n - nc - driven.iter().filter(|d| **d).count();
     let mut ws = Workspace::new(n, nc, nu);
-    ws.set_state(&info.initial.q, &info.initial.qd);
+    ws.set_state(q, qd);
     model.prescribed(t0, &mut ws.q, &mut ws.qd, &mut ws.qdd);
     if ws.q().iter().chain(ws.qd()).any(|x| !x.is_finite()) {
         return Err(ws.non_finite(t0, "initial guess"));
     }
-    let solved = assemble_positions(model, &mut ws, &driven, t0)?;
+    let solved = assemble_positions(model, &mut ws, &driven, hold, t0)?;
     ws.factor_jacobian(model, &solved, t0)?;
     ws.solve_velocities(&solved);
     let eligible: Vec<bool> = driven.iter().map(|d| !d).collect();
@@ -467,13 +516,12 @@ fn assemble_positions<D: Dynamics + ?Sized>(
     model: &D,
     ws: &mut Workspace,
     driven: &[bool],
+    hold: &[bool],
     t0: f64,
 ) -> Result<Vec<usize>, SimError> {
     let info = model.info();
     let (n, nc) = (info.n(), info.n_contacts());
-    let solvable: Vec<bool> = (0..n)
-        .map(|i| !driven[i] && !info.initial.hold[i])
-        .collect();
+    let solvable: Vec<bool> = (0..n).map(|i| !driven[i] && !hold[i]).collect();
     model.constraint_jacobian(&ws.q, &mut ws.jacobian);
     if ws.jacobian.iter().any(|x| !x.is_finite()) {
         return Err(ws.non_finite(t0, "J"));
@@ -494,7 +542,7 @@ fn assemble_positions<D: Dynamics + ?Sized>(
 
 /// What a sample holds beyond t, q, q̇ and the quadratures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum SampleLevel {
+pub(crate) enum SampleLevel {
     /// Everything [`Sample`] describes.
     Full,
     /// Only t, q, q̇, the quadratures and the partition: no accelerations, forces,
@@ -513,6 +561,7 @@ fn run<D: Dynamics + ?Sized>(
     observe: &mut dyn FnMut(&Sample),
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
+    let mut events = Vec::new();
     let checks = check_belongs(model, &state)
         .and_then(|()| validate_integration(settings))
         .and_then(|()| validate_output(settings, state.t));
@@ -522,11 +571,12 @@ fn run<D: Dynamics + ?Sized>(
             trajectory.samples.push(sample);
         };
         if settings.integrator.is_adaptive() {
-            run_dense(model, &mut state, settings, level, &mut emit)
+            run_dense(model, &mut state, settings, level, &mut emit, &mut events)
         } else {
             run_landing(model, &mut state, settings, level, &mut emit)
         }
     });
+    trajectory.events = events;
     match outcome {
         Ok(stats) => {
             trajectory.stats = stats;
@@ -578,10 +628,11 @@ fn run_dense<D: Dynamics + ?Sized>(
     settings: &SimSettings,
     level: SampleLevel,
     emit: &mut dyn FnMut(Sample),
+    events: &mut Vec<ContactEvent>,
 ) -> RunResult {
     let before = all_counters(&state.engine);
     let mut stats = Stats::default();
-    let outcome = dense_loop(model, state, settings, level, emit, &mut stats);
+    let outcome = dense_loop(model, state, settings, level, emit, &mut stats, events);
     add_counters_since(&mut stats, &state.engine, before);
     match outcome {
         Ok(()) => Ok(stats),
@@ -600,50 +651,307 @@ fn dense_loop<D: Dynamics + ?Sized>(
     level: SampleLevel,
     emit: &mut dyn FnMut(Sample),
     stats: &mut Stats,
+    events: &mut Vec<ContactEvent>,
 ) -> Result<(), SimError> {
-    if state.modified_since_last_step() {
-        state.load_integrated_state();
-    }
-    let t0 = state.t;
-    let intervals = output_intervals(t0, settings);
-    emit(sample_in_place(model, state, level)?);
-    let mut sample_ws = state.engine.ws.clone();
-    let mut y_out = state.engine.y.clone();
-    let mut next = 1;
-    let mut steps_since_output = 0;
-    while next <= intervals {
-        if steps_since_output == MAX_STEPS_PER_CALL {
-            return Err(SimError::TooManySteps { t: state.t });
+    let mut grid = Grid::new(state.t, settings);
+    let watch = match level {
+        SampleLevel::Full if model.info().n_contacts() > 0 => Watch::Forces { stop: false },
+        _ => Watch::Nothing,
+    };
+    let mut phase = Phase {
+        settings,
+        level,
+        watch: &watch,
+        grid: &mut grid,
+        emit,
+        stats,
+        events,
+    };
+    phase.run(model, state)?;
+    Ok(())
+}
+
+/// The output times of a run, t0 + k·dt_out and t_end, shared by its phases.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Grid {
+    t0: f64,
+    intervals: usize,
+    /// Index of the next output to emit.
+    pub(crate) next: usize,
+}
+
+impl Grid {
+    /// The grid of `settings` from t0, nothing emitted yet.
+    pub(crate) fn new(t0: f64, settings: &SimSettings) -> Self {
+        Grid {
+            t0,
+            intervals: output_intervals(t0, settings),
+            next: 0,
         }
-        let t_new = adaptive_step(model, state, settings.t_end, settings)?;
-        steps_since_output += 1;
-        while next <= intervals && output_time(t0, next, intervals, settings) < t_new {
-            let t_out = output_time(t0, next, intervals, settings);
-            interpolate_last_step(model, state, settings, t_out, &mut y_out)?;
+    }
+
+    fn time(&self, k: usize, settings: &SimSettings) -> f64 {
+        output_time(self.t0, k, self.intervals, settings)
+    }
+
+    /// The next output time, if any is left.
+    fn pending(&self, settings: &SimSettings) -> Option<f64> {
+        (self.next <= self.intervals).then(|| self.time(self.next, settings))
+    }
+}
+
+/// What a phase of a run watches for at every step (see [`crate::events`]).
+pub(crate) enum Watch<'a> {
+    /// Nothing.
+    Nothing,
+    /// Sign changes of the normal forces, recorded as events; with `stop`, the first one
+    /// to zero or below ends the phase (a unilateral follower lifts off).
+    Forces {
+        /// End the phase when a force reaches zero from above.
+        stop: bool,
+    },
+    /// The gap h(q) of a contact (a flying follower), computed by `gap`: its reaching zero
+    /// from above ends the phase (the follower lands).
+    Gap {
+        /// h of the contact at q.
+        gap: &'a dyn Fn(&[f64]) -> f64,
+    },
+}
+
+/// Where and why a phase ended before t_end.
+#[derive(Debug, Clone)]
+pub(crate) struct Stop {
+    pub(crate) t: f64,
+    pub(crate) contact: usize,
+    pub(crate) q: Vec<f64>,
+    pub(crate) qd: Vec<f64>,
+    /// Dissipated energy and driven work at t.
+    pub(crate) quadratures: (f64, f64),
+}
+
+/// One phase of a run: free adaptive steps with dense output, outputs on the shared grid,
+/// events located inside the steps.
+pub(crate) struct Phase<'p, 'w> {
+    pub(crate) settings: &'p SimSettings,
+    pub(crate) level: SampleLevel,
+    pub(crate) watch: &'p Watch<'w>,
+    pub(crate) grid: &'p mut Grid,
+    pub(crate) emit: &'p mut dyn FnMut(Sample),
+    pub(crate) stats: &'p mut Stats,
+    pub(crate) events: &'p mut Vec<ContactEvent>,
+}
+
+impl Phase<'_, '_> {
+    /// Integrates until the grid is done or the watch stops the phase.
+    pub(crate) fn run<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        state: &mut State,
+    ) -> Result<Option<Stop>, SimError> {
+        if state.modified_since_last_step() {
+            state.load_integrated_state();
+        }
+        let settings = self.settings;
+        if self.grid.next == 0 {
+            (self.emit)(sample_in_place(model, state, self.level)?);
+            self.grid.next = 1;
+        }
+        let mut sample_ws = state.engine.ws.clone();
+        let mut y_out = state.engine.y.clone();
+        let y_start = state.engine.y.clone();
+        let mut watched = self.watch_values(model, state, &mut sample_ws, state.t, &y_start)?;
+        if let Watch::Gap { .. } = self.watch {
+            // A flight starts on the cam (gap 0 up to Newton's tolerance): count it as
+            // above, so that a landing within the first step is not missed.
+            for g in &mut watched {
+                *g = g.max(f64::MIN_POSITIVE);
+            }
+        }
+        if let Some(stop) = self.stop_at_start(model, state, &watched)? {
+            return Ok(Some(stop));
+        }
+        let mut steps_since_output = 0;
+        while self.grid.pending(settings).is_some() {
+            if steps_since_output == MAX_STEPS_PER_CALL {
+                return Err(SimError::TooManySteps { t: state.t });
+            }
+            let t_old = state.t;
+            let t_new = adaptive_step(model, state, settings.t_end, settings)?;
+            steps_since_output += 1;
+            interpolate_last_step(model, state, settings, t_new, &mut y_out)?;
             sample_ws
                 .v_anchor
                 .copy_from_slice(&state.engine.ws.v_anchor);
-            emit(sample_interpolated(
+            let now = self.watch_values(model, state, &mut sample_ws, t_new, &y_out)?;
+            let stop = self.locate_events(
                 model,
                 state,
                 &mut sample_ws,
-                t_out,
-                &y_out,
-                level,
-            )?);
-            next += 1;
-            steps_since_output = 0;
+                (t_old, &watched),
+                (t_new, &now),
+            )?;
+            let limit = stop.as_ref().map_or(t_new, |s| s.t);
+            while let Some(t_out) = self.grid.pending(settings) {
+                let inside = t_out < limit || (stop.is_some() && t_out <= limit);
+                if !inside {
+                    break;
+                }
+                interpolate_last_step(model, state, settings, t_out, &mut y_out)?;
+                let sample =
+                    sample_interpolated(model, state, &mut sample_ws, t_out, &y_out, self.level)?;
+                (self.emit)(sample);
+                self.grid.next += 1;
+                steps_since_output = 0;
+            }
+            if stop.is_some() {
+                return Ok(stop);
+            }
+            if finish_step(model, state, t_new)? {
+                self.stats.repartitions += 1;
+            }
+            if self
+                .grid
+                .pending(settings)
+                .is_some_and(|t_out| t_out <= t_new)
+            {
+                (self.emit)(sample_in_place(model, state, self.level)?);
+                self.grid.next += 1;
+                steps_since_output = 0;
+            }
+            watched = now;
         }
-        if finish_step(model, state, t_new)? {
-            stats.repartitions += 1;
+        Ok(None)
+    }
+
+    /// The watched quantities at (t, y) of the current step's partition.
+    fn watch_values<D: Dynamics + ?Sized>(
+        &self,
+        model: &D,
+        state: &State,
+        ws: &mut Workspace,
+        t: f64,
+        y: &[f64],
+    ) -> Result<Vec<f64>, SimError> {
+        if matches!(self.watch, Watch::Nothing) {
+            return Ok(Vec::new());
         }
-        if next <= intervals && output_time(t0, next, intervals, settings) <= t_new {
-            emit(sample_in_place(model, state, level)?);
-            next += 1;
-            steps_since_output = 0;
+        let partition = &state.partition;
+        load_state(model, partition, ws, t, y)?;
+        match self.watch {
+            Watch::Nothing => Ok(Vec::new()),
+            Watch::Forces { .. } => {
+                ws.solve_accelerations(model, partition, t)?;
+                ws.solve_multipliers(partition, t)?;
+                let mut contacts = vec![ContactGeometry::default(); partition.dependent().len()];
+                model.contact_geometry(ws.q(), &mut contacts);
+                Ok(ws
+                    .lambda()
+                    .iter()
+                    .zip(&contacts)
+                    .map(|(&l, g)| normal_force(l, g.slope))
+                    .collect())
+            }
+            Watch::Gap { gap } => Ok(vec![gap(ws.q())]),
         }
     }
-    Ok(())
+
+    /// A phase that must stop at once: a unilateral contact starting with a pulling force.
+    fn stop_at_start<D: Dynamics + ?Sized>(
+        &self,
+        model: &D,
+        state: &State,
+        watched: &[f64],
+    ) -> Result<Option<Stop>, SimError> {
+        let Watch::Forces { stop: true } = self.watch else {
+            return Ok(None);
+        };
+        let _ = model;
+        Ok(watched.iter().position(|&n| n <= 0.0).map(|contact| Stop {
+            t: state.t,
+            contact,
+            q: state.q.clone(),
+            qd: state.qd.clone(),
+            quadratures: (state.dissipated, state.driven_work),
+        }))
+    }
+
+    /// Sign changes of the watched quantities inside the step, located by root finding on
+    /// the dense output; records them as events and returns the first one that stops the
+    /// phase (with q, q̇ there).
+    fn locate_events<D: Dynamics + ?Sized>(
+        &mut self,
+        model: &D,
+        state: &mut State,
+        ws: &mut Workspace,
+        (t0, before): (f64, &[f64]),
+        (t1, after): (f64, &[f64]),
+    ) -> Result<Option<Stop>, SimError> {
+        let mut found: Vec<(f64, usize, bool)> = Vec::new();
+        for (k, (&g0, &g1)) in before.iter().zip(after).enumerate() {
+            // A gap only matters when it closes.
+            let gap = matches!(self.watch, Watch::Gap { .. });
+            if !changes_sign(g0, g1) || (gap && g0 <= 0.0) {
+                continue;
+            }
+            let stops = match self.watch {
+                Watch::Nothing => false,
+                Watch::Forces { stop } => *stop && g0 > 0.0,
+                Watch::Gap { .. } => g0 > 0.0,
+            };
+            let mut y = vec![0.0; state.engine.y.len()];
+            let g = |t: f64| -> Result<f64, SimError> {
+                interpolate_last_step(model, state, self.settings, t, &mut y)?;
+                let values = self.watch_values(model, state, ws, t, &y)?;
+                Ok(values[k])
+            };
+            let t = locate_root(g, (t0, g0), (t1, g1), EVENT_TIME_TOLERANCE)?;
+            found.push((t, k, stops));
+        }
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let first_stop = found.iter().find(|e| e.2).map(|e| e.0);
+        let mut stop = None;
+        for (t, k, stops) in found {
+            if first_stop.is_some_and(|ts| t > ts) {
+                break;
+            }
+            let mut y = vec![0.0; state.engine.y.len()];
+            interpolate_last_step(model, state, self.settings, t, &mut y)?;
+            load_state(model, &state.partition, ws, t, &y)?;
+            let kind = match self.watch {
+                Watch::Gap { .. } => EventKind::Impact {
+                    normal_velocity: f64::NAN,
+                    rebound: f64::NAN,
+                    stays: false,
+                    loss: f64::NAN,
+                },
+                _ if stops => EventKind::LiftOff,
+                _ if before[k] > 0.0 => EventKind::ForceBecameNegative,
+                _ => EventKind::ForceBecamePositive,
+            };
+            let (q, qd) = (ws.q().to_vec(), ws.qd().to_vec());
+            if stops {
+                // The driver records the stopping event (it completes impacts).
+                let nu = state.partition.independent().len();
+                let quadratures = (y[2 * nu], y[2 * nu + 1]);
+                stop = Some(Stop {
+                    t,
+                    contact: k,
+                    q,
+                    qd,
+                    quadratures,
+                });
+                break;
+            }
+            self.events.push(ContactEvent {
+                t,
+                contact: k,
+                kind,
+                q,
+                qd,
+            });
+        }
+        Ok(stop)
+    }
 }
 
 /// The sample at an interpolated y inside the last step (the partition of that step).
@@ -925,6 +1233,27 @@ impl<D: Dynamics + ?Sized> StepParts<'_, D> {
         });
         Ok(if lands { t_target } else { t + accepted.h })
     }
+}
+
+/// The counters of a state's integrators (before a phase).
+pub(crate) fn phase_counters(state: &State) -> [Counters; 3] {
+    all_counters(&state.engine)
+}
+
+/// Adds the work a phase did on `state` since `before`.
+pub(crate) fn add_phase_counters(stats: &mut Stats, state: &State, before: [Counters; 3]) {
+    add_counters_since(stats, &state.engine, before);
+}
+
+/// The checks every run makes before it starts.
+pub(crate) fn validate_run<D: Dynamics + ?Sized>(
+    model: &D,
+    state: &State,
+    settings: &SimSettings,
+) -> Result<(), SimError> {
+    check_belongs(model, state)
+        .and_then(|()| validate_integration(settings))
+        .and_then(|()| validate_output(settings, state.t))
 }
 
 /// The counters of the three integrators of an engine.

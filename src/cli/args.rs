@@ -131,6 +131,12 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "TOL", value_parser = positive_number)]
     pub atol: Option<f64>,
 
+    /// One-sided contact: the follower lifts off where the normal force reaches zero and
+    /// lands with this coefficient of restitution (0 plastic … 1 elastic); needs an adaptive
+    /// integrator and one contact [default: bilateral contact, as in the paper]
+    #[arg(long, value_name = "E", value_parser = restitution)]
+    pub restitution: Option<f64>,
+
     /// Coordinates plotted in the time-history figure, comma-separated, e.g. q4,q3 (the
     /// paper's figures 3 and 5) [default: all, from the tip to the base]
     #[arg(long, value_name = "NAMES", value_delimiter = ',')]
@@ -214,6 +220,19 @@ pub fn integrator_name(kind: IntegratorKind) -> &'static str {
         IntegratorKind::Rk4 => "rk4",
         IntegratorKind::Dopri5 => "dopri5",
         IntegratorKind::Dop853 => "dop853",
+    }
+}
+
+/// A coefficient of restitution: a number in [0, 1].
+fn restitution(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if (0.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("{value} is not in [0, 1]"))
     }
 }
 

@@ -162,6 +162,7 @@ fn integrate(
     model: &dyn Dynamics,
     label: &str,
     settings: &SimSettings,
+    restitution: Option<f64>,
     quiet: bool,
 ) -> (Trajectory, Option<String>, Duration) {
     let start = Instant::now();
@@ -172,7 +173,12 @@ fn integrate(
             Some(format!("assembly onto the cam failed: {e}")),
         ),
         Ok(state) => {
-            match model.simulate_observed(state, settings, &mut |s| progress.update(s.t)) {
+            let run = match restitution {
+                // One-sided contact runs in phases; its progress is not reported.
+                Some(e) => model.simulate_unilateral(state, settings, e),
+                None => model.simulate_observed(state, settings, &mut |s| progress.update(s.t)),
+            };
+            match run {
                 Ok(trajectory) => (trajectory, None),
                 Err(failure) => {
                     let message = failure.to_string();
@@ -191,7 +197,13 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console) -> Result<Trajecto
     let dynamics = model.engine.dynamics();
     let info = dynamics.info();
     let settings = args.settings(&info.defaults);
-    let (trajectory, failure, wall) = integrate(dynamics, &model.label, &settings, args.quiet);
+    let (trajectory, failure, wall) = integrate(
+        dynamics,
+        &model.label,
+        &settings,
+        args.restitution,
+        args.quiet,
+    );
     let mut ok = failure.is_none();
     if let Some(message) = &failure {
         eprintln!("error: {}: {message}", model.label);
@@ -226,6 +238,7 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console) -> Result<Trajecto
         info,
         settings: &settings,
         samples: &trajectory.samples,
+        events: &trajectory.events,
         stats: trajectory.stats,
         wall,
     }));

@@ -7,6 +7,7 @@
 //! real, one-sided follower would lift off the cam there.
 
 use super::args::integrator_name;
+use camchain::runtime::events::{ContactEvent, EventKind};
 use camchain::runtime::{CoordinateKind, IntegratorKind, ModelInfo, Sample, SimSettings, Stats};
 use std::fmt::Write;
 use std::time::Duration;
@@ -23,6 +24,8 @@ pub struct RunReport<'a> {
     pub settings: &'a SimSettings,
     /// The samples (all of them, or those computed before a failure).
     pub samples: &'a [Sample],
+    /// Contact events located during the run (adaptive integrators).
+    pub events: &'a [ContactEvent],
     /// The integrator's work.
     pub stats: Stats,
     /// Assembly plus simulation.
@@ -156,6 +159,7 @@ pub fn render(report: &RunReport) -> String {
         info,
         settings,
         samples,
+        events,
         stats,
         wall,
     } = report;
@@ -186,7 +190,13 @@ pub fn render(report: &RunReport) -> String {
         }
         let mut checks = Vec::new();
         for (k, name) in info.contacts.iter().enumerate() {
-            let max_h = samples.iter().map(|s| s.h[k].abs()).fold(0.0, f64::max);
+            // In flight (one-sided contact, no dependent coordinate) h is the gap, not a
+            // residual.
+            let max_h = samples
+                .iter()
+                .filter(|s| !s.dependent.is_empty())
+                .map(|s| s.h[k].abs())
+                .fold(0.0, f64::max);
             checks.push(format!("max |{name}_h| {max_h:.2e} m"));
         }
         checks.push(format!(
@@ -204,6 +214,11 @@ pub fn render(report: &RunReport) -> String {
         stats.repartitions,
         wall_time(*wall)
     );
+    if !events.is_empty() || settings.integrator.is_adaptive() {
+        text.push_str(&render_events(info, events));
+        return text;
+    }
+    // RK4 runs locate no events: the sign change is interpolated between outputs.
     for (k, name) in info.contacts.iter().enumerate() {
         match lift_off(samples, k) {
             Some(l) if l.from_start => {
@@ -223,6 +238,51 @@ pub fn render(report: &RunReport) -> String {
             }
             None => {}
         }
+    }
+    text
+}
+
+/// Most events listed one by one in the summary.
+const LISTED_EVENTS: usize = 8;
+
+/// One line per contact event (the first [`LISTED_EVENTS`], then a count).
+fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
+    let mut text = String::new();
+    for event in events.iter().take(LISTED_EVENTS) {
+        let name = info.contacts.get(event.contact).map_or("?", String::as_str);
+        let what = match event.kind {
+            EventKind::ForceBecameNegative => format!(
+                "warning: the normal force on {name} becomes negative: a one-sided follower \
+                 would lift off the cam here"
+            ),
+            EventKind::ForceBecamePositive => {
+                format!("the normal force on {name} becomes positive again")
+            }
+            EventKind::LiftOff => format!("{name} lifts off the cam"),
+            EventKind::Impact {
+                normal_velocity,
+                rebound,
+                stays,
+                loss,
+            } => format!(
+                "{name} lands at {:.3e} m/s, {}; impact loss {loss:.2e} J",
+                -normal_velocity,
+                if stays {
+                    "stays on the cam".to_string()
+                } else {
+                    format!("rebounds at {rebound:.3e} m/s")
+                }
+            ),
+        };
+        let _ = writeln!(text, "  t = {:.9} s: {what}", event.t);
+    }
+    if events.len() > LISTED_EVENTS {
+        let _ = writeln!(
+            text,
+            "  … and {} more contact events (the last at t = {:.9} s)",
+            events.len() - LISTED_EVENTS,
+            events.last().map_or(f64::NAN, |e| e.t)
+        );
     }
     text
 }

@@ -1,0 +1,417 @@
+//! One-sided contact: the follower may leave the cam and land on it again.
+//!
+//! The paper's contact is bilateral: the cam may pull as well as push. A real follower held
+//! on the cam by gravity or a spring is one-sided. [`simulate_unilateral`] integrates in
+//! phases:
+//!
+//! - **in contact** the constrained equations (13)–(18) run as usual and the normal force N
+//!   is watched; where it reaches zero from above (located to 1e-9 s on the dense output) the
+//!   follower **lifts off**;
+//! - **in flight** the same chain runs without the constraint (the model seen through
+//!   [`Detached`]) and the gap h(q) (3), positive above the cam, is watched; where it
+//!   reaches zero the follower **lands**;
+//! - at landing the **impact law** applies: a frictionless impulse along the contact normal
+//!   (Jᵀ Λ, on the free coordinates only: driven joints keep their prescribed velocity) such
+//!   that the normal velocity reverses with Newton's coefficient of restitution e:
+//!   J q̇⁺ = −e J q̇⁻, i.e. q̇⁺_f = q̇⁻_f − (1 + e) M_ff⁻¹ J_fᵀ (J q̇⁻) / (J_f M_ff⁻¹ J_fᵀ).
+//!   The kinetic energy the impact removes is added to the dissipated energy and the
+//!   drives' impulsive work to the driven work, so that the energy balance still closes.
+//!   A rebound slower than [`RESTING_SPEED`] ends in contact (e taken as 0), which stops the
+//!   infinite sequence of ever shorter bounces a rigid model would otherwise make.
+//!
+//! Outputs stay on the run's grid; in flight the samples report N = 0 and the gap as h.
+
+use crate::dynamics::VelocityTerms;
+use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, Energy, ModelInfo};
+use crate::error::SimError;
+use crate::events::{ContactEvent, EventKind};
+use crate::simulate::{
+    Grid, Phase, SampleLevel, SimFailure, Simulate, State, Stats, Stop, Trajectory, Watch,
+    add_phase_counters, phase_counters, validate_run,
+};
+use crate::{Sample, SimSettings};
+use nalgebra::{DMatrix, DVector};
+use std::cell::RefCell;
+
+/// Slowest rebound (m/s of the normal velocity J q̇) with which the follower flies off again
+/// after an impact; slower rebounds end in contact.
+pub const RESTING_SPEED: f64 = 1e-4;
+
+/// Most contact events a unilateral run accepts before it reports chattering.
+pub const MAX_EVENTS: usize = 100_000;
+
+/// The contact law of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactLaw {
+    /// The paper's bilateral contact: the cam pushes and pulls; sign changes of the normal
+    /// force are reported as events.
+    Bilateral,
+    /// One-sided contact with Newton's coefficient of restitution e ∈ [0, 1] at landing.
+    Unilateral {
+        /// Coefficient of restitution.
+        restitution: f64,
+    },
+}
+
+/// A model seen without its cam contacts (a flying follower): same bodies, joints, drives
+/// and forces, no constraint.
+pub struct Detached<'a, D: ?Sized> {
+    inner: &'a D,
+    info: ModelInfo,
+    /// h, J and c of the inner model, computed alongside and ignored.
+    scratch: RefCell<(Vec<f64>, Vec<f64>, Vec<f64>)>,
+}
+
+impl<'a, D: Dynamics + ?Sized> Detached<'a, D> {
+    /// `inner` without its contacts.
+    pub fn new(inner: &'a D) -> Self {
+        let mut info = inner.info().clone();
+        let (n, nc) = (info.n(), info.n_contacts());
+        info.contacts.clear();
+        Detached {
+            inner,
+            info,
+            scratch: RefCell::new((vec![0.0; nc], vec![0.0; nc * n], vec![0.0; nc])),
+        }
+    }
+}
+
+impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
+    fn info(&self) -> &ModelInfo {
+        &self.info
+    }
+    fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
+        self.inner.mass_matrix(q, m);
+    }
+    fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
+        self.inner.inertial_forces(q, qd, f);
+    }
+    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.inner.applied_forces(t, q, qd, out);
+    }
+    fn constraint(&self, _q: &[f64], _h: &mut [f64]) {}
+    fn constraint_jacobian(&self, _q: &[f64], _j: &mut [f64]) {}
+    fn constraint_bias(&self, _q: &[f64], _qd: &[f64], _c: &mut [f64]) {}
+    fn contact_geometry(&self, _q: &[f64], _out: &mut [ContactGeometry]) {}
+    fn contact_kinematics(&self, q: &[f64], qd: &[f64], k: usize) -> ContactKinematics {
+        self.inner.contact_kinematics(q, qd, k)
+    }
+    fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
+        self.inner.prescribed(t, q, qd, qdd);
+    }
+    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy {
+        self.inner.energy(q, qd)
+    }
+    fn damper_power(&self, qd: &[f64]) -> f64 {
+        self.inner.damper_power(qd)
+    }
+    fn equations(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        m: &mut [f64],
+        f: &mut [f64],
+        applied: &mut [f64],
+    ) {
+        self.inner.equations(t, q, qd, m, f, applied);
+    }
+    fn cache_len(&self) -> usize {
+        self.inner.cache_len()
+    }
+    fn position_terms(&self, q: &[f64], _h: &mut [f64], _j: &mut [f64], cache: &mut [f64]) {
+        let mut scratch = self.scratch.borrow_mut();
+        let (h, j, _) = &mut *scratch;
+        self.inner.position_terms(q, h, j, cache);
+    }
+    fn velocity_terms(&self, t: f64, q: &[f64], qd: &[f64], cache: &[f64], out: VelocityTerms) {
+        let mut scratch = self.scratch.borrow_mut();
+        let inner_out = VelocityTerms {
+            mass: out.mass,
+            inertial: out.inertial,
+            applied: out.applied,
+            bias: &mut scratch.2,
+        };
+        self.inner.velocity_terms(t, q, qd, cache, inner_out);
+    }
+}
+
+/// Velocities after an impact, and the bookkeeping of the event.
+struct Impact {
+    qd: Vec<f64>,
+    normal_velocity: f64,
+    rebound: f64,
+    stays: bool,
+    /// Kinetic energy removed by the impact (J, ≥ 0 up to round-off).
+    loss: f64,
+    /// Work of the drives' impulsive reactions (J).
+    drive_work: f64,
+}
+
+/// The impact law of the module documentation at (q, q̇⁻) for contact `k`.
+fn impact<D: Dynamics + ?Sized>(
+    model: &D,
+    t: f64,
+    (q, qd): (&[f64], &[f64]),
+    k: usize,
+    restitution: f64,
+) -> Result<Impact, SimError> {
+    let info = model.info();
+    let (n, nc) = (info.n(), info.n_contacts());
+    let free: Vec<usize> = (0..n).filter(|&i| !info.coordinates[i].driven).collect();
+    let mut m = vec![0.0; n * n];
+    model.mass_matrix(q, &mut m);
+    let mut j = vec![0.0; nc * n];
+    model.constraint_jacobian(q, &mut j);
+    let row = &j[k * n..(k + 1) * n];
+    let normal_velocity: f64 = row.iter().zip(qd).map(|(a, b)| a * b).sum();
+    let m_ff = DMatrix::from_fn(free.len(), free.len(), |a, b| m[free[a] * n + free[b]]);
+    let j_f = DVector::from_iterator(free.len(), free.iter().map(|&i| row[i]));
+    let singular = || SimError::SingularConstraint { t, q: q.to_vec() };
+    let x = m_ff.cholesky().ok_or_else(singular)?.solve(&j_f);
+    let denominator = j_f.dot(&x);
+    if !(denominator > 0.0 && denominator.is_finite()) {
+        return Err(singular());
+    }
+    let stays = restitution * normal_velocity.abs() < RESTING_SPEED;
+    let e = if stays { 0.0 } else { restitution };
+    let impulse = -(1.0 + e) * normal_velocity / denominator;
+    let mut after = qd.to_vec();
+    for (a, &i) in free.iter().enumerate() {
+        after[i] += x[a] * impulse;
+    }
+    let rebound: f64 = row.iter().zip(&after).map(|(a, b)| a * b).sum();
+    let kinetic = |v: &[f64]| model.energy(q, v).kinetic;
+    let delta_qd: Vec<f64> = after.iter().zip(qd).map(|(a, b)| a - b).collect();
+    // The drives' impulsive reactions P_d = (M Δq̇)_d − J_d Λ (what the contact impulse
+    // does not supply on a driven coordinate) act at the constant velocities q̇_d.
+    let drive_work: f64 = (0..n)
+        .filter(|&d| info.coordinates[d].driven)
+        .map(|d| {
+            let p: f64 = (0..n).map(|c| m[d * n + c] * delta_qd[c]).sum();
+            (p - row[d] * impulse) * qd[d]
+        })
+        .sum();
+    let loss = drive_work - (kinetic(&after) - kinetic(qd));
+    Ok(Impact {
+        qd: after,
+        normal_velocity,
+        rebound,
+        stays,
+        loss,
+        drive_work,
+    })
+}
+
+/// The flight samples of the detached model, completed with the contact's view: the gap
+/// as h, N = 0, the geometry under the point.
+fn complete_flight_sample<D: Dynamics + ?Sized>(model: &D, sample: &mut Sample) {
+    let nc = model.info().n_contacts();
+    let mut h = vec![0.0; nc];
+    model.constraint(&sample.q, &mut h);
+    let mut contacts = vec![ContactGeometry::default(); nc];
+    model.contact_geometry(&sample.q, &mut contacts);
+    sample.h = h;
+    sample.contacts = contacts;
+    sample.normal_force = vec![0.0; nc];
+    sample.lambda = vec![0.0; nc];
+}
+
+/// What the follower is doing.
+enum Mode<'a, D: ?Sized> {
+    Contact(State),
+    Flight(State, &'a Detached<'a, D>),
+}
+
+/// Simulates `state` of `model` (one cam contact) to `settings.t_end` with one-sided contact
+/// and restitution `restitution` (see the module documentation). Needs an adaptive
+/// integrator (events are located on its dense output).
+pub fn simulate_unilateral<D: Dynamics + ?Sized>(
+    model: &D,
+    state: State,
+    settings: &SimSettings,
+    restitution: f64,
+) -> Result<Trajectory, Box<SimFailure>> {
+    let mut trajectory = Trajectory::default();
+    let mut events = Vec::new();
+    let mut stats = Stats::default();
+    let outcome = validate_unilateral(model, &state, settings, restitution).and_then(|()| {
+        let mut emit = |sample: Sample| trajectory.samples.push(sample);
+        run_phases(
+            model,
+            state,
+            settings,
+            restitution,
+            &mut emit,
+            &mut stats,
+            &mut events,
+        )
+    });
+    trajectory.events = events;
+    trajectory.stats = stats;
+    match outcome {
+        Ok(()) => Ok(trajectory),
+        Err(error) => Err(Box::new(SimFailure {
+            error,
+            partial: trajectory,
+        })),
+    }
+}
+
+fn validate_unilateral<D: Dynamics + ?Sized>(
+    model: &D,
+    state: &State,
+    settings: &SimSettings,
+    restitution: f64,
+) -> Result<(), SimError> {
+    validate_run(model, state, settings)?;
+    let invalid = |message: String| Err(SimError::InvalidSettings { message });
+    if model.info().n_contacts() != 1 {
+        return invalid(format!(
+            "unilateral contact needs a model with exactly one cam contact; {} has {}",
+            model.info().name,
+            model.info().n_contacts()
+        ));
+    }
+    if !settings.integrator.is_adaptive() {
+        return invalid(
+            "unilateral contact needs an adaptive integrator (dopri5 or dop853): lift-off \
+             and landing are located on its dense output"
+                .into(),
+        );
+    }
+    if !(0.0..=1.0).contains(&restitution) {
+        return invalid(format!(
+            "the coefficient of restitution must lie in [0, 1], got {restitution}"
+        ));
+    }
+    Ok(())
+}
+
+fn run_phases<D: Dynamics + ?Sized>(
+    model: &D,
+    state: State,
+    settings: &SimSettings,
+    restitution: f64,
+    emit: &mut dyn FnMut(Sample),
+    stats: &mut Stats,
+    events: &mut Vec<ContactEvent>,
+) -> Result<(), SimError> {
+    let detached = Detached::new(model);
+    let mut grid = Grid::new(state.t, settings);
+    let mut mode = Mode::Contact(state);
+    loop {
+        if events.len() > MAX_EVENTS {
+            return Err(SimError::InvalidSettings {
+                message: format!(
+                    "more than {MAX_EVENTS} contact events before t_end: the follower \
+                     chatters on the cam"
+                ),
+            });
+        }
+        let (stop, flying) = match &mut mode {
+            Mode::Contact(state) => {
+                let watch = Watch::Forces { stop: true };
+                let stop = run_phase(
+                    model, state, settings, &watch, &mut grid, emit, stats, events,
+                )?;
+                (stop, false)
+            }
+            Mode::Flight(state, detached) => {
+                let gap = |q: &[f64]| {
+                    let mut h = [0.0];
+                    model.constraint(q, &mut h);
+                    h[0]
+                };
+                let watch = Watch::Gap { gap: &gap };
+                let mut flight_emit = |mut sample: Sample| {
+                    complete_flight_sample(model, &mut sample);
+                    emit(sample);
+                };
+                let stop = run_phase(
+                    *detached,
+                    state,
+                    settings,
+                    &watch,
+                    &mut grid,
+                    &mut flight_emit,
+                    stats,
+                    events,
+                )?;
+                (stop, true)
+            }
+        };
+        let Some(stop) = stop else {
+            return Ok(());
+        };
+        let (dissipated, driven_work) = stop.quadratures;
+        mode = if flying {
+            let hit = impact(
+                model,
+                stop.t,
+                (&stop.q, &stop.qd),
+                stop.contact,
+                restitution,
+            )?;
+            events.push(ContactEvent {
+                t: stop.t,
+                contact: stop.contact,
+                kind: EventKind::Impact {
+                    normal_velocity: hit.normal_velocity,
+                    rebound: hit.rebound,
+                    stays: hit.stays,
+                    loss: hit.loss,
+                },
+                q: stop.q.clone(),
+                qd: stop.qd.clone(),
+            });
+            let quadratures = (dissipated + hit.loss, driven_work + hit.drive_work);
+            if hit.stays {
+                let mut next = model.state_at(stop.t, &stop.q, &hit.qd)?;
+                next.set_quadratures(quadratures);
+                Mode::Contact(next)
+            } else {
+                let mut next = detached.state_at(stop.t, &stop.q, &hit.qd)?;
+                next.set_quadratures(quadratures);
+                Mode::Flight(next, &detached)
+            }
+        } else {
+            events.push(ContactEvent {
+                t: stop.t,
+                contact: stop.contact,
+                kind: EventKind::LiftOff,
+                q: stop.q.clone(),
+                qd: stop.qd.clone(),
+            });
+            let mut next = detached.state_at(stop.t, &stop.q, &stop.qd)?;
+            next.set_quadratures((dissipated, driven_work));
+            Mode::Flight(next, &detached)
+        };
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_phase<D: Dynamics + ?Sized>(
+    model: &D,
+    state: &mut State,
+    settings: &SimSettings,
+    watch: &Watch,
+    grid: &mut Grid,
+    emit: &mut dyn FnMut(Sample),
+    stats: &mut Stats,
+    events: &mut Vec<ContactEvent>,
+) -> Result<Option<Stop>, SimError> {
+    let mut phase = Phase {
+        settings,
+        level: SampleLevel::Full,
+        watch,
+        grid,
+        emit,
+        stats,
+        events,
+    };
+    let before = phase_counters(state);
+    let outcome = phase.run(model, state);
+    add_phase_counters(phase.stats, state, before);
+    outcome
+}
