@@ -1,4 +1,6 @@
-//! Turns every `models/*.ron` into a generated Rust module under `OUT_DIR/models/`.
+//! Turns every `models/*.ron` into a generated Rust module under `OUT_DIR/models/`, and, with
+//! the `random-models` feature, every `tests/random_models/*.ron` (random models of the
+//! property tests, not user-facing) into one under `OUT_DIR/random_models/`.
 //!
 //! A model that does not validate stops the build with `file:line:column: field: message`
 //! lines (no panic backtrace). Output is deterministic: models are processed in file-name
@@ -8,10 +10,21 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    println!("cargo:rerun-if-changed=models");
     let manifest = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").unwrap_or_default());
     let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").unwrap_or_default());
-    match generate_all(&manifest, &out_dir) {
+    let mut sets = vec![("models", manifest.join("models"))];
+    // Set by cargo when the `random-models` feature is on (this package's own tests).
+    if std::env::var_os("CARGO_FEATURE_RANDOM_MODELS").is_some() {
+        sets.push((
+            "random_models",
+            manifest.join("tests").join("random_models"),
+        ));
+    }
+    let built = sets.iter().try_for_each(|(set, dir)| {
+        println!("cargo:rerun-if-changed={}", dir.display());
+        generate_all(&manifest, dir, &out_dir, set)
+    });
+    match built {
         Ok(()) => ExitCode::SUCCESS,
         Err(messages) => {
             for m in messages {
@@ -32,9 +45,11 @@ fn model_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(files)
 }
 
-fn generate_all(manifest: &Path, out_dir: &Path) -> Result<(), Vec<String>> {
-    let files = model_files(&manifest.join("models")).map_err(|e| vec![e])?;
-    let module_dir = out_dir.join("models");
+/// Generates one module per model file of `dir` under `OUT_DIR/<set>/` and the index
+/// `OUT_DIR/<set>.rs`.
+fn generate_all(manifest: &Path, dir: &Path, out_dir: &Path, set: &str) -> Result<(), Vec<String>> {
+    let files = model_files(dir).map_err(|e| vec![e])?;
+    let module_dir = out_dir.join(set);
     std::fs::create_dir_all(&module_dir)
         .map_err(|e| vec![format!("{}: {e}", module_dir.display())])?;
     let mut errors = Vec::new();
@@ -68,10 +83,10 @@ fn generate_all(manifest: &Path, out_dir: &Path) -> Result<(), Vec<String>> {
         return Err(errors);
     }
     let index = module_index(&modules);
-    write_if_changed(&out_dir.join("models.rs"), &index).map_err(|e| vec![e.to_string()])
+    write_if_changed(&out_dir.join(format!("{set}.rs")), &index).map_err(|e| vec![e.to_string()])
 }
 
-/// `models.rs`: one `pub mod` per model and the table of all built-in models.
+/// The index: one `pub mod` per model and the table of all of them.
 fn module_index(modules: &[(String, PathBuf, String)]) -> String {
     let mut text = String::new();
     for (name, path, summary) in modules {
@@ -80,7 +95,7 @@ fn module_index(modules: &[(String, PathBuf, String)]) -> String {
             path.display().to_string()
         ));
     }
-    text.push_str("/// Every built-in model by name, in file-name order.\n");
+    text.push_str("/// Every model of this set by name, in file-name order.\n");
     text.push_str("pub static ALL: &[(&str, &(dyn ::camchain_runtime::Dynamics + Sync))] = &[\n");
     for (name, _, _) in modules {
         text.push_str(&format!("    ({name:?}, &{name}::Model),\n"));

@@ -22,3 +22,14 @@ pub mod models {
         ALL.iter().find(|(n, _)| *n == name).map(|(_, m)| *m)
     }
 }
+
+/// Random models of the property tests (`tests/random_models/`, written by
+/// `runtime/tests/random_models.rs`), compiled like the built-in ones so that
+/// `tests/random_compiled.rs` checks the emitted Rust itself against the numeric reference.
+/// Not part of the user-facing model list: compiled only with the `random-models` feature, which
+/// this package's tests turn on.
+#[cfg(feature = "random-models")]
+#[doc(hidden)]
+pub mod random_models {
+    include!(concat!(env!("OUT_DIR"), "/random_models.rs"));
+}

@@ -13,8 +13,7 @@ mod common;
 use camchain::models;
 use camchain::runtime::reference::NumericModel;
 use camchain::runtime::{Dynamics, Simulate};
-use common::{Rng, max_rel_diff};
-use std::cell::Cell;
+use common::{Rng, compare_dynamics, max_rel_diff};
 
 /// Relative agreement demanded, against max(1, |value|) of the reference. Both routes
 /// evaluate the same physics in double precision with different operation orders; for
@@ -23,125 +22,6 @@ use std::cell::Cell;
 /// wrong term (the smallest physical term, e.g. a 0.01 kg·m² inertia times a rate of 1e-2,
 /// is ~1e-4).
 const TOL: f64 = 1e-12;
-
-/// Asserts agreement within [`TOL`] and records the largest relative difference seen.
-fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str, worst: &Cell<f64>) {
-    common::assert_close(a, b, tol, what);
-    worst.set(worst.get().max(max_rel_diff(a, b)));
-}
-
-/// Compares every function of the trait; returns the largest relative difference.
-fn compare_model(name: &str, generated: &dyn Dynamics, numeric: &NumericModel) -> f64 {
-    let worst = Cell::new(0.0);
-    let n = generated.info().n();
-    let nc = generated.info().n_contacts();
-    assert_eq!(numeric.info().n(), n);
-    let mut rng = Rng::new(name.len() as u64 * 7919 + 17);
-    for _ in 0..100 {
-        let q = rng.vec(n, -1.5, 1.5);
-        let qd = rng.vec(n, -2.0, 2.0);
-        let t = rng.uniform(0.0, 10.0);
-        let both = |f: &dyn Fn(&dyn Dynamics) -> Vec<f64>| (f(generated), f(numeric));
-        let (a, b) = both(&|m| {
-            let mut out = vec![0.0; n * n];
-            m.mass_matrix(&q, &mut out);
-            out
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: M"), &worst);
-        let (a, b) = both(&|m| {
-            let mut out = vec![0.0; n];
-            m.inertial_forces(&q, &qd, &mut out);
-            out
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: F"), &worst);
-        let (a, b) = both(&|m| {
-            let mut out = vec![0.0; n];
-            m.applied_forces(t, &q, &qd, &mut out);
-            out
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: Q"), &worst);
-        let (a, b) = both(&|m| {
-            let (mut mm, mut f, mut qa) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
-            m.equations(t, &q, &qd, &mut mm, &mut f, &mut qa);
-            [mm, f, qa].concat()
-        });
-        assert_close(
-            &a,
-            &b,
-            TOL,
-            &format!("{name}: equations (M, F, Q together)"),
-            &worst,
-        );
-        let (a, b) = both(&|m| {
-            let (mut h, mut j, mut c) = (vec![0.0; nc], vec![0.0; nc * n], vec![0.0; nc]);
-            m.constraint(&q, &mut h);
-            m.constraint_jacobian(&q, &mut j);
-            m.constraint_bias(&q, &qd, &mut c);
-            [h, j, c].concat()
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: h, J, c"), &worst);
-        let (a, b) = both(&|m| {
-            let (mut j, mut c) = (vec![0.0; nc * n], vec![0.0; nc]);
-            m.constraint_terms(&q, &qd, &mut j, &mut c);
-            [j, c].concat()
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: constraint_terms"), &worst);
-        // The fused pair a right-hand side calls: the velocity level reads the cache the
-        // position level filled (the numeric model's default ignores the cache).
-        let (a, b) = both(&|m| {
-            let (mut h, mut j) = (vec![0.0; nc], vec![0.0; nc * n]);
-            let mut cache = vec![f64::NAN; m.cache_len()];
-            m.position_terms(&q, &mut h, &mut j, &mut cache);
-            let (mut mm, mut f, mut qa, mut c) =
-                (vec![0.0; n * n], vec![0.0; n], vec![0.0; n], vec![0.0; nc]);
-            let out = camchain::runtime::VelocityTerms {
-                mass: &mut mm,
-                inertial: &mut f,
-                applied: &mut qa,
-                bias: &mut c,
-            };
-            m.velocity_terms(t, &q, &qd, &cache, out);
-            [h, j, mm, f, qa, c].concat()
-        });
-        assert_close(
-            &a,
-            &b,
-            TOL,
-            &format!("{name}: position_terms then velocity_terms"),
-            &worst,
-        );
-        for k in 0..nc {
-            let (a, b) = both(&|m| {
-                let ck = m.contact_kinematics(&q, &qd, k);
-                let g = ck.geometry;
-                let mut v = vec![g.x, g.y, g.slope, g.curvature, ck.conv1, ck.conv2];
-                v.extend(g.position);
-                v.extend(ck.j1);
-                v.extend(ck.j2);
-                v
-            });
-            assert_close(
-                &a,
-                &b,
-                TOL,
-                &format!("{name}: contact {k} kinematics"),
-                &worst,
-            );
-        }
-        let (a, b) = both(&|m| {
-            let e = m.energy(&q, &qd);
-            vec![e.kinetic, e.gravity, e.spring, m.damper_power(&qd)]
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: energies"), &worst);
-        let (a, b) = both(&|m| {
-            let (mut pq, mut pv, mut pa) = (q.clone(), qd.clone(), vec![0.0; n]);
-            m.prescribed(t, &mut pq, &mut pv, &mut pa);
-            [pq, pv, pa].concat()
-        });
-        assert_close(&a, &b, TOL, &format!("{name}: prescribed motion"), &worst);
-    }
-    worst.get()
-}
 
 #[test]
 fn every_generated_model_agrees_with_the_numeric_recursion() {
@@ -153,7 +33,7 @@ fn every_generated_model_agrees_with_the_numeric_recursion() {
         let path = format!("{}/models/{name}.ron", env!("CARGO_MANIFEST_DIR"));
         let numeric = NumericModel::load(std::path::Path::new(&path))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let worst = compare_model(name, *generated, &numeric);
+        let worst = compare_dynamics(name, *generated, &numeric, TOL);
         println!("{name}: largest relative difference generated vs numeric {worst:.2e}");
     }
 }
