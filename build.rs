@@ -101,6 +101,19 @@ fn module_index(modules: &[(String, PathBuf, String)]) -> String {
         text.push_str(&format!("    ({name:?}, &{name}::Model),\n"));
     }
     text.push_str("];\n");
+    text.push_str(
+        "/// Operation counts of every built-in model's generated functions, by model name \
+         (add/sub, mul, div, sin/cos, sqrt, other).\n",
+    );
+    text.push_str(
+        "/// One generated function's operation counts: its name and add/sub, mul, div, \
+         sin/cos, sqrt, other.\npub type OpCountRow = (&'static str, [usize; 6]);\n",
+    );
+    text.push_str("pub static OP_COUNTS: &[(&str, &[OpCountRow])] = &[\n");
+    for (name, _, _) in modules {
+        text.push_str(&format!("    ({name:?}, {name}::OP_COUNTS),\n"));
+    }
+    text.push_str("];\n");
     text
 }
 

@@ -3,13 +3,16 @@
 //! For a marker A on body b and a cam y = f3(x) in a plane with origin o and axes
 //! (x̂, ŷ): f1 = x̂·(p_A − o), f2 = ŷ·(p_A − o) (1), h = f2 − f3(f1) (3),
 //! J = J2 − f3'(f1) J1 (5b), c = (J2 q̇)_q q̇ − f3' (J1 q̇)_q q̇ − f3'' (J1 q̇)² (7, 8).
-//! J1, J2 and the convective terms are read off the point's acceleration from the forward
-//! recursion (coefficients of q̈ and the velocity remainder), projected on the cam axes;
-//! f3' and f3'' are derived symbolically from the profile.
+//! Everything is formed in the ground frame, where a planar chain's absolute angles make the
+//! closed forms short: the Jacobian column of joint j is u_j × (p_A − o_j) for a revolute
+//! joint and u_j for a prismatic one (u_j the joint axis, o_j the joint point, both in the
+//! ground frame), with p_A − o_j summed from the tip; the convective acceleration of A comes
+//! from a ground-frame recursion along the path from the ground to the marker's body. Both
+//! are projected on the cam axes; f3' and f3'' are derived symbolically from the profile.
 
 use crate::expr::{Graph, Id};
-use crate::kinematics::{BodyKinematics, V3, point_accel, point_position, vec3};
-use crate::model::{Contact, Model};
+use crate::kinematics::{BodyKinematics, V3, vec3};
+use crate::model::{Contact, JointKind, Model};
 use crate::profile::Scalar;
 
 /// Symbolic terms of one contact.
@@ -117,40 +120,100 @@ fn one_contact(
         contact.name
     ));
     let marker = &model.markers[contact.marker];
-    let body = &kin[marker.body];
-    let position = point_position(g, body, marker.position);
-    let origin = vec3::constant(g, contact.origin);
-    let rel = vec3::sub(g, position, origin);
+    // The joints between the ground and the marker's body, tip first.
+    let mut path = Vec::new();
+    let mut at = Some(marker.body);
+    while let Some(j) = at {
+        path.push(j);
+        at = model.bodies[j].parent;
+    }
+    // Angular velocity and the velocity-product part of the angular acceleration of every
+    // body on the path, ground frame (from the ground out).
+    let n = model.n();
+    let zero3 = vec3::zero(g);
+    let (mut omega, mut alpha) = (vec![zero3; n], vec![zero3; n]);
+    let (mut w, mut a) = (zero3, zero3);
+    let mut coriolis = zero3;
+    for &j in path.iter().rev() {
+        let k = &kin[j];
+        match model.bodies[j].joint.kind {
+            JointKind::Revolute => {
+                let rate = vec3::scale(g, qd[j], k.axis_ground);
+                let w_e = vec3::cross(g, w, rate);
+                a = vec3::add(g, a, w_e);
+                w = vec3::add(g, w, rate);
+            }
+            JointKind::Prismatic => {
+                // 2 ω × e q̇ of the sliding joint point, as (2 q̇ ω) × e: scalars first.
+                let two = g.constant(2.0);
+                let two_qd = g.mul(two, qd[j]);
+                let tw = vec3::scale(g, two_qd, w);
+                let cor = vec3::cross(g, tw, k.axis_ground);
+                coriolis = vec3::add(g, coriolis, cor);
+            }
+        }
+        omega[j] = w;
+        alpha[j] = a;
+    }
+    // From the tip down: p_A − o_j for the Jacobian columns, and the convective acceleration
+    // α × s + ω × (ω × s) of each segment s. Across a prismatic joint the two bodies turn
+    // together, so their segments are summed in the common frame before being rotated
+    // (`pending`, in the frame of `body`): (l2 + q3 + l3) once instead of two segments.
+    let mut pending = vec3::constant(g, marker.position);
+    let mut done = zero3;
+    let mut accel = coriolis;
+    let (mut j1, mut j2) = (vec![g.zero(); n], vec![g.zero(); n]);
     let (x_axis, y_axis) = (
         vec3::constant(g, contact.x_axis),
         vec3::constant(g, contact.y_axis),
     );
+    for &j in &path {
+        let k = &kin[j];
+        let column = match model.bodies[j].joint.kind {
+            JointKind::Revolute => {
+                let seg = k.rotation.apply(g, pending);
+                let a_s = vec3::cross(g, alpha[j], seg);
+                let w_w_s = vec3::omega_omega(g, omega[j], seg);
+                accel = vec3::add(g, accel, a_s);
+                accel = vec3::add(g, accel, w_w_s);
+                done = vec3::add(g, seg, done);
+                pending = k.offset;
+                vec3::cross(g, k.axis_ground, done)
+            }
+            JointKind::Prismatic => {
+                // No rotation at this joint: the segment continues in the same frame.
+                pending = vec3::add(g, k.offset, pending);
+                k.axis_ground
+            }
+        };
+        j1[j] = vec3::dot(g, x_axis, column);
+        j2[j] = vec3::dot(g, y_axis, column);
+    }
+    // The root's segment is fixed in the ground.
+    let position = vec3::add(g, pending, done);
+    let origin = vec3::constant(g, contact.origin);
+    let rel = vec3::sub(g, position, origin);
     let f1 = vec3::dot(g, x_axis, rel);
     let f2 = vec3::dot(g, y_axis, rel);
-    // Cam axes seen in the body frame, to project the body-frame acceleration.
-    let xb = body.rotation.apply_transpose(g, x_axis);
-    let yb = body.rotation.apply_transpose(g, y_axis);
-    let accel = point_accel(g, body, marker.position);
-    let a1 = crate::kinematics::lin3::dot_v(g, xb, &accel);
-    let a2 = crate::kinematics::lin3::dot_v(g, yb, &accel);
+    let conv1 = vec3::dot(g, x_axis, accel);
+    let conv2 = vec3::dot(g, y_axis, accel);
     let [f3, slope, curvature] =
         value_and_derivatives(g, &contact.profile, &format!("__cam_{}", contact.name), f1);
     let h = g.sub(f2, f3);
-    let jacobian: Vec<Id> = a1
-        .qdd
+    let jacobian: Vec<Id> = j1
         .iter()
-        .zip(&a2.qdd)
+        .zip(&j2)
         .map(|(&j1, &j2)| {
             let s = g.mul(slope, j1);
             g.sub(j2, s)
         })
         .collect();
-    let j1_qd = dot_list(g, &a1.qdd, qd);
+    let j1_qd = dot_list(g, &j1, qd);
     let bias = {
-        let t1 = g.mul(slope, a1.vel);
+        let t1 = g.mul(slope, conv1);
         let sq = g.powi(j1_qd, 2);
         let t2 = g.mul(curvature, sq);
-        let b = g.sub(a2.vel, t1);
+        let b = g.sub(conv2, t1);
         g.sub(b, t2)
     };
     let name = &contact.name;
@@ -163,10 +226,10 @@ fn one_contact(
         position,
         f1,
         f2,
-        j1: a1.qdd,
-        j2: a2.qdd,
-        conv1: a1.vel,
-        conv2: a2.vel,
+        j1,
+        j2,
+        conv1,
+        conv2,
         slope,
         curvature,
         h,

@@ -1,22 +1,27 @@
-//! Backward recursion (tip → ground) of joint loads on symbolic expressions, eqs. (10)–(13).
+//! M, F and Q of eq. (13) on symbolic expressions, each by the recursion that suits it.
 //!
-//! For body i, in its own frame, the force and the moment about its joint point carried by
-//! joint i are the inertial minus applied loads of i plus those carried by its children:
+//! - M by composite inertias (the composite-rigid-body form of the backward recursion): the
+//!   spatial inertia of every subtree about its joint point, in the subtree root's frame, is
+//!   summed from the tip; M_ii is the joint axis projection of the subtree's momentum for a
+//!   unit joint rate, and moving that momentum down to each ancestor's joint gives M_ji.
+//! - F by the backward recursion of the inertial loads at q̈ = 0 (10)–(12): for body i, in its
+//!   own frame, about its joint point,
 //!
-//! ```text
-//! F_i = m_i a_Gi + Σ_c R_c F_c
-//! N_i = I_i α_i + ω_i × I_i ω_i + c_i × m_i a_Gi + Σ_c (R_c N_c + r_c × R_c F_c)
-//! ```
+//!   ```text
+//!   F_i = m_i a_i + α_i × h_i + ω_i × (ω_i × h_i) + Σ_c R_c F_c
+//!   N_i = I_i α_i + ω_i × I_i ω_i + h_i × a_i + Σ_c (R_c N_c + r_c × R_c F_c)
+//!   ```
 //!
-//! (gravity is already inside a_Gi through the ground's acceleration −g). Projecting N_i (a
-//! revolute joint) or F_i (a prismatic joint) on the joint axis gives one [`Lin`] form per
-//! joint whose q̈ coefficients are the row of M, whose velocity remainder is F, and whose
-//! gravity remainder, plus the joint's spring-damper, is Q (13).
+//!   with h_i = m_i c_i and I_i the inertia about the joint point (so no centre-of-mass
+//!   acceleration is formed), projected on the joint axis.
+//! - Q: the gravity loads of a subtree are its mass times −g, so their moment about joint i is
+//!   (h_i + Σ_c M_c r_c) × (−g_i) + Σ_c R_c N_c, with −g carried into each body frame by the
+//!   forward recursion; plus the joint's spring-damper.
 
 use crate::expr::{Graph, Id};
-use crate::kinematics::{BodyKinematics, L3, Lin, Symbols};
-use crate::kinematics::{lin3, point_accel, point_position, point_velocity, vec3};
-use crate::model::{JointKind, Model};
+use crate::kinematics::{BodyKinematics, Symbols, V3};
+use crate::kinematics::{point_position, point_velocity, vec3};
+use crate::model::{Body, JointKind, Model};
 
 /// M, F and Q of eq. (13) as expressions.
 #[derive(Debug, Clone)]
@@ -29,90 +34,22 @@ pub struct DynamicsTerms {
     pub applied: Vec<Id>,
 }
 
-/// Joint load of one body: force and moment about its joint point, body frame.
-struct Load {
-    force: L3,
-    moment: L3,
-}
-
-/// Runs the backward recursion over all bodies and collects M, F, Q.
+/// Derives M, F and Q.
 pub fn backward(
     g: &mut Graph,
     model: &Model,
     s: &Symbols,
     kin: &[BodyKinematics],
 ) -> DynamicsTerms {
-    let n = model.n();
-    let mut loads: Vec<Option<Load>> = (0..n).map(|_| None).collect();
-    let mut forms: Vec<Option<Lin>> = vec![None; n];
-    for i in (0..n).rev() {
-        g.set_section(format!(
-            "{}: inertial loads and joint {} load (backward recursion)",
-            model.bodies[i].name, model.bodies[i].joint.coordinate
-        ));
-        let mut load = body_load(g, model, i, &kin[i]);
-        for c in (i + 1..n).filter(|&c| model.bodies[c].parent == Some(i)) {
-            if let Some(child) = loads[c].take() {
-                load = add_child_load(g, &kin[c], load, &child);
-            }
-        }
-        // Generalised force of joint i: the carried load projected on the joint axis.
-        let carried = match model.bodies[i].joint.kind {
-            JointKind::Revolute => &load.moment,
-            JointKind::Prismatic => &load.force,
-        };
-        forms[i] = Some(lin3::dot_v(g, kin[i].axis, carried));
-        loads[i] = Some(load);
-    }
-    let forms: Vec<Lin> = forms.into_iter().flatten().collect();
-    collect_terms(g, model, s, &forms)
-}
-
-/// Inertial minus applied loads of body i alone (10, 11).
-fn body_load(g: &mut Graph, model: &Model, i: usize, k: &BodyKinematics) -> Load {
-    let body = &model.bodies[i];
-    let mass = g.constant(body.mass);
-    let a_com = point_accel(g, k, body.com);
-    let force = lin3::scale(g, mass, &a_com);
-    let i_alpha = lin3::mat_mul(g, &body.inertia, &k.alpha);
-    let i_omega = vec3::mat_mul(g, &body.inertia, k.omega);
-    let gyro = vec3::cross(g, k.omega, i_omega);
-    let com = vec3::constant(g, body.com);
-    let c_f = lin3::v_cross(g, com, &force);
-    let moment = lin3::add_vel(g, &i_alpha, gyro);
-    let moment = lin3::add(g, &moment, &c_f);
-    Load { force, moment }
-}
-
-/// Adds a child's joint load, moved to the parent's joint point (12).
-fn add_child_load(g: &mut Graph, child: &BodyKinematics, load: Load, c: &Load) -> Load {
-    let f = child.relative.apply_lin(g, &c.force);
-    let m = child.relative.apply_lin(g, &c.moment);
-    let r_f = lin3::v_cross(g, child.offset, &f);
-    let force = lin3::add(g, &load.force, &f);
-    let moment = lin3::add(g, &load.moment, &m);
-    let moment = lin3::add(g, &moment, &r_f);
-    Load { force, moment }
-}
-
-/// Splits the joint forms into M, F and Q (adding springs and dampers to Q).
-fn collect_terms(g: &mut Graph, model: &Model, s: &Symbols, forms: &[Lin]) -> DynamicsTerms {
-    let n = model.n();
-    let mut mass = vec![vec![g.zero(); n]; n];
-    for (i, form) in forms.iter().enumerate() {
-        for (j, &entry) in form.qdd.iter().enumerate().skip(i) {
-            // M is symmetric; the recursion yields both triangles, the upper one is used.
-            mass[i][j] = entry;
-            mass[j][i] = entry;
-        }
-    }
-    let inertial = forms.iter().map(|f| f.vel).collect();
-    let applied = forms
+    let mass = mass_matrix(g, model, kin);
+    let inertial = inertial_forces(g, model, kin);
+    let gravity = gravity_forces(g, model, kin);
+    let applied = gravity
         .iter()
         .enumerate()
-        .map(|(i, f)| {
+        .map(|(i, &grav)| {
             let spring = spring_damper_load(g, model, s, i);
-            g.add(f.grav, spring)
+            g.add(grav, spring)
         })
         .collect();
     DynamicsTerms {
@@ -120,6 +57,280 @@ fn collect_terms(g: &mut Graph, model: &Model, s: &Symbols, forms: &[Lin]) -> Dy
         inertial,
         applied,
     }
+}
+
+/// Spatial inertia about a frame origin, in that frame.
+#[derive(Debug, Clone, Copy)]
+struct Inertia {
+    /// Mass.
+    mass: Id,
+    /// First moment h = Σ m c.
+    first: V3,
+    /// Inertia tensor about the origin (symmetric).
+    tensor: [V3; 3],
+}
+
+/// Numeric mass, first moment and inertia about the joint point of one body.
+fn body_constants(body: &Body) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+    let (m, c) = (body.mass, body.com);
+    let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    let mut tensor = body.inertia;
+    for (a, row) in tensor.iter_mut().enumerate() {
+        for (b, cell) in row.iter_mut().enumerate() {
+            let delta = if a == b { cc } else { 0.0 };
+            *cell += m * (delta - c[a] * c[b]);
+        }
+    }
+    (m, c.map(|x| m * x), tensor)
+}
+
+fn body_inertia(g: &mut Graph, body: &Body) -> Inertia {
+    let (m, h, tensor) = body_constants(body);
+    Inertia {
+        mass: g.constant(m),
+        first: vec3::constant(g, h),
+        tensor: [
+            vec3::constant(g, tensor[0]),
+            vec3::constant(g, tensor[1]),
+            vec3::constant(g, tensor[2]),
+        ],
+    }
+}
+
+/// A child's composite inertia seen from its parent's frame and joint point.
+fn to_parent(g: &mut Graph, child: &BodyKinematics, c: &Inertia) -> Inertia {
+    let h = child.relative.apply(g, c.first);
+    let rotated = rotate_tensor(g, child, &c.tensor);
+    let r = child.offset;
+    let mr = vec3::scale(g, c.mass, r);
+    let first = vec3::add(g, h, mr);
+    // I' = R I Rᵀ + δ r·(h' + h̃) − (r h'ᵀ + h̃ rᵀ), h̃ = R h, h' = h̃ + m r.
+    let both = vec3::add(g, first, h);
+    let diag = vec3::dot(g, r, both);
+    let mut tensor = rotated;
+    for a in 0..3 {
+        for b in a..3 {
+            let t1 = g.mul(r[a], first[b]);
+            let t2 = g.mul(h[a], r[b]);
+            let off = g.add(t1, t2);
+            let mut e = g.sub(rotated[a][b], off);
+            if a == b {
+                e = g.add(e, diag);
+            }
+            tensor[a][b] = e;
+            tensor[b][a] = e;
+        }
+    }
+    Inertia {
+        mass: c.mass,
+        first,
+        tensor,
+    }
+}
+
+/// R I Rᵀ for the child's joint rotation (upper triangle computed, mirrored).
+fn rotate_tensor(g: &mut Graph, child: &BodyKinematics, t: &[V3; 3]) -> [V3; 3] {
+    if child.relative == crate::kinematics::Rotation::Identity {
+        return *t;
+    }
+    let r = child.relative.matrix(g);
+    // (R I)_{aj} = row_a(R)·column_j(I); (R I Rᵀ)_{ab} = row_a(R I)·row_b(R).
+    let ri: Vec<V3> = (0..3)
+        .map(|a| {
+            let cols: V3 = [0, 1, 2].map(|j| {
+                let col = [t[0][j], t[1][j], t[2][j]];
+                vec3::dot(g, r[a], col)
+            });
+            cols
+        })
+        .collect();
+    let mut out = *t;
+    for a in 0..3 {
+        for b in a..3 {
+            let e = vec3::dot(g, ri[a], r[b]);
+            out[a][b] = e;
+            out[b][a] = e;
+        }
+    }
+    out
+}
+
+fn add_inertia(g: &mut Graph, a: &Inertia, b: &Inertia) -> Inertia {
+    let mut tensor = a.tensor;
+    for (i, j) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)] {
+        let e = g.add(a.tensor[i][j], b.tensor[i][j]);
+        tensor[i][j] = e;
+        tensor[j][i] = e;
+    }
+    Inertia {
+        mass: g.add(a.mass, b.mass),
+        first: vec3::add(g, a.first, b.first),
+        tensor,
+    }
+}
+
+fn mat_vec(g: &mut Graph, m: &[V3; 3], v: V3) -> V3 {
+    [
+        vec3::dot(g, m[0], v),
+        vec3::dot(g, m[1], v),
+        vec3::dot(g, m[2], v),
+    ]
+}
+
+/// The children of every body.
+fn children(model: &Model) -> Vec<Vec<usize>> {
+    let mut out = vec![Vec::new(); model.n()];
+    for (i, b) in model.bodies.iter().enumerate() {
+        if let Some(p) = b.parent {
+            out[p].push(i);
+        }
+    }
+    out
+}
+
+/// A spatial force (moment about the frame origin, force), moved from a child's frame to its
+/// parent's: f' = R f, n' = R n + r × f'.
+fn force_to_parent(g: &mut Graph, child: &BodyKinematics, n: V3, f: V3) -> (V3, V3) {
+    let f = child.relative.apply(g, f);
+    let n = child.relative.apply(g, n);
+    let r_f = vec3::cross(g, child.offset, f);
+    (vec3::add(g, n, r_f), f)
+}
+
+/// The generalised component of a spatial force on joint i.
+fn project(g: &mut Graph, model: &Model, kin: &[BodyKinematics], i: usize, n: V3, f: V3) -> Id {
+    match model.bodies[i].joint.kind {
+        JointKind::Revolute => vec3::dot(g, kin[i].axis, n),
+        JointKind::Prismatic => vec3::dot(g, kin[i].axis, f),
+    }
+}
+
+/// M by composite inertias.
+fn mass_matrix(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Vec<Id>> {
+    let n = model.n();
+    let kids = children(model);
+    let mut composite: Vec<Option<Inertia>> = vec![None; n];
+    let mut mass = vec![vec![g.zero(); n]; n];
+    for i in (0..n).rev() {
+        g.set_section(format!(
+            "{}: composite inertia and column {} of M",
+            model.bodies[i].name, model.bodies[i].joint.coordinate
+        ));
+        let mut c = body_inertia(g, &model.bodies[i]);
+        for &k in &kids[i] {
+            if let Some(child) = composite[k] {
+                let moved = to_parent(g, &kin[k], &child);
+                c = add_inertia(g, &c, &moved);
+            }
+        }
+        // Momentum of the subtree for a unit rate of joint i, about the joint point.
+        let u = kin[i].axis;
+        let (mut nn, mut ff) = match model.bodies[i].joint.kind {
+            JointKind::Revolute => (mat_vec(g, &c.tensor, u), vec3::cross(g, u, c.first)),
+            JointKind::Prismatic => (vec3::cross(g, c.first, u), vec3::scale(g, c.mass, u)),
+        };
+        mass[i][i] = project(g, model, kin, i, nn, ff);
+        let mut k = i;
+        while let Some(p) = model.bodies[k].parent {
+            (nn, ff) = force_to_parent(g, &kin[k], nn, ff);
+            let e = project(g, model, kin, p, nn, ff);
+            mass[p][i] = e;
+            mass[i][p] = e;
+            k = p;
+        }
+        composite[i] = Some(c);
+    }
+    mass
+}
+
+/// F: inertial loads at q̈ = 0, summed from the tip.
+fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Id> {
+    let n = model.n();
+    let kids = children(model);
+    let mut loads: Vec<Option<(V3, V3)>> = vec![None; n];
+    let mut out = vec![g.zero(); n];
+    for i in (0..n).rev() {
+        g.set_section(format!(
+            "{}: inertial loads and joint {} load (backward recursion)",
+            model.bodies[i].name, model.bodies[i].joint.coordinate
+        ));
+        let k = &kin[i];
+        let b = body_inertia(g, &model.bodies[i]);
+        // Own loads about the joint point (no centre-of-mass acceleration needed).
+        let ma = vec3::scale(g, b.mass, k.accel);
+        let a_h = vec3::cross(g, k.alpha, b.first);
+        let w_w_h = vec3::omega_omega(g, k.omega, b.first);
+        let f = vec3::add(g, ma, a_h);
+        let mut force = vec3::add(g, f, w_w_h);
+        let i_a = mat_vec(g, &b.tensor, k.alpha);
+        let i_w = mat_vec(g, &b.tensor, k.omega);
+        let gyro = vec3::cross(g, k.omega, i_w);
+        let h_a = vec3::cross(g, b.first, k.accel);
+        let m = vec3::add(g, i_a, gyro);
+        let mut moment = vec3::add(g, m, h_a);
+        for &c in &kids[i] {
+            if let Some((nc, fc)) = loads[c].take() {
+                let (nc, fc) = force_to_parent(g, &kin[c], nc, fc);
+                moment = vec3::add(g, moment, nc);
+                force = vec3::add(g, force, fc);
+            }
+        }
+        out[i] = project(g, model, kin, i, moment, force);
+        loads[i] = Some((moment, force));
+    }
+    out
+}
+
+/// The gravity part of Q: moments of the subtrees' weights about the joints.
+fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Id> {
+    let n = model.n();
+    let kids = children(model);
+    if model.gravity == [0.0; 3] {
+        return vec![g.zero(); n];
+    }
+    // Subtree masses are constants.
+    let mut subtree = vec![0.0; n];
+    for i in (0..n).rev() {
+        subtree[i] += model.bodies[i].mass;
+        if let Some(p) = model.bodies[i].parent {
+            subtree[p] += subtree[i];
+        }
+    }
+    let mut moments: Vec<Option<V3>> = vec![None; n];
+    let mut out = vec![g.zero(); n];
+    for i in (0..n).rev() {
+        g.set_section(format!(
+            "{}: gravity load of the subtree on joint {}",
+            model.bodies[i].name, model.bodies[i].joint.coordinate
+        ));
+        let k = &kin[i];
+        let (_, h, _) = body_constants(&model.bodies[i]);
+        // First moment of the subtree's weights about the joint point, children at their
+        // joint points: h_i + Σ_c M_c r_c.
+        let mut arm = vec3::constant(g, h);
+        let mut moment = vec3::zero(g);
+        for &c in &kids[i] {
+            let mc = g.constant(subtree[c]);
+            let mr = vec3::scale(g, mc, kin[c].offset);
+            arm = vec3::add(g, arm, mr);
+            if let Some(nc) = moments[c].take() {
+                let nc = kin[c].relative.apply(g, nc);
+                moment = vec3::add(g, moment, nc);
+            }
+        }
+        let own = vec3::cross(g, arm, k.gravity);
+        let moment = vec3::add(g, own, moment);
+        out[i] = match model.bodies[i].joint.kind {
+            JointKind::Revolute => vec3::dot(g, k.axis, moment),
+            JointKind::Prismatic => {
+                let m = g.constant(subtree[i]);
+                let ug = vec3::dot(g, k.axis, k.gravity);
+                g.mul(m, ug)
+            }
+        };
+        moments[i] = Some(moment);
+    }
+    out
 }
 
 /// k (q − rest) + c q̇ of joint i (the sign of Q in M q̈ + F + Q = 0).

@@ -95,6 +95,7 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
         contact_kinematics_dispatch(model)
     );
     file.push_str(&contact_kinematics_helpers(model, &d, &mut op_counts));
+    file.push_str(&op_count_table(&op_counts));
     let syntax =
         syn::parse_file(&file).map_err(|e| format!("generated code does not parse: {e}"))?;
     let formatted = prettyplease::unparse(&syntax);
@@ -147,6 +148,25 @@ fn header(out: &mut String, model: &Model, source: &str, counts: &[(String, OpCo
             c.total()
         );
     }
+}
+
+/// `pub const OP_COUNTS`: the header's table as data, for `camchain ops`.
+fn op_count_table(counts: &[(String, OpCount)]) -> String {
+    let rows: Vec<String> = counts
+        .iter()
+        .map(|(name, c)| {
+            format!(
+                "({name:?}, [{}, {}, {}, {}, {}, {}])",
+                c.add_sub, c.mul, c.div, c.sin_cos, c.sqrt, c.other
+            )
+        })
+        .collect();
+    format!(
+        "/// Operation count of every generated function: add/sub, mul, div, sin/cos, sqrt, \
+         other (the table of the header).\n\
+         pub const OP_COUNTS: &[(&str, [usize; 6])] = &[{}];\n",
+        rows.join(", ")
+    )
 }
 
 fn model_type(model: &Model) -> String {

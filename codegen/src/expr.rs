@@ -251,12 +251,43 @@ impl Graph {
             let two = self.constant(2.0);
             return self.mul(two, a);
         }
+        // Like terms: k1·x + k2·x → (k1 + k2)·x, x + k·x → (1 + k)·x.
+        let (ka, xa) = self.split_factor(a);
+        let (kb, xb) = self.split_factor(b);
+        if xa == xb {
+            return self.scale(ka + kb, xa);
+        }
+        // Constants gather: k1 + (k2 + x) → (k1 + k2) + x.
+        for (k, other) in [(a, b), (b, a)] {
+            if let (Some(k1), Node::Add(y, z)) = (self.as_const(k), self.node(other)) {
+                if let Some(k2) = self.as_const(y) {
+                    let c = self.constant(k1 + k2);
+                    return self.add(c, z);
+                }
+                if let Some(k2) = self.as_const(z) {
+                    let c = self.constant(k1 + k2);
+                    return self.add(c, y);
+                }
+            }
+        }
         if let (Node::Neg(x), Node::Neg(y)) = (self.node(a), self.node(b)) {
             let sum = self.add(x, y);
             return self.neg(sum);
         }
         let (a, b) = if a <= b { (a, b) } else { (b, a) };
         self.intern(Node::Add(a, b))
+    }
+
+    /// A term as (constant factor, rest): k·x → (k, x), −x → (−1, x), x → (1, x).
+    fn split_factor(&self, id: Id) -> (f64, Id) {
+        match self.node(id) {
+            Node::Mul(k, x) if self.as_const(k).is_some() => (self.as_const(k).unwrap_or(1.0), x),
+            Node::Neg(y) => {
+                let (k, x) = self.split_factor(y);
+                (-k, x)
+            }
+            _ => (1.0, id),
+        }
     }
 
     /// True for cos²x + sin²x in either order (written as products), which is exactly 1.
@@ -332,6 +363,12 @@ impl Graph {
             Node::Mul(x, y) if self.as_const(x).is_some() => {
                 let d = self.as_const(x).unwrap_or(1.0);
                 self.scale(c * d, y)
+            }
+            // c·(k + x) → ck + c·x: the same two operations, and the constant can merge.
+            Node::Add(x, y) if self.as_const(x).is_some() => {
+                let k = self.constant(c * self.as_const(x).unwrap_or(0.0));
+                let cy = self.scale(c, y);
+                self.add(k, cy)
             }
             _ => {
                 let cid = self.constant(c);
@@ -632,6 +669,20 @@ impl Graph {
     /// own operations, and those only they need, are not counted).
     pub fn op_count_until(&self, roots: &[Id], given: &HashSet<Id>) -> OpCount {
         let reachable = self.reachable_until(roots, given);
+        // For every reachable node: is it used at all, and only by additions? (One pass, so
+        // the count stays linear in the graph's size.)
+        let mut used = vec![false; self.nodes.len()];
+        let mut only_by_add = vec![true; self.nodes.len()];
+        for (i, node) in self.nodes.iter().enumerate() {
+            if !reachable[i] || given.contains(&Id(i as u32)) {
+                continue;
+            }
+            let is_add = matches!(node, Node::Add(..));
+            for c in self.children(Id(i as u32)) {
+                used[c.index()] = true;
+                only_by_add[c.index()] &= is_add;
+            }
+        }
         let mut count = OpCount::default();
         for (i, node) in self.nodes.iter().enumerate() {
             if !reachable[i] {
@@ -644,7 +695,8 @@ impl Graph {
                 Node::Const(_) | Node::Var(_) => {}
                 Node::Add(..) => count.add_sub += 1,
                 Node::Neg(_) => {
-                    if !self.neg_absorbed(Id(i as u32), &reachable) {
+                    // Absorbed when every use is an addition (written as a subtraction).
+                    if !(used[i] && only_by_add[i]) {
                         count.add_sub += 1
                     }
                 }
@@ -656,25 +708,6 @@ impl Graph {
             }
         }
         count
-    }
-
-    /// True when every use of the negation `id` is as an operand of an addition (where the
-    /// emitted code writes a subtraction instead).
-    fn neg_absorbed(&self, id: Id, reachable: &[bool]) -> bool {
-        let mut used = false;
-        for (i, node) in self.nodes.iter().enumerate().skip(id.index() + 1) {
-            if !reachable[i] {
-                continue;
-            }
-            let uses = self.children(Id(i as u32)).contains(&id);
-            if uses {
-                used = true;
-                if !matches!(node, Node::Add(..)) {
-                    return false;
-                }
-            }
-        }
-        used
     }
 
     /// Marks the nodes the roots depend on.

@@ -4,10 +4,11 @@
 //! joint only brings in the sine and cosine of its own angle; absolute rotations are kept as
 //! "rotation about a fixed axis by an angle" as long as consecutive axes are parallel, so a
 //! planar chain composes `q1 + q2 + q4` into one angle whose sine and cosine are computed
-//! once (the Robotran treatment of sums of angles). Accelerations are [`Lin`] forms: the
-//! coefficients of every q̈_j plus a velocity-dependent remainder and a gravity remainder
-//! (gravity enters as the ground's acceleration −g), so the backward recursion can read off
-//! M, F and the gravity part of Q separately.
+//! once (the Robotran treatment of sums of angles). Accelerations carry only their
+//! velocity-product part (the q̈ coefficients are not needed: M comes from composite inertias,
+//! the contact Jacobian from the joint axes in the ground frame), and the gravity vector is
+//! carried separately, seen in each body's frame, so that F and the gravity part of Q are
+//! separate recursions and each only costs O(n).
 
 use crate::expr::{Graph, Id};
 use crate::model::{JointKind, Model};
@@ -36,69 +37,6 @@ impl Symbols {
         Symbols { q, qd, t }
     }
 }
-
-/// An expression linear in the accelerations: Σ_j `qdd[j]`·q̈_j + vel + grav.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Lin {
-    /// Coefficient of each q̈_j.
-    pub qdd: Vec<Id>,
-    /// Remainder that depends on q̇ (Coriolis, centripetal).
-    pub vel: Id,
-    /// Remainder proportional to gravity.
-    pub grav: Id,
-}
-
-impl Lin {
-    /// The zero form over n accelerations.
-    pub fn zero(g: &mut Graph, n: usize) -> Self {
-        let z = g.zero();
-        Lin {
-            qdd: vec![z; n],
-            vel: z,
-            grav: z,
-        }
-    }
-
-    /// a + b
-    pub fn add(g: &mut Graph, a: &Lin, b: &Lin) -> Lin {
-        Lin {
-            qdd: a
-                .qdd
-                .iter()
-                .zip(&b.qdd)
-                .map(|(&x, &y)| g.add(x, y))
-                .collect(),
-            vel: g.add(a.vel, b.vel),
-            grav: g.add(a.grav, b.grav),
-        }
-    }
-
-    /// s · a for a scalar expression s.
-    pub fn scale(g: &mut Graph, s: Id, a: &Lin) -> Lin {
-        Lin {
-            qdd: a.qdd.iter().map(|&x| g.mul(s, x)).collect(),
-            vel: g.mul(s, a.vel),
-            grav: g.mul(s, a.grav),
-        }
-    }
-
-    /// a + v where v goes to the velocity remainder.
-    pub fn add_vel(g: &mut Graph, a: &Lin, v: Id) -> Lin {
-        let mut r = a.clone();
-        r.vel = g.add(a.vel, v);
-        r
-    }
-
-    /// a + s·q̈_j
-    pub fn add_qdd(g: &mut Graph, a: &Lin, j: usize, s: Id) -> Lin {
-        let mut r = a.clone();
-        r.qdd[j] = g.add(a.qdd[j], s);
-        r
-    }
-}
-
-/// A 3-vector of [`Lin`] forms.
-pub type L3 = [Lin; 3];
 
 /// Helpers for constant and symbolic 3-vectors.
 pub mod vec3 {
@@ -146,6 +84,17 @@ pub mod vec3 {
         [c(1, 2), c(2, 0), c(0, 1)]
     }
 
+    /// ω × (ω × r), written as ω (ω·r) − r (ω·ω): ω·ω is shared by every point of a body,
+    /// and for rotation about a fixed axis perpendicular to r (planar motion) ω·r is a
+    /// structural zero, leaving −|ω|² r.
+    pub fn omega_omega(g: &mut Graph, w: V3, r: V3) -> V3 {
+        let wr = dot(g, w, r);
+        let ww = dot(g, w, w);
+        let a = scale(g, wr, w);
+        let b = scale(g, ww, r);
+        sub(g, a, b)
+    }
+
     /// Matrix · vector for a constant matrix (an inertia tensor).
     pub fn mat_mul(g: &mut Graph, m: &[[f64; 3]; 3], v: V3) -> V3 {
         let row = |g: &mut Graph, r: [f64; 3]| {
@@ -160,110 +109,6 @@ pub mod vec3 {
         for (c, axis) in v.iter().zip(["x", "y", "z"]) {
             g.label(*c, format!("{name}_{axis}"));
         }
-    }
-}
-
-/// Helpers for 3-vectors of [`Lin`] forms.
-pub mod lin3 {
-    use super::*;
-
-    /// A vector of pure velocity remainders.
-    pub fn from_vel(g: &mut Graph, n: usize, v: V3) -> L3 {
-        v.map(|c| {
-            let z = Lin::zero(g, n);
-            Lin::add_vel(g, &z, c)
-        })
-    }
-
-    /// a + b
-    pub fn add(g: &mut Graph, a: &L3, b: &L3) -> L3 {
-        [
-            Lin::add(g, &a[0], &b[0]),
-            Lin::add(g, &a[1], &b[1]),
-            Lin::add(g, &a[2], &b[2]),
-        ]
-    }
-
-    /// a + v (v into the velocity remainder)
-    pub fn add_vel(g: &mut Graph, a: &L3, v: V3) -> L3 {
-        [
-            Lin::add_vel(g, &a[0], v[0]),
-            Lin::add_vel(g, &a[1], v[1]),
-            Lin::add_vel(g, &a[2], v[2]),
-        ]
-    }
-
-    /// a + axis·q̈_j
-    pub fn add_qdd(g: &mut Graph, a: &L3, j: usize, axis: V3) -> L3 {
-        [
-            Lin::add_qdd(g, &a[0], j, axis[0]),
-            Lin::add_qdd(g, &a[1], j, axis[1]),
-            Lin::add_qdd(g, &a[2], j, axis[2]),
-        ]
-    }
-
-    /// s · a
-    pub fn scale(g: &mut Graph, s: Id, a: &L3) -> L3 {
-        [
-            Lin::scale(g, s, &a[0]),
-            Lin::scale(g, s, &a[1]),
-            Lin::scale(g, s, &a[2]),
-        ]
-    }
-
-    /// a × v for a Lin vector a and an expression vector v.
-    pub fn cross_v(g: &mut Graph, a: &L3, v: V3) -> L3 {
-        let mut c = |i: usize, j: usize| {
-            let p = Lin::scale(g, v[j], &a[i]);
-            let neg_vi = g.neg(v[i]);
-            let m = Lin::scale(g, neg_vi, &a[j]);
-            Lin::add(g, &p, &m)
-        };
-        [c(1, 2), c(2, 0), c(0, 1)]
-    }
-
-    /// v × a for an expression vector v and a Lin vector a.
-    pub fn v_cross(g: &mut Graph, v: V3, a: &L3) -> L3 {
-        let x = cross_v(g, a, v);
-        let minus_one = g.constant(-1.0);
-        scale(g, minus_one, &x)
-    }
-
-    /// Constant matrix · Lin vector.
-    pub fn mat_mul(g: &mut Graph, m: &[[f64; 3]; 3], a: &L3) -> L3 {
-        let mut row = |r: [f64; 3]| {
-            let mut acc = Lin::zero(g, a[0].qdd.len());
-            for k in 0..3 {
-                let c = g.constant(r[k]);
-                let t = Lin::scale(g, c, &a[k]);
-                acc = Lin::add(g, &acc, &t);
-            }
-            acc
-        };
-        [row(m[0]), row(m[1]), row(m[2])]
-    }
-
-    /// Rotation · Lin vector.
-    pub fn rotate(g: &mut Graph, r: &[V3; 3], a: &L3) -> L3 {
-        let mut row = |row: V3| {
-            let mut acc = Lin::zero(g, a[0].qdd.len());
-            for k in 0..3 {
-                let t = Lin::scale(g, row[k], &a[k]);
-                acc = Lin::add(g, &acc, &t);
-            }
-            acc
-        };
-        [row(r[0]), row(r[1]), row(r[2])]
-    }
-
-    /// e · a for an expression vector e.
-    pub fn dot_v(g: &mut Graph, e: V3, a: &L3) -> Lin {
-        let mut acc = Lin::zero(g, a[0].qdd.len());
-        for k in 0..3 {
-            let t = Lin::scale(g, e[k], &a[k]);
-            acc = Lin::add(g, &acc, &t);
-        }
-        acc
     }
 }
 
@@ -358,24 +203,6 @@ impl Rotation {
             [m[0][2], m[1][2], m[2][2]],
         ]
     }
-
-    /// R · a for a Lin vector.
-    pub fn apply_lin(&self, g: &mut Graph, a: &L3) -> L3 {
-        if *self == Rotation::Identity {
-            return a.clone();
-        }
-        let m = self.matrix(g);
-        lin3::rotate(g, &m, a)
-    }
-
-    /// Rᵀ · a for a Lin vector.
-    pub fn apply_transpose_lin(&self, g: &mut Graph, a: &L3) -> L3 {
-        if *self == Rotation::Identity {
-            return a.clone();
-        }
-        let m = self.transpose_rows(g);
-        lin3::rotate(g, &m, a)
-    }
 }
 
 /// Rodrigues: R = c I + s [a]× + (1 − c) a aᵀ.
@@ -425,20 +252,25 @@ pub struct BodyKinematics {
     pub rotation: Rotation,
     /// Origin in ground coordinates.
     pub origin: V3,
+    /// Origin minus the parent's origin, ground coordinates (the offset seen from the ground).
+    pub step: V3,
+    /// Joint axis in ground coordinates.
+    pub axis_ground: V3,
     /// Angular velocity, body frame.
     pub omega: V3,
     /// Velocity of the origin, body frame.
     pub velocity: V3,
-    /// Angular acceleration, body frame.
-    pub alpha: L3,
-    /// Acceleration of the origin (including −g), body frame.
-    pub accel: L3,
+    /// Velocity-product part of the angular acceleration (q̈ = 0), body frame.
+    pub alpha: V3,
+    /// Velocity-product part of the origin's acceleration (q̈ = 0), body frame.
+    pub accel: V3,
+    /// −g (gravity enters as an acceleration of the ground) seen in the body frame.
+    pub gravity: V3,
 }
 
 /// Forward recursion over all bodies (parents first), eq. (9).
 pub fn forward(g: &mut Graph, model: &Model, s: &Symbols) -> Vec<BodyKinematics> {
-    let n = model.n();
-    let mut out: Vec<BodyKinematics> = Vec::with_capacity(n);
+    let mut out: Vec<BodyKinematics> = Vec::with_capacity(model.n());
     let ground = ground_kinematics(g, model);
     for (i, body) in model.bodies.iter().enumerate() {
         let parent = match body.parent {
@@ -456,27 +288,22 @@ pub fn forward(g: &mut Graph, model: &Model, s: &Symbols) -> Vec<BodyKinematics>
     out
 }
 
-/// The ground as a "body" at rest whose acceleration is −g (gravity enters every body's
-/// acceleration through the recursion and lands in the gravity remainder).
+/// The ground as a "body" at rest.
 fn ground_kinematics(g: &mut Graph, model: &Model) -> BodyKinematics {
-    let n = model.n();
     let zero = vec3::zero(g);
-    let minus_g = vec3::constant(g, model.gravity.map(|x| -x));
-    let accel = minus_g.map(|c| {
-        let mut l = Lin::zero(g, n);
-        l.grav = c;
-        l
-    });
     BodyKinematics {
         relative: Rotation::Identity,
         offset: zero,
         axis: zero,
         rotation: Rotation::Identity,
         origin: zero,
+        step: zero,
+        axis_ground: zero,
         omega: zero,
         velocity: zero,
-        alpha: lin3::from_vel(g, n, zero),
-        accel,
+        alpha: zero,
+        accel: zero,
+        gravity: vec3::constant(g, model.gravity.map(|x| -x)),
     }
 }
 
@@ -508,49 +335,52 @@ fn child_kinematics(
     let w_r = vec3::cross(g, p.omega, offset);
     let v_joint = vec3::add(g, p.velocity, w_r);
     // Acceleration of the joint point, parent frame: a_p + α_p × r + ω_p × (ω_p × r).
-    let alpha_r = lin3::cross_v(g, &p.alpha, offset);
-    let w_w_r = vec3::cross(g, p.omega, w_r);
-    let a_joint = lin3::add(g, &p.accel, &alpha_r);
-    let a_joint = lin3::add_vel(g, &a_joint, w_w_r);
+    let alpha_r = vec3::cross(g, p.alpha, offset);
+    let w_w_r = vec3::omega_omega(g, p.omega, offset);
+    let a_joint = vec3::add(g, p.accel, alpha_r);
+    let a_joint = vec3::add(g, a_joint, w_w_r);
     // Parent quantities seen in the body frame.
     let omega_p = relative.apply_transpose(g, p.omega);
-    let alpha_p = relative.apply_transpose_lin(g, &p.alpha);
+    let alpha_p = relative.apply_transpose(g, p.alpha);
     let v_p = relative.apply_transpose(g, v_joint);
-    let a_p = relative.apply_transpose_lin(g, &a_joint);
+    let a_p = relative.apply_transpose(g, a_joint);
+    let gravity = relative.apply_transpose(g, p.gravity);
     let axis_rate = vec3::scale(g, qd, axis);
     let (omega, velocity, alpha, accel) = match joint.kind {
         JointKind::Revolute => {
-            // ω = ω_p + e q̇;  α = α_p + e q̈ + ω_p × e q̇.
+            // ω = ω_p + e q̇;  α = α_p + ω_p × e q̇ (+ e q̈).
             let omega = vec3::add(g, omega_p, axis_rate);
             let coriolis = vec3::cross(g, omega_p, axis_rate);
-            let alpha = lin3::add_qdd(g, &alpha_p, i, axis);
-            let alpha = lin3::add_vel(g, &alpha, coriolis);
+            let alpha = vec3::add(g, alpha_p, coriolis);
             (omega, v_p, alpha, a_p)
         }
         JointKind::Prismatic => {
-            // v = v_p + e q̇;  a = a_p + e q̈ + 2 ω_p × e q̇.
+            // v = v_p + e q̇;  a = a_p + 2 ω_p × e q̇ (+ e q̈).
             let velocity = vec3::add(g, v_p, axis_rate);
             let two = g.constant(2.0);
             let w_e = vec3::cross(g, omega_p, axis_rate);
             let coriolis = vec3::scale(g, two, w_e);
-            let accel = lin3::add_qdd(g, &a_p, i, axis);
-            let accel = lin3::add_vel(g, &accel, coriolis);
+            let accel = vec3::add(g, a_p, coriolis);
             (omega_p, velocity, alpha_p, accel)
         }
     };
     let rotation = p.rotation.compose(g, &relative);
-    let moved = p.rotation.apply(g, offset);
-    let origin = vec3::add(g, p.origin, moved);
+    let step = p.rotation.apply(g, offset);
+    let origin = vec3::add(g, p.origin, step);
+    let axis_ground = p.rotation.apply(g, axis);
     BodyKinematics {
         relative,
         offset,
         axis,
         rotation,
         origin,
+        step,
+        axis_ground,
         omega,
         velocity,
         alpha,
         accel,
+        gravity,
     }
 }
 
@@ -560,22 +390,11 @@ fn label_body(g: &mut Graph, k: &BodyKinematics, name: &str) {
     vec3::label(g, k.origin, &format!("pos_{name}"));
 }
 
-/// A point fixed on a body: position (ground), and its acceleration as a Lin form
-/// projected on a ground direction.
+/// A point fixed on a body: its position in ground coordinates.
 pub fn point_position(g: &mut Graph, k: &BodyKinematics, local: [f64; 3]) -> V3 {
     let m = vec3::constant(g, local);
     let moved = k.rotation.apply(g, m);
     vec3::add(g, k.origin, moved)
-}
-
-/// Acceleration of a body-fixed point, body frame: a_O + α × m + ω × (ω × m).
-pub fn point_accel(g: &mut Graph, k: &BodyKinematics, local: [f64; 3]) -> L3 {
-    let m = vec3::constant(g, local);
-    let alpha_m = lin3::cross_v(g, &k.alpha, m);
-    let w_m = vec3::cross(g, k.omega, m);
-    let w_w_m = vec3::cross(g, k.omega, w_m);
-    let a = lin3::add(g, &k.accel, &alpha_m);
-    lin3::add_vel(g, &a, w_w_m)
 }
 
 /// Velocity of a body-fixed point, body frame: v_O + ω × m.

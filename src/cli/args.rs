@@ -1,4 +1,4 @@
-//! Command-line syntax (clap derive): `camchain [simulate [MODEL]... [OPTIONS] | list]`.
+//! Command-line syntax (clap derive): `camchain [simulate [MODEL]... [OPTIONS] | list | ops [MODEL]...]`.
 //!
 //! Values are checked here, so a bad one is a usage error (exit code 2) before anything
 //! runs: times must be positive and finite, tolerances positive, the integrator one of the
@@ -57,6 +57,17 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// List the built-in models with their coordinates, contacts and default settings.
     List,
+    /// Print the operation count of every generated function (add/sub, mul, div, sin/cos,
+    /// sqrt, other, total): the table of the generated file's header.
+    #[command(after_help = "Examples:\n  \
+                      camchain ops                      # every built-in model\n  \
+                      camchain ops paper_concave\n  \
+                      camchain ops my_cam.ron           # derived now, without rebuilding")]
+    Ops {
+        /// Built-in model names or paths to .ron model files [default: every built-in model]
+        #[arg(value_name = "MODEL")]
+        models: Vec<String>,
+    },
     /// Measure: run time against error of every integrator, and generated code against
     /// the numeric recursion; writes the sections of BENCHMARKS.md.
     Bench(BenchArgs),

@@ -5,7 +5,8 @@
 //! - [`simulate`]: the `simulate` command, run by run;
 //! - [`progress`], [`summary`], [`csv`], [`output`]: what a run shows and writes;
 //! - [`kinematics`], [`figures`], [`plots`]: the figures after the paper's figures 3–6;
-//! - [`list`]: the `list` command.
+//! - [`list`]: the `list` command;
+//! - [`ops`]: the `ops` command (operation counts of the generated functions).
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
 //! for a usage error (bad option or value, unknown model name) and 1 for anything else (a
@@ -17,6 +18,7 @@ mod csv;
 mod figures;
 mod kinematics;
 mod list;
+mod ops;
 mod output;
 mod plots;
 mod progress;
@@ -68,6 +70,9 @@ pub fn main() -> ExitCode {
         None => simulate::run(&cli.simulate),
         Some(Command::Simulate(args)) => simulate::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Ops { models }) => ops::render(&models).map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+        }),
         Some(Command::List) => {
             // A closed pipe (`camchain list | head`) is not an error worth a panic.
             let _ = std::io::stdout().write_all(list::render().as_bytes());
