@@ -393,3 +393,140 @@ fn a_failed_run_leaves_only_a_partial_csv() {
     assert_eq!(piped.status.code(), Some(1));
     assert!(piped.stdout.is_empty());
 }
+
+/// More bad invocations than `bad_input_gets_one_line_and_an_exit_code`: every numeric
+/// option with each kind of bad value, unknown flags, directories and unreadable files
+/// where files are expected, and a corpus model (`tests/bad_models/`) run from its file.
+/// Each must exit with the code, print one `error:` line naming the option or file and
+/// every listed phrase, and not panic.
+#[test]
+fn bad_options_and_files_name_the_flag_and_the_problem() {
+    let dir = scratch("bad-options");
+    std::fs::create_dir(dir.join("adir")).unwrap();
+    std::fs::write(dir.join("a_file"), "not a directory").unwrap();
+    std::fs::write(dir.join("empty.ron"), "").unwrap();
+    std::fs::write(dir.join("binary.ron"), [0xff, 0xfe, 0x00, 0x28]).unwrap();
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_models");
+    let exit_call = corpus.join("profile_process_exit.ron");
+    let exit_call = exit_call.to_str().unwrap();
+    let positive = "must be positive and finite";
+    let mut cases: Vec<(Vec<&str>, i32, Vec<&str>)> = vec![
+        (
+            vec!["--frobnicate"],
+            2,
+            vec!["unexpected argument '--frobnicate'"],
+        ),
+        (
+            vec!["list", "extra"],
+            2,
+            vec!["unexpected argument 'extra'"],
+        ),
+        (
+            vec!["simulate", "--t-end"],
+            2,
+            vec!["a value is required for '--t-end"],
+        ),
+        (
+            vec!["simulate", "--dt", "abc"],
+            2,
+            vec!["'--dt <SECONDS>'", "`abc` is not a number"],
+        ),
+        (
+            vec!["simulate", "--integrator", "RK4"],
+            2,
+            vec!["'--integrator <NAME>'", "possible values: rk4, dopri5"],
+        ),
+        (
+            vec!["simulate", "paper_concave", "--coords", "q4,,q3"],
+            2,
+            vec!["--coords", "empty coordinate name"],
+        ),
+        (
+            vec!["simulate", "paper_concave", "paper_concave"],
+            2,
+            vec!["paper_concave is given twice"],
+        ),
+        (
+            vec!["simulate", "adir/"],
+            1,
+            vec!["cannot read model file adir/", "it is a directory"],
+        ),
+        (
+            vec!["simulate", "binary.ron"],
+            1,
+            vec!["cannot read model file binary.ron", "UTF-8"],
+        ),
+        (
+            vec!["simulate", "empty.ron"],
+            1,
+            vec!["invalid model file: empty.ron:1:1: <top level>"],
+        ),
+        (
+            vec!["simulate", exit_call],
+            1,
+            vec![
+                "profile_process_exit.ron:68:54: contacts[0].profile",
+                "`std::process::exit` is not a known math function",
+            ],
+        ),
+        (
+            vec!["simulate", "paper_concave", "--csv", "adir"],
+            1,
+            vec!["cannot write adir", "it is a directory"],
+        ),
+        (
+            vec!["simulate", "paper_concave", "--csv", "nowhere/x.csv"],
+            1,
+            vec![
+                "cannot write nowhere/x.csv",
+                "directory nowhere does not exist",
+            ],
+        ),
+        (
+            // 0.01 s / 1e-300 s steps per output interval: refused before running.
+            vec!["simulate", "--integrator", "rk4", "--dt", "1e-300"],
+            2,
+            vec!["--dt", "rk4 step of 1e-300 s", "steps per output interval"],
+        ),
+        (
+            vec!["simulate", "paper_concave", "--out", "a_file"],
+            1,
+            vec!["cannot create output directory a_file"],
+        ),
+    ];
+    // Every numeric option with each kind of bad value: zero, negative (in exponent form,
+    // which clap would otherwise take for a flag), NaN, infinities.
+    for flag in ["--t-end", "--dt", "--dt-out", "--rtol", "--atol"] {
+        for value in ["0", "-1e-3", "NaN", "inf", "-inf"] {
+            cases.push((vec!["simulate", flag, value], 2, vec![flag, positive]));
+        }
+    }
+    let mut failures = Vec::new();
+    for (args, code, phrases) in &cases {
+        let out = camchain(&dir, args);
+        let stderr = text(&out.stderr);
+        let mut problems = Vec::new();
+        if out.status.code() != Some(*code) {
+            problems.push(format!("exit code {:?}, want {code}", out.status.code()));
+        }
+        if stderr.lines().count() != 1 || !stderr.starts_with("error: ") {
+            problems.push("not one `error:` line".to_string());
+        }
+        if stderr.contains("panicked") {
+            problems.push("panicked".to_string());
+        }
+        for phrase in phrases {
+            if !stderr.contains(phrase) {
+                problems.push(format!("lacks `{phrase}`"));
+            }
+        }
+        if !problems.is_empty() {
+            failures.push(format!(
+                "{args:?}: {} — stderr: {stderr}",
+                problems.join("; ")
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(!dir.join("out").exists(), "nothing ran");
+}

@@ -44,12 +44,8 @@ pub fn assemble(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
             return Ok(q);
         }
         let j = d.eval(&j_ids, 0.0, &q, &qd);
-        let step = newton_step(&j, &h, n, nc, &free).ok_or_else(|| {
-            format!(
-                "initial state cannot be assembled onto the cam: the constraint Jacobian has no \
-                 usable free column at q = {q:?} (hold fewer coordinates)"
-            )
-        })?;
+        let step = newton_step(&j, &h, n, nc, &free)
+            .ok_or_else(|| no_free_column(model, &free, residual, &q))?;
         for (i, dq) in step {
             q[i] -= dq;
         }
@@ -62,6 +58,34 @@ pub fn assemble(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
          left |h| = {residual:.3e} m after {MAX_ITERATIONS} iterations (q = {q:?}); the contact \
          point cannot reach the cam from this guess: change initial.q or initial.hold"
     ))
+}
+
+/// Why Newton cannot take a step: no free coordinate, or none that moves a contact point
+/// across its cam.
+fn no_free_column(model: &Model, free: &[bool], residual: f64, q: &[f64]) -> String {
+    let names: Vec<&str> = model
+        .bodies
+        .iter()
+        .zip(free)
+        .filter(|(_, free)| **free)
+        .map(|(b, _)| b.joint.coordinate.as_str())
+        .collect();
+    let why = if names.is_empty() {
+        "every coordinate is held or driven, so none can be solved: leave one per contact out \
+         of initial.hold"
+            .to_string()
+    } else {
+        format!(
+            "the coordinates that are neither held nor driven ({}) do not move the contact \
+             point across the cam there (their constraint Jacobian entries are 0): hold other \
+             coordinates or change initial.q",
+            names.join(", ")
+        )
+    };
+    format!(
+        "initial state cannot be assembled onto the cam: |h| = {residual:.3e} m at q = {q:?}, \
+         and {why}"
+    )
 }
 
 /// One Newton step on the free columns with the largest pivots; returns (index, Δq) pairs

@@ -16,6 +16,7 @@
 
 use proc_macro2::TokenStream;
 use quote::ToTokens;
+use std::cell::Cell;
 use std::str::FromStr;
 use syn::spanned::Spanned;
 use syn::{BinOp, Expr, Lit, UnOp};
@@ -184,12 +185,235 @@ fn apply(func: Func, a: f64) -> f64 {
 /// .sinh() .cosh() .tanh() .atan() .powi(n) .powf(e)` with `n` an integer literal, and the
 /// same functions in call form (`sin(x)`, `f64::sin(x)`, `powi(x, 3)`). Rejected, with the
 /// byte offset of the offending token: other names, other functions, operators, literals,
-/// blocks, macros, closures, assignments, a divisor that is a constant equal to zero and
-/// constant subexpressions that are not finite.
+/// blocks, macros, closures, assignments, a divisor that is a constant equal to zero,
+/// constant subexpressions that are not finite, `powi` exponents beyond ±[`MAX_POWI`], and
+/// expressions nested deeper than [`MAX_NESTING`] or [`MAX_TREE_DEPTH`] or longer than
+/// [`MAX_TOKENS`] tokens (limits that keep parsing within a small stack).
 pub fn parse_expression(source: &str, variable: &str) -> Result<Scalar, ExprError> {
     let tokens = TokenStream::from_str(source).map_err(|e| lex_error(source, &e))?;
+    screen_tokens(&tokens)?;
     let expr: Expr = syn::parse2(tokens).map_err(|e| syntax_error(source, &e))?;
-    Converter { variable }.expr(&expr)
+    Converter {
+        variable,
+        depth: Cell::new(0),
+    }
+    .expr(&expr)
+}
+
+/// Deepest nesting of parentheses and prefix operators (`-(-(x))` is 4 deep) accepted.
+///
+/// syn parses nested groups and prefix operators by recursion, as does the conversion to
+/// [`Scalar`]; the limit keeps both far inside a 2 MiB thread stack (about 2 KiB per level
+/// at opt-level 2, a few times more unoptimised), while real profiles nest a handful of
+/// levels.
+pub const MAX_NESTING: usize = 32;
+
+/// Deepest expression tree accepted: operations applied to the results of operations, e.g. a
+/// sum of 300 terms written without parentheses is 300 deep (see also [`MAX_NESTING`]).
+pub const MAX_TREE_DEPTH: usize = 256;
+
+/// Most tokens accepted in one expression (a 100-term Fourier series has about 1000).
+///
+/// Bounds the depth of the parsed tree (a long sum is a left-deep chain of additions, which
+/// every tree walk recurses through) and the quadratic cost of the constant checks.
+pub const MAX_TOKENS: usize = 2000;
+
+/// Multi-character Rust operators, which proc-macro2 splits into joint punctuation; the
+/// screen glues the longest one it can.
+const OPERATORS: [&str; 26] = [
+    "..=", "...", "<<=", ">>=", "::", "..", "==", "!=", "<=", ">=", "&&", "||", "+=", "-=", "*=",
+    "/=", "%=", "^=", "&=", "|=", "<<", ">>", "->", "=>", "<-", "#!",
+];
+
+/// Keywords that may not appear in an expression, with what they would introduce.
+fn keyword_error(word: &str) -> Option<String> {
+    let what = match word {
+        "as" => "casts (`as`) are not allowed",
+        "if" | "else" | "match" | "loop" | "while" | "for" | "break" | "continue" | "return"
+        | "yield" | "do" => "control flow is not allowed",
+        "move" | "async" | "await" | "gen" => "closures and async blocks are not allowed",
+        "unsafe" | "const" | "static" | "let" | "mut" | "ref" | "box" | "in" | "impl" | "dyn"
+        | "fn" | "struct" | "enum" | "trait" | "type" | "use" | "mod" | "pub" | "where"
+        | "extern" | "macro" | "try" | "become" | "abstract" | "final" | "override" | "priv"
+        | "typeof" | "unsized" | "virtual" => "is a Rust keyword and not allowed here",
+        _ => return None,
+    };
+    Some(if what.starts_with("is ") {
+        format!("`{word}` {what}; {ALLOWED_SUMMARY}")
+    } else {
+        what.to_string()
+    })
+}
+
+/// What the previous token at the same nesting level was, for telling prefix operators and
+/// macro calls apart.
+#[derive(Clone, Copy)]
+enum Previous {
+    /// Start of the expression or of a group.
+    Start,
+    /// An operator or separator.
+    Operator,
+    /// An identifier, starting at the byte offset.
+    Ident(usize),
+    /// A literal or a group.
+    Operand,
+}
+
+/// One open group while screening: its tokens, nesting depth and scanning state.
+struct Level {
+    tokens: std::iter::Peekable<proc_macro2::token_stream::IntoIter>,
+    depth: usize,
+    prefix_run: usize,
+    previous: Previous,
+}
+
+/// Rejects, before syn sees them, the token shapes that are never valid here and the ones
+/// syn would parse by deep recursion: brackets and braces, keywords, operators other than
+/// `+ - * /`, macros, closures, ranges, and nesting deeper than [`MAX_NESTING`] or more than
+/// [`MAX_TOKENS`] tokens. Iterative, so any input is screened in bounded stack.
+fn screen_tokens(tokens: &TokenStream) -> Result<(), ExprError> {
+    use proc_macro2::{Delimiter, Spacing, TokenTree};
+    let offset = |span: proc_macro2::Span| span.byte_range().start;
+    let mut stack = vec![Level {
+        tokens: tokens.clone().into_iter().peekable(),
+        depth: 0,
+        prefix_run: 0,
+        previous: Previous::Start,
+    }];
+    let mut count = 0usize;
+    while let Some(level) = stack.last_mut() {
+        let Some(token) = level.tokens.next() else {
+            stack.pop();
+            continue;
+        };
+        count += 1;
+        if count > MAX_TOKENS {
+            return Err(ExprError::new(
+                offset(token.span()),
+                format!("the expression is too long: more than {MAX_TOKENS} tokens"),
+            ));
+        }
+        match token {
+            TokenTree::Group(group) => {
+                let at = offset(group.span_open());
+                match group.delimiter() {
+                    Delimiter::Parenthesis | Delimiter::None => {}
+                    Delimiter::Bracket => {
+                        return Err(ExprError::new(
+                            at,
+                            "brackets `[...]` are not allowed (no arrays or indexing)",
+                        ));
+                    }
+                    Delimiter::Brace => return Err(ExprError::new(at, "blocks are not allowed")),
+                }
+                let depth = level.depth + level.prefix_run + 1;
+                if depth > MAX_NESTING {
+                    return Err(nesting_error(at));
+                }
+                level.prefix_run = 0;
+                level.previous = Previous::Operand;
+                stack.push(Level {
+                    tokens: group.stream().into_iter().peekable(),
+                    depth,
+                    prefix_run: 0,
+                    previous: Previous::Start,
+                });
+            }
+            TokenTree::Ident(ident) => {
+                let word = ident.to_string();
+                let at = offset(ident.span());
+                if let Some(message) = keyword_error(&word) {
+                    return Err(ExprError::new(at, message));
+                }
+                level.prefix_run = 0;
+                level.previous = Previous::Ident(at);
+            }
+            TokenTree::Literal(_) => {
+                level.prefix_run = 0;
+                level.previous = Previous::Operand;
+            }
+            TokenTree::Punct(punct) => {
+                let at = offset(punct.span());
+                let mut op = punct.as_char().to_string();
+                let mut joint = punct.spacing() == Spacing::Joint;
+                // Glue the longest known operator out of the joint punctuation.
+                while joint {
+                    let Some(TokenTree::Punct(next)) = level.tokens.peek() else {
+                        break;
+                    };
+                    let longer = format!("{op}{}", next.as_char());
+                    if !OPERATORS.iter().any(|o| o.starts_with(&longer)) {
+                        break;
+                    }
+                    joint = next.spacing() == Spacing::Joint;
+                    op = longer;
+                    level.tokens.next();
+                }
+                let prefix_position =
+                    matches!(level.previous, Previous::Start | Previous::Operator);
+                match op.as_str() {
+                    "-" | "*" if prefix_position => {
+                        level.prefix_run += 1;
+                        if level.depth + level.prefix_run > MAX_NESTING {
+                            return Err(nesting_error(at));
+                        }
+                    }
+                    "+" | "-" | "*" | "/" | "," | "." | "::" | ":" => level.prefix_run = 0,
+                    "!" => {
+                        return Err(match level.previous {
+                            Previous::Ident(start) => {
+                                ExprError::new(start, "macros are not allowed")
+                            }
+                            _ => ExprError::new(
+                                at,
+                                "operator `!` is not allowed; only unary minus is",
+                            ),
+                        });
+                    }
+                    "|" | "||" if prefix_position => {
+                        return Err(ExprError::new(at, "closures are not allowed"));
+                    }
+                    ".." | "..=" | "..." => {
+                        return Err(ExprError::new(at, "ranges (`..`) are not allowed"));
+                    }
+                    "#" | "#!" => return Err(ExprError::new(at, "attributes are not allowed")),
+                    "'" => {
+                        return Err(ExprError::new(at, "labels and lifetimes are not allowed"));
+                    }
+                    "=" => return Err(ExprError::new(at, "assignments are not allowed")),
+                    "==" | "!=" | "<=" | ">=" | "=>" | "->" | "<-" => {
+                        return Err(operator_error(at, &op));
+                    }
+                    _ if op.len() > 1 && op.ends_with('=') => {
+                        return Err(ExprError::new(
+                            at,
+                            format!("`{op}` is an assignment; assignments are not allowed"),
+                        ));
+                    }
+                    _ => return Err(operator_error(at, &op)),
+                }
+                level.previous = Previous::Operator;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn nesting_error(offset: usize) -> ExprError {
+    ExprError::new(
+        offset,
+        format!(
+            "the expression is nested too deeply: more than {MAX_NESTING} levels of \
+             parentheses and signs"
+        ),
+    )
+}
+
+fn operator_error(offset: usize, op: &str) -> ExprError {
+    ExprError::new(
+        offset,
+        format!("operator `{op}` is not allowed; allowed: + - * /"),
+    )
 }
 
 /// A syn parse error; errors at the end of input carry the call-site span (0..0).
@@ -244,11 +468,26 @@ fn closing_of(open: char) -> char {
 /// Converts the syn tree to [`Scalar`], checking every node.
 struct Converter<'a> {
     variable: &'a str,
+    /// Current depth of the recursion through [`Converter::expr`].
+    depth: Cell<usize>,
 }
 
 impl Converter<'_> {
     fn expr(&self, expr: &Expr) -> Result<Scalar, ExprError> {
-        let scalar = self.node(expr)?;
+        let depth = self.depth.get() + 1;
+        if depth > MAX_TREE_DEPTH {
+            return Err(ExprError::at(
+                expr,
+                format!(
+                    "the expression is nested too deeply: more than {MAX_TREE_DEPTH} operations \
+                     inside one another (group long sums with parentheses)"
+                ),
+            ));
+        }
+        self.depth.set(depth);
+        let scalar = self.node(expr);
+        self.depth.set(depth - 1);
+        let scalar = scalar?;
         match scalar.constant_value() {
             Some(value) if !value.is_finite() => Err(ExprError::at(
                 expr,
@@ -461,8 +700,26 @@ fn literal(lit: &Lit) -> Result<Scalar, ExprError> {
     }
 }
 
-/// The exponent of `powi`: an integer literal, possibly negated or parenthesised.
+/// Largest |n| accepted in `powi(n)`: far beyond any sensible profile, and small enough
+/// that the exponents of the derivatives (n − 1, n − 2) cannot overflow an i32.
+pub const MAX_POWI: i32 = 1_000_000;
+
+/// The exponent of `powi`: an integer literal (possibly negated or parenthesised) with
+/// |n| ≤ [`MAX_POWI`].
 fn integer_argument(expr: &Expr) -> Result<i32, ExprError> {
+    let n = integer_literal(expr)?;
+    if n.unsigned_abs() <= MAX_POWI.unsigned_abs() {
+        Ok(n)
+    } else {
+        Err(ExprError::at(
+            expr,
+            format!("the `powi` exponent {n} is outside ±{MAX_POWI}"),
+        ))
+    }
+}
+
+/// An integer literal, possibly negated or parenthesised, that fits an i32.
+fn integer_literal(expr: &Expr) -> Result<i32, ExprError> {
     let message = "`powi` needs an integer literal exponent such as `.powi(3)`; \
                    use `.powf(...)` for other exponents";
     match expr {
@@ -475,10 +732,10 @@ fn integer_argument(expr: &Expr) -> Result<i32, ExprError> {
             op: UnOp::Neg(_),
             expr: inner,
             ..
-        }) => integer_argument(inner)?
+        }) => integer_literal(inner)?
             .checked_neg()
             .ok_or_else(|| ExprError::at(expr, "the `powi` exponent does not fit in an i32")),
-        Expr::Paren(p) => integer_argument(&p.expr),
+        Expr::Paren(p) => integer_literal(&p.expr),
         _ => Err(ExprError::at(expr, message)),
     }
 }
@@ -656,7 +913,7 @@ mod tests {
         ("x.foo()", 2, "`foo` is not a known math function"),
         ("x.powi(2.5)", 7, "integer literal exponent"),
         ("x.powi(x)", 7, "integer literal exponent"),
-        ("x = 2", 0, "assignments are not allowed"),
+        ("x = 2", 2, "assignments are not allowed"),
         ("x += 2", 2, "assignment"),
         ("{ x }", 0, "blocks are not allowed"),
         ("vec![x]", 0, "macros are not allowed"),
@@ -666,7 +923,7 @@ mod tests {
         ("1e400 * x", 0, "not a finite f64"),
         ("x * (0.0).ln()", 4, "evaluates to -inf"),
         ("x % 2", 2, "operator `%` is not allowed"),
-        ("x as f64", 0, "casts"),
+        ("x as f64", 2, "casts"),
         ("x.sin", 0, "field access"),
         ("x.sin(2)", 0, "takes exactly one value"),
         ("sin", 0, "`sin` is a function"),
@@ -680,6 +937,21 @@ mod tests {
         ("!x", 0, "operator `!`"),
         ("TAU * x", 0, "unknown name `TAU`"),
         ("x.powi(99999999999)", 7, "does not fit"),
+        ("x.powi(-2147483647)", 7, "outside ±1000000"),
+        ("x == 1", 2, "operator `==` is not allowed"),
+        ("x[0]", 1, "brackets"),
+        ("(|v| v)(x)", 1, "closures are not allowed"),
+        ("x || 1", 2, "operator `||` is not allowed"),
+        ("0..x", 1, "ranges"),
+        ("return x", 0, "control flow"),
+        ("let y = x", 0, "`let` is a Rust keyword"),
+        ("#[inline] x", 0, "attributes"),
+        ("x <<= 1", 2, "`<<=` is an assignment"),
+        (
+            "std::process::exit(1)",
+            0,
+            "`std::process::exit` is not a known math function",
+        ),
     ];
 
     #[test]

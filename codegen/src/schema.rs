@@ -120,6 +120,12 @@ impl<'a> Locator<'a> {
         self.at_offset(self.document.locate(field), field, message.into())
     }
 
+    /// An error about `field`, located at the value of the path `locate` (e.g. the k-th
+    /// entry `initial.q[3]` of a map whose key `"q1"` is repeated).
+    fn error_located(&self, field: &str, locate: &str, message: impl Into<String>) -> ModelError {
+        self.at_offset(self.document.locate(locate), field, message.into())
+    }
+
     /// An error at byte `offset` inside the string literal that is the value of `field`
     /// (exact when the literal has no escapes before that point).
     fn error_in_string(&self, field: &str, offset: usize, message: String) -> ModelError {
@@ -134,22 +140,76 @@ impl<'a> Locator<'a> {
         self.at_offset(position, field, message)
     }
 
-    /// A ron syntax or type error, with the field path at its position. ron's span often
-    /// starts at the whitespace before the offending token; the position is moved onto it.
+    /// A ron syntax or type error, with the field path at its position.
+    ///
+    /// ron's span often starts at the whitespace before the offending token; the position is
+    /// moved onto it, and the token is quoted (`Expected comma, found \`kg\``). Where ron
+    /// only notices a missing `,` or closing bracket at the first token of a later line, the
+    /// error points just after the last value before it, where the character is missing. A
+    /// missing field is reported at the opening of the struct that lacks it.
     fn ron_error(&self, error: &ron::error::SpannedError) -> ModelError {
+        use ron::Error as E;
         let start = error.span.start;
         let offset = scan::byte_offset(self.source, start.line, start.col);
-        let offset =
+        let mut offset =
             offset + (self.source[offset..].len() - self.source[offset..].trim_start().len());
-        let (line, column) = scan::line_column(self.source, offset);
-        let mut field = self.document.path_at(offset);
-        if let ron::Error::MissingStructField { field: missing, .. } = &error.code {
+        let mut message = error.code.to_string();
+        let (before, at) = scan::tokens_around(self.source, offset);
+        let missing_delimiter = matches!(
+            error.code,
+            E::ExpectedComma
+                | E::ExpectedStructLikeEnd
+                | E::ExpectedArrayEnd
+                | E::ExpectedMapEnd
+                | E::ExpectedOptionEnd
+        );
+        let mut field_offset = offset;
+        match (&error.code, before, at) {
+            (_, Some((_, end)), _)
+                if missing_delimiter && self.source[end..offset].contains('\n') =>
+            {
+                // `mass: 0.5` ⏎ `com: …`: the comma is missing after `0.5`, not before `com`.
+                offset = end;
+                field_offset = end - 1;
+                message = match self.document.group_at(field_offset) {
+                    Some(open) if !matches!(error.code, E::ExpectedComma) => {
+                        let (line, column) = scan::line_column(self.source, open);
+                        format!(
+                            "{message} after this value: the group opened at {line}:{column} \
+                             is not closed"
+                        )
+                    }
+                    _ => format!("{message} after this value"),
+                };
+            }
+            (E::ExpectedStringEnd, _, _) => {
+                message = format!("{message}: this string has no closing `\"`");
+            }
+            (E::MissingStructField { .. }, _, _) => {}
+            (_, before, Some((token_start, token_end))) => {
+                let token = &self.source[token_start..token_end];
+                if token.chars().count() <= 40 && !message.contains("found") {
+                    message = format!("{message}, found `{token}`");
+                }
+                if let (E::ExpectedComma, Some((_, end))) = (&error.code, before) {
+                    // A stray token after a value belongs to that value's field.
+                    field_offset = end - 1;
+                }
+            }
+            _ => {}
+        }
+        let mut field = self.document.path_at(field_offset);
+        if let E::MissingStructField { field: missing, .. } = &error.code {
+            if let Some(open) = self.document.locate(&field).filter(|_| !field.is_empty()) {
+                offset = open;
+            }
             field = if field.is_empty() {
                 (*missing).to_string()
             } else {
                 format!("{field}.{missing}")
             };
         }
+        let (line, column) = scan::line_column(self.source, offset);
         ModelError {
             file: self.file.to_path_buf(),
             line,
@@ -159,7 +219,7 @@ impl<'a> Locator<'a> {
             } else {
                 field
             },
-            message: error.code.to_string(),
+            message,
         }
     }
 }
@@ -640,13 +700,15 @@ mod tests {
 
     #[test]
     fn rejects_repeated_and_non_finite_initial_values() {
-        assert_rejected(
+        let e = assert_rejected(
             "q: {\"q1\": -1.0}",
             "q: {\"q1\": -1.0, \"q1\": 2}",
             "initial.q[\"q1\"]",
             35,
             "given twice",
         );
+        // At the second `"q1"` (column 31), not the first (column 19).
+        assert_eq!(e.column, 31);
         assert_rejected(
             "q: {\"q1\": -1.0}",
             "q: {\"q1\": NaN}",
@@ -684,13 +746,15 @@ mod tests {
 
     #[test]
     fn ron_missing_field_names_the_path() {
-        assert_rejected(
+        // Located at the opening of the body that lacks it.
+        let e = assert_rejected(
             "            mass: 0.5,\n",
             "",
             "bodies[1].mass",
-            30,
+            18,
             "missing field named `mass`",
         );
+        assert_eq!(e.column, 9);
     }
 
     #[test]
@@ -721,6 +785,37 @@ mod tests {
         let e = error_of("(\n  bodies: [\n  (name: \"a\" parent: \"ground\")\n  ],\n)");
         assert_eq!(e.line, 3, "{e}");
         assert!(e.field.starts_with("bodies[0]"), "{e}");
+    }
+
+    #[test]
+    fn ron_missing_comma_or_bracket_points_at_the_end_of_the_value_before() {
+        // BASE line 21 is `            mass: 0.5,`: without its comma ron stops at line 22.
+        let e = assert_rejected(
+            "mass: 0.5,",
+            "mass: 0.5",
+            "bodies[1].mass",
+            21,
+            "Expected comma after this value",
+        );
+        assert_eq!(e.column, 22, "just after `0.5`");
+        // On the same line the unexpected token itself is the defect.
+        let e = assert_rejected(
+            "mass: 0.5,",
+            "mass: 0.5 kg,",
+            "bodies[1].mass",
+            21,
+            "Expected comma, found `kg`",
+        );
+        assert_eq!(e.column, 23);
+        // BASE line 10, `            com: (0.5, 0.0, 0.0),`, with its `)` missing.
+        let e = assert_rejected(
+            "com: (0.5, 0.0, 0.0),",
+            "com: (0.5, 0.0, 0.0,",
+            "bodies[0].com",
+            10,
+            "the group opened at 10:18 is not closed",
+        );
+        assert_eq!(e.column, 33, "just after the last comma");
     }
 
     #[test]

@@ -117,12 +117,12 @@ pub struct SimulateArgs {
     pub numeric: bool,
 
     /// End time in seconds [default: the model's, see `camchain list`]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time)]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
 
     /// Output interval in seconds: one CSV row and one plotted point per interval
     /// [default: the model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time)]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub dt_out: Option<f64>,
 
     /// Integrator: rk4 (fixed step --dt) or dopri5 (adaptive, --rtol/--atol, first step
@@ -131,15 +131,15 @@ pub struct SimulateArgs {
     pub integrator: Option<IntegratorArg>,
 
     /// Step in seconds: fixed step of rk4, first step of dopri5 [default: the model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time)]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub dt: Option<f64>,
 
     /// Relative tolerance of dopri5 [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = positive_number)]
+    #[arg(long, value_name = "TOL", value_parser = positive_number, allow_hyphen_values = true)]
     pub rtol: Option<f64>,
 
     /// Absolute tolerance of dopri5 [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = positive_number)]
+    #[arg(long, value_name = "TOL", value_parser = positive_number, allow_hyphen_values = true)]
     pub atol: Option<f64>,
 
     /// One-sided contact: the follower lifts off where the normal force reaches zero and
@@ -247,22 +247,27 @@ fn restitution(text: &str) -> Result<f64, String> {
     }
 }
 
-/// A positive, finite number.
-fn positive_number(text: &str) -> Result<f64, String> {
+/// A positive, finite number; `what` names it in messages.
+fn positive(text: &str, what: &str) -> Result<f64, String> {
     let value: f64 = text
         .trim()
         .parse()
-        .map_err(|_| format!("`{text}` is not a number"))?;
+        .map_err(|_| format!("`{text}` is not a number ({what} is expected)"))?;
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(format!("must be positive and finite, got {text}"))
+        Err(format!("{what} must be positive and finite, got {text}"))
     }
+}
+
+/// A positive, finite tolerance.
+fn positive_number(text: &str) -> Result<f64, String> {
+    positive(text, "a tolerance")
 }
 
 /// A positive, finite time in seconds.
 fn positive_time(text: &str) -> Result<f64, String> {
-    positive_number(text).map_err(|e| format!("a time in seconds {e}"))
+    positive(text, "a time in seconds")
 }
 
 #[cfg(test)]

@@ -42,8 +42,15 @@ pub fn create_dir(dir: &Path) -> Result<(), String> {
         .map_err(|e| format!("cannot write in output directory {}: {e}", dir.display()))
 }
 
-/// Checks before a run that a CSV file can be created at `path`: its directory exists.
+/// Checks before a run that a CSV file can be created at `path`: it is not a directory and
+/// its directory exists.
 pub fn check_csv_destination(path: &Path) -> Result<(), String> {
+    if path.is_dir() {
+        return Err(format!(
+            "cannot write {}: it is a directory (--csv takes a file name)",
+            path.display()
+        ));
+    }
     let dir = parent_dir(path);
     if dir.is_dir() {
         Ok(())

@@ -14,7 +14,8 @@ use super::plots::Figure;
 use super::progress::Progress;
 use super::source::{self, LoadedModel};
 use super::summary::{self, RunReport};
-use camchain::runtime::{Dynamics, SimSettings, Simulate, Trajectory};
+use camchain::runtime::simulate::MAX_STEPS_PER_CALL;
+use camchain::runtime::{Dynamics, IntegratorKind, SimSettings, Simulate, Trajectory};
 use std::collections::HashSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -106,6 +107,7 @@ fn plan(args: &SimulateArgs) -> Result<Vec<Job>, CliError> {
         if !labels.insert(model.label.clone()) {
             return Err(CliError::Usage(format!("{} is given twice", model.label)));
         }
+        check_step_budget(&model, args)?;
         let coords = coordinates(&model, &args.coords)?;
         jobs.push(Job {
             coords,
@@ -134,6 +136,21 @@ fn plan(args: &SimulateArgs) -> Result<Vec<Job>, CliError> {
     Ok(jobs)
 }
 
+/// Refuses, before running, an rk4 step so small that the runtime would give up only after
+/// [`MAX_STEPS_PER_CALL`] steps in the first output interval (a minute or more of work).
+fn check_step_budget(model: &LoadedModel, args: &SimulateArgs) -> Result<(), CliError> {
+    let settings = args.settings(&model.engine.dynamics().info().defaults);
+    let steps = settings.dt_out / settings.dt;
+    if settings.integrator == IntegratorKind::Rk4 && steps > MAX_STEPS_PER_CALL as f64 {
+        return Err(CliError::Usage(format!(
+            "--dt: {}: an rk4 step of {:e} s needs {steps:.1e} steps per output interval \
+             (--dt-out {:e} s), more than the {MAX_STEPS_PER_CALL} allowed",
+            model.label, settings.dt, settings.dt_out
+        )));
+    }
+    Ok(())
+}
+
 /// The coordinates of the time-history figure: those named by `--coords`, or all from
 /// the tip to the base.
 fn coordinates(model: &LoadedModel, names: &[String]) -> Result<Vec<usize>, CliError> {
@@ -144,6 +161,13 @@ fn coordinates(model: &LoadedModel, names: &[String]) -> Result<Vec<usize>, CliE
     names
         .iter()
         .map(|name| {
+            if name.trim().is_empty() {
+                return Err(CliError::Usage(
+                    "--coords: empty coordinate name; give names separated by commas, e.g. \
+                     --coords q4,q3"
+                        .to_string(),
+                ));
+            }
             info.coordinate_index(name.trim()).ok_or_else(|| {
                 let known: Vec<&str> = info.coordinates.iter().map(|c| c.name.as_str()).collect();
                 CliError::Usage(format!(

@@ -133,6 +133,12 @@ fn from_file(file: &Path) -> Result<LoadedModel, CliError> {
 /// Reads and validates a model file; errors are one line, located in the file when the
 /// problem is in its content.
 fn read_model(file: &Path) -> Result<Model, CliError> {
+    if file.is_dir() {
+        return Err(CliError::Failed(format!(
+            "cannot read model file {}: it is a directory, not a .ron file",
+            file.display()
+        )));
+    }
     let source = std::fs::read_to_string(file)
         .map_err(|e| CliError::Failed(format!("cannot read model file {}: {e}", file.display())))?;
     parse_model(&source, file).map_err(|e| {

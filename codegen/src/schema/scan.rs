@@ -43,6 +43,8 @@ struct Node {
     name: Option<String>,
     /// Entries of a group, in order; empty for atoms.
     entries: Vec<Entry>,
+    /// True for a bracketed group (possibly empty), false for an atom.
+    group: bool,
 }
 
 /// One element of a group: `value`, `field: value` or `"key": value`.
@@ -103,6 +105,22 @@ impl Document {
                     });
                 }
                 None => break,
+            }
+        }
+        found
+    }
+
+    /// Start of the deepest bracketed group (its name for `Name(...)`) whose text contains
+    /// byte `offset`: for a group that is never closed, its text runs to where the scanner
+    /// found a closing bracket or to the end of the source.
+    pub(super) fn group_at(&self, offset: usize) -> Option<usize> {
+        let contains = |n: &Node| n.group && n.start <= offset && offset < n.end;
+        let mut node = &self.root;
+        let mut found = contains(node).then_some(node.start);
+        while let Some((_, entry)) = entry_containing(node, offset) {
+            node = &entry.value;
+            if contains(node) {
+                found = Some(node.start);
             }
         }
         found
@@ -203,6 +221,25 @@ pub(super) fn line_column(source: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// The byte range `start..end` of a token.
+pub(super) type Span = (usize, usize);
+
+/// Byte ranges of the token ending last at or before `offset` and of the token starting at
+/// `offset` (comments and whitespace are not tokens).
+pub(super) fn tokens_around(source: &str, offset: usize) -> (Option<Span>, Option<Span>) {
+    let tokens = tokenize(source);
+    let before = tokens
+        .iter()
+        .take_while(|t| t.end <= offset)
+        .last()
+        .map(|t| (t.start, t.end));
+    let at = tokens
+        .iter()
+        .find(|t| t.start == offset)
+        .map(|t| (t.start, t.end));
+    (before, at)
+}
+
 /// Byte offset of the 1-based (line, column) position; clamped to the text.
 pub(super) fn byte_offset(source: &str, line: usize, column: usize) -> usize {
     let line_start = if line <= 1 {
@@ -290,6 +327,7 @@ impl Parser<'_> {
                 end,
                 name,
                 entries: Vec::new(),
+                group: true,
             };
         }
         let mut entries = Vec::new();
@@ -301,6 +339,7 @@ impl Parser<'_> {
                         end: self.source.len(),
                         name,
                         entries,
+                        group: true,
                     };
                 }
                 Some(t) if t.kind == Kind::Close => {
@@ -310,6 +349,7 @@ impl Parser<'_> {
                         end: t.end,
                         name,
                         entries,
+                        group: true,
                     };
                 }
                 Some(t) if matches!(t.kind, Kind::Comma | Kind::Colon) => self.pos += 1,

@@ -161,14 +161,17 @@ fn lookup(
     name: &str,
     what: &str,
 ) -> Checked<usize> {
-    index.get(name).copied().ok_or_else(|| {
-        let mut known: Vec<&str> = index.keys().copied().collect();
-        known.sort_unstable();
-        at.error(
-            field,
-            format!("unknown {what} `{name}`; known: {}", known.join(", ")),
-        )
-    })
+    index
+        .get(name)
+        .copied()
+        .ok_or_else(|| at.error(field, unknown(index, name, what)))
+}
+
+/// "unknown {what} `{name}`; known: …" with the known names sorted.
+fn unknown(index: &HashMap<&str, usize>, name: &str, what: &str) -> String {
+    let mut known: Vec<&str> = index.keys().copied().collect();
+    known.sort_unstable();
+    format!("unknown {what} `{name}`; known: {}", known.join(", "))
 }
 
 /// Indexes `names`, reporting the second occurrence of a repeated name.
@@ -559,17 +562,28 @@ fn coordinate_values(
     at: &Locator,
     path: &str,
     values: &raw::NamedValues,
-    by_name: &HashMap<&str, usize>,
+    index: &HashMap<&str, usize>,
 ) -> Checked<Vec<f64>> {
-    let mut out = vec![0.0; by_name.len()];
-    let mut given = vec![false; by_name.len()];
-    for (name, value) in &values.0 {
+    let mut out = vec![0.0; index.len()];
+    let mut given = vec![false; index.len()];
+    for (k, (name, value)) in values.0.iter().enumerate() {
         let field = format!("{path}[{name:?}]");
-        let i = lookup(at, &field, by_name, name, "coordinate")?;
+        // Located by position, so a repeated key points at its second occurrence.
+        let entry = format!("{path}[{k}]");
+        let i = index
+            .get(name.as_str())
+            .copied()
+            .ok_or_else(|| at.error_located(&field, &entry, unknown(index, name, "coordinate")))?;
         if std::mem::replace(&mut given[i], true) {
-            return Err(at.error(&field, format!("coordinate `{name}` is given twice")));
+            let message = format!("coordinate `{name}` is given twice");
+            return Err(at.error_located(&field, &entry, message));
         }
-        out[i] = finite(at, &field, *value)?;
+        out[i] = if value.is_finite() {
+            *value
+        } else {
+            let message = format!("must be finite, got {value}");
+            return Err(at.error_located(&field, &entry, message));
+        };
     }
     Ok(out)
 }
