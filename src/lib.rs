@@ -13,6 +13,8 @@
 
 pub use camchain_runtime as runtime;
 
+pub mod stress;
+
 /// The generated models, one module per file in `models/`.
 pub mod models {
     include!(concat!(env!("OUT_DIR"), "/models.rs"));

@@ -12,8 +12,9 @@ pub enum SimError {
     #[error(
         "at t = {t} s the contact point cannot reach the cam: Newton on the dependent \
          coordinates (15) stopped after {iterations} iterations with |h|∞ = {residual:.3e} \
-         at q = {}",
-        Compact(.q)
+         at q = {}{}",
+        Compact(.q),
+        DivergenceHint(.q, &[])
     )]
     NewtonFailed {
         /// Time (s).
@@ -55,14 +56,16 @@ pub enum SimError {
 
     /// A computed quantity is NaN or infinite.
     #[error(
-        "at t = {t} s {quantity} is not finite; q = {}, q̇ = {}",
+        "at t = {t} s {quantity} is not finite; q = {}, q̇ = {}{}",
         Compact(.q),
-        Compact(.qd)
+        Compact(.qd),
+        DivergenceHint(.q, .qd)
     )]
     NonFinite {
         /// Time (s).
         t: f64,
-        /// Which quantity, e.g. `"q̈"`, `"λ"`, `"h"`.
+        /// Which quantity, e.g. `"q̈"`, `"λ"`, `"h"`, or `"q"`, `"q̇"` for a state that was
+        /// already not finite (set so by the caller).
         quantity: &'static str,
         /// Coordinates.
         q: Vec<f64>,
@@ -95,6 +98,35 @@ pub enum SimError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// A coordinate or velocity this large (rad, m, rad/s, m/s) in a failed state means that
+/// the integration has almost certainly diverged before the reported failure.
+const DIVERGED: f64 = 1e6;
+
+/// Appended to a failure's message when the state has blown up (a finite entry of q or q̇
+/// beyond [`DIVERGED`]), e.g. a fixed step beyond the stability limit of a stiff spring:
+/// `; the integration has diverged (|q|∞ = 3.842e7, |q̇|∞ = 6.461e263): step too large
+/// for the stiffest mode?`. Empty otherwise.
+struct DivergenceHint<'a>(&'a [f64], &'a [f64]);
+
+impl fmt::Display for DivergenceHint<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let largest = |v: &[f64]| {
+            v.iter()
+                .filter(|x| x.is_finite())
+                .fold(0.0_f64, |m, x| m.max(x.abs()))
+        };
+        let (q, qd) = (largest(self.0), largest(self.1));
+        if q.max(qd) <= DIVERGED {
+            return Ok(());
+        }
+        write!(f, "; the integration has diverged (|q|∞ = {q:.3e}")?;
+        if !self.1.is_empty() {
+            write!(f, ", |q̇|∞ = {qd:.3e}")?;
+        }
+        f.write_str("): step too large for the stiffest mode?")
+    }
 }
 
 /// Compact display of a vector: `[0.1, -1.570796, 2.5e-7]` (7 significant digits at most,
@@ -150,5 +182,38 @@ mod tests {
         assert!(text.contains("cannot reach the cam"), "{text}");
         assert!(text.contains("[0.5, -2]"), "{text}");
         assert!(text.contains("25 iterations"), "{text}");
+        assert!(!text.contains("diverged"), "{text}");
+    }
+
+    #[test]
+    fn a_blown_up_state_is_called_a_divergence() {
+        let error = SimError::NonFinite {
+            t: 0.03,
+            quantity: "q̈",
+            q: vec![6.5e109, -1.9],
+            qd: vec![2.0e221, f64::NAN],
+        };
+        let text = error.to_string();
+        assert!(
+            text.contains("diverged (|q|∞ = 6.500e109, |q̇|∞ = 2.000e221)"),
+            "{text}"
+        );
+        let newton = SimError::NewtonFailed {
+            t: 0.18,
+            q: vec![15108.8, -3.842e7],
+            residual: 0.33,
+            iterations: 25,
+        };
+        assert!(
+            newton.to_string().contains("diverged (|q|∞ = 3.842e7)"),
+            "{newton}"
+        );
+        let sane = SimError::NonFinite {
+            t: 0.0,
+            quantity: "q̇",
+            q: vec![1.0],
+            qd: vec![f64::NAN],
+        };
+        assert!(!sane.to_string().contains("diverged"), "{sane}");
     }
 }

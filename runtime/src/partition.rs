@@ -538,6 +538,11 @@ impl Workspace {
         t: f64,
     ) -> Result<(), SimError> {
         self.evaluate_position_terms(model);
+        // h comes first in the report: a non-finite J at a point where h is already not
+        // finite (a profile evaluated outside its domain) is a consequence.
+        if self.h.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "h"));
+        }
         self.factor_current_jacobian(dependent, t)
     }
 

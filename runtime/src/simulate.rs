@@ -19,8 +19,11 @@ use crate::partition::{
 };
 
 /// A step ending within this fraction of a step before an output time is stretched to land
-/// on it (avoids a useless sliver step caused by round-off in t + h).
-const LANDING_SLACK: f64 = 1e-9;
+/// on it (avoids a useless sliver step caused by round-off in t + h). The round-off
+/// accumulated over the steps of one output interval must fit: at t ≈ 1000 s with h = 1 ms,
+/// 100 steps of up to ulp(t)/2 ≈ 6e-14 s each reach ~1e-11 s = 1e-8·h. Stretching a step by
+/// 1e-6 of itself changes its local error by a relative 5e-6 (RK4), nothing measurable.
+const LANDING_SLACK: f64 = 1e-6;
 
 /// Accepted steps allowed in one call of `step`/`step_with`, or per output interval of
 /// `simulate`, before [`SimError::TooManySteps`].
@@ -316,6 +319,7 @@ pub trait Simulate: Dynamics {
     /// constraint residuals, contact geometry and energies.
     fn sample(&self, state: &State) -> Result<Sample, SimError> {
         check_belongs(self, state)?;
+        check_finite_state(state)?;
         let mut ws = state.engine.ws.clone();
         compute_sample(self, state, &mut ws, SampleLevel::Full)
     }
@@ -437,6 +441,24 @@ fn check_belongs<D: Dynamics + ?Sized>(model: &D, state: &State) -> Result<(), S
             model.info().name
         )))
     }
+}
+
+/// A NaN or infinite coordinate or velocity in the state (e.g. set by the caller) is
+/// reported as `q` or `q̇`, rather than as the first quantity computed from it.
+fn check_finite_state(state: &State) -> Result<(), SimError> {
+    let quantity = if state.q.iter().any(|x| !x.is_finite()) {
+        "q"
+    } else if state.qd.iter().any(|x| !x.is_finite()) {
+        "q̇"
+    } else {
+        return Ok(());
+    };
+    Err(SimError::NonFinite {
+        t: state.t,
+        quantity,
+        q: state.q.clone(),
+        qd: state.qd.clone(),
+    })
 }
 
 fn assemble_state<D: Dynamics + ?Sized>(model: &D, t0: f64) -> Result<State, SimError> {
@@ -562,9 +584,7 @@ fn run<D: Dynamics + ?Sized>(
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
     let mut events = Vec::new();
-    let checks = check_belongs(model, &state)
-        .and_then(|()| validate_integration(settings))
-        .and_then(|()| validate_output(settings, state.t));
+    let checks = validate_run(model, &state, settings);
     let outcome = checks.map_err(|e| (e, Stats::default())).and_then(|()| {
         let mut emit = |sample: Sample| {
             observe(&sample);
@@ -1099,6 +1119,7 @@ fn advance<D: Dynamics + ?Sized>(
             state.t
         )));
     }
+    check_finite_state(state)?;
     if state.modified_since_last_step() {
         state.load_integrated_state();
     }
@@ -1252,6 +1273,7 @@ pub(crate) fn validate_run<D: Dynamics + ?Sized>(
     settings: &SimSettings,
 ) -> Result<(), SimError> {
     check_belongs(model, state)
+        .and_then(|()| check_finite_state(state))
         .and_then(|()| validate_integration(settings))
         .and_then(|()| validate_output(settings, state.t))
 }
@@ -2225,6 +2247,19 @@ mod tests {
         assert!(max_difference(&a.q, &b.q) < 1e-9, "{:?} vs {:?}", a.q, b.q);
         assert_eq!(fixed.stats.rhs_evaluations, 4 * fixed.stats.steps);
         assert_eq!(fixed.stats.steps, 1000);
+    }
+
+    #[test]
+    fn fixed_steps_stay_fixed_late_in_a_long_run() {
+        // At t ≈ 1000 s each t + h rounds by up to ulp(1000)/2 ≈ 6e-14 s, which accumulates
+        // over the 100 steps of an output interval to more than 1e-9·dt: the last step of
+        // an interval must still land on the output time, not leave a sliver step.
+        let arm = Arm::new(true, false);
+        let state = arm.assemble(1000.0).unwrap();
+        let mut settings = rk4(1010.0, 1e-3);
+        settings.dt_out = 0.1;
+        let trajectory = arm.simulate(state, &settings).unwrap();
+        assert_eq!(trajectory.stats.steps, 10_000);
     }
 
     #[test]

@@ -71,6 +71,21 @@ pub enum Command {
     /// Measure: run time against error of every integrator, and generated code against
     /// the numeric recursion; writes the sections of BENCHMARKS.md.
     Bench(BenchArgs),
+    /// Run the numerical stability stress suite; write STRESS.md and its figures.
+    #[command(
+        long_about = "Run the numerical stability stress suite and write STRESS.md and its \
+                      figures.\n\n\
+                      Scenarios (variants of the reference models, on the numeric reference): \
+                      1000 s runs without dampers, stiff springs, tiny and large masses, fast \
+                      motion, re-partitioning, steep/flat/inflected/wavy profiles, a cam out of \
+                      reach, NaN and infinity. Each runs with RK4 at several steps and each \
+                      adaptive integrator at several tolerances; a failing run is reported in \
+                      its table. Takes a few minutes in release (--quick: under a minute).",
+        after_help = "Examples:\n  \
+                      cargo run --release -- stress                 # STRESS.md, docs/stress/\n  \
+                      cargo run --release -- stress --quick --out /tmp/STRESS.md"
+    )]
+    Stress(StressArgs),
 }
 
 /// Options of `bench`.
@@ -99,6 +114,22 @@ pub enum BenchWhat {
     WorkPrecision,
     /// One evaluation of each term, generated against numeric, side by side.
     Evaluations,
+}
+
+/// Options of `stress`.
+#[derive(Debug, Clone, Args)]
+pub struct StressArgs {
+    /// Shorter long runs (100 s instead of 1000 s) and fewer RK4 steps in them
+    #[arg(long)]
+    pub quick: bool,
+
+    /// The report to write
+    #[arg(long, value_name = "FILE", default_value = "STRESS.md")]
+    pub out: PathBuf,
+
+    /// Directory of the figures (PNG and SVG) [default: docs/stress beside the report]
+    #[arg(long, value_name = "DIR")]
+    pub figures: Option<PathBuf>,
 }
 
 /// Options of `simulate`.
@@ -315,6 +346,24 @@ mod tests {
         assert_eq!(settings.integrator, IntegratorKind::Rk4);
         assert_eq!(settings.dt_out, 0.01);
         assert_eq!(args.out_dir(), Some(PathBuf::from("out")));
+    }
+
+    #[test]
+    fn stress_writes_stress_md_unless_told_otherwise() {
+        let cli = Cli::try_parse_from(["camchain", "stress"]).unwrap();
+        let Some(Command::Stress(args)) = cli.command else {
+            panic!("stress expected");
+        };
+        assert!(!args.quick && args.figures.is_none());
+        assert_eq!(args.out, PathBuf::from("STRESS.md"));
+        let cli =
+            Cli::try_parse_from(["camchain", "stress", "--quick", "--out", "r/S.md"]).unwrap();
+        let Some(Command::Stress(args)) = cli.command else {
+            panic!("stress expected");
+        };
+        assert!(args.quick);
+        assert_eq!(args.out, PathBuf::from("r/S.md"));
+        assert!(Cli::try_parse_from(["camchain", "stress", "paper_concave"]).is_err());
     }
 
     #[test]

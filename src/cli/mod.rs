@@ -7,6 +7,7 @@
 //! - [`kinematics`], [`figures`], [`plots`]: the figures after the paper's figures 3–6;
 //! - [`list`]: the `list` command;
 //! - [`ops`]: the `ops` command (operation counts of the generated functions).
+//! - [`stress`]: the `stress` command (numerical stability stress suite, `STRESS.md`).
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
 //! for a usage error (bad option or value, unknown model name) and 1 for anything else (a
@@ -24,6 +25,7 @@ mod plots;
 mod progress;
 mod simulate;
 mod source;
+mod stress;
 mod summary;
 
 use args::{Cli, Command};
@@ -73,6 +75,7 @@ pub fn main() -> ExitCode {
         Some(Command::Ops { models }) => ops::render(&models).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
         }),
+        Some(Command::Stress(args)) => stress::run(&args),
         Some(Command::List) => {
             // A closed pipe (`camchain list | head`) is not an error worth a panic.
             let _ = std::io::stdout().write_all(list::render().as_bytes());
