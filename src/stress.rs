@@ -20,7 +20,10 @@ use std::time::{Duration, Instant};
 
 /// The adaptive integrators swept by [`sweep`], with their command-line names. A new
 /// adaptive [`IntegratorKind`] is one more line here.
-pub const ADAPTIVE: &[(&str, IntegratorKind)] = &[("dopri5", IntegratorKind::Dopri5)];
+pub const ADAPTIVE: &[(&str, IntegratorKind)] = &[
+    ("dopri5", IntegratorKind::Dopri5),
+    ("dop853", IntegratorKind::Dop853),
+];
 
 /// One integrator configuration of a sweep.
 #[derive(Debug, Clone, PartialEq)]

@@ -309,10 +309,11 @@ fn non_finite_values_stop_the_run_and_name_the_quantity() {
                 integration.label, record.error
             );
         };
-        // h or J: at x = 0 the profile's value is finite but its slope (in J) is not; which
-        // of the two the run meets first depends on where the steps land.
+        // h, J or q̈: at x = 0 the profile's value is finite but its slope (in J) and
+        // curvature (in c, hence q̈) are not; which the run meets first depends on where
+        // the steps land. All three are computed from the profile at the contact point.
         assert!(
-            ["h", "J"].contains(quantity),
+            ["h", "J", "q̈"].contains(quantity),
             "{}: {quantity}",
             integration.label
         );

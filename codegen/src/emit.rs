@@ -62,16 +62,25 @@ const SECTION_MACRO: &str = "__section__";
 pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
     let d = Derivation::new(model);
     let specs = function_specs(model, &d);
+    let fused = FusedTerms::new(&d);
+    let fused_specs = fused.specs(&d);
+    let fused_ops: usize = fused_specs
+        .iter()
+        .map(|(spec, given)| fused_count(&d, spec, given))
+        .sum();
+    let wrap = fused_ops > LARGE_MODEL_OPS;
     let mut functions = String::new();
     let mut op_counts = Vec::new();
     for spec in &specs {
-        let (text, count) = emit_function(&d, spec);
+        let (text, count) = match wrapper(model, &fused, &spec.name).filter(|_| wrap) {
+            Some(text) => (text, function_count(&d, spec)),
+            None => emit_function(&d, spec),
+        };
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
-    let fused = FusedTerms::new(&d);
-    for (spec, given) in fused.specs(&d) {
-        let (text, count) = emit_function_given(&d, &spec, "", true, &given);
+    for (spec, given) in &fused_specs {
+        let (text, count) = emit_function_given(&d, spec, "", true, given);
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
@@ -83,6 +92,15 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
     );
     let mut file = String::new();
     header(&mut file, model, source, &op_counts);
+    if wrap {
+        let _ = writeln!(
+            file,
+            "//!\n//! Large model: `mass_matrix`, `inertial_forces`, `applied_forces`, `equations`, \
+             `constraint`, `constraint_jacobian`, `constraint_bias` and `constraint_terms` call \
+             `position_terms` and `velocity_terms` (every expression is compiled once); their \
+             counts above are those of the outputs they return."
+        );
+    }
     // Literals come verbatim from the model file (e.g. −π/2 written out in full).
     file.push_str("#![allow(clippy::approx_constant, clippy::excessive_precision)]\n");
     file.push_str(&model_type(model));
@@ -531,6 +549,143 @@ impl FusedTerms {
         let _ = d;
         vec![(position, Vec::new()), (velocity, given)]
     }
+}
+
+/// Above this many operations in the fused pair (`position_terms` + `velocity_terms`), the
+/// other entry points to M, F, Q, h, J and c are emitted as calls of the pair instead of
+/// with their own copies of the expressions: every expression is then compiled once, which
+/// keeps the build time of large models in check (a 64-body chain compiled each term up to
+/// three times). Below it, each function keeps only the operations it needs. (The paper
+/// models stay below, about 200; `spatial_arm`, about 1800, is above and checks the calls.)
+const LARGE_MODEL_OPS: usize = 1000;
+
+/// Operation count of a function's outputs (what it computes when emitted on its own).
+fn function_count(d: &Derivation, spec: &FunctionSpec) -> OpCount {
+    let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
+    d.graph.op_count(&roots)
+}
+
+/// Operation count of a fused function, the cached nodes read rather than computed.
+fn fused_count(d: &Derivation, spec: &FunctionSpec, given: &[(Id, String)]) -> usize {
+    let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
+    let given: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
+    d.graph.op_count_until(&roots, &given).total()
+}
+
+/// The body of `name` as a call of the fused pair, with stack scratch for the outputs it
+/// does not return; `None` for the functions that keep their own expressions.
+fn wrapper(model: &Model, fused: &FusedTerms, name: &str) -> Option<String> {
+    let (n, nc, cl) = (model.n(), model.contacts.len(), fused.cached.len());
+    let position = |h: &str, j: &str| {
+        format!(
+            "let mut cache = [0.0; {cl}];
+{h}{j}             self.position_terms(q, h, j, &mut cache);
+"
+        )
+    };
+    let scratch = |name: &str, len: usize| {
+        format!(
+            "let {name} = &mut [0.0; {len}];
+"
+        )
+    };
+    let velocity = |t: &str, qd: &str, m: &str, f: &str, a: &str, c: &str| {
+        format!(
+            "{m}{f}{a}{c}self.velocity_terms({t}, q, {qd}, &cache,              ::camchain_runtime::VelocityTerms {{ mass: m, inertial: f, applied, bias: c }});
+"
+        )
+    };
+    let doc = "/// Calls the fused pair `position_terms`/`velocity_terms` (large model: every                expression is compiled once).
+";
+    let body = match name {
+        "mass_matrix" => format!(
+            "fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {{
+{}{}{}}}",
+            position(&scratch("h", nc), &scratch("j", nc * n)),
+            scratch("qd", n),
+            velocity(
+                "0.0",
+                "qd",
+                "",
+                &scratch("f", n),
+                &scratch("applied", n),
+                &scratch("c", nc)
+            )
+        ),
+        "inertial_forces" => format!(
+            "fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {{
+{}{}}}",
+            position(&scratch("h", nc), &scratch("j", nc * n)),
+            velocity(
+                "0.0",
+                "qd",
+                &scratch("m", n * n),
+                "",
+                &scratch("applied", n),
+                &scratch("c", nc)
+            )
+        ),
+        "applied_forces" => format!(
+            "fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], applied: &mut [f64])              {{
+{}{}}}",
+            position(&scratch("h", nc), &scratch("j", nc * n)),
+            velocity(
+                "t",
+                "qd",
+                &scratch("m", n * n),
+                &scratch("f", n),
+                "",
+                &scratch("c", nc)
+            )
+        ),
+        "equations" => format!(
+            "fn equations(&self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], f: &mut [f64],              applied: &mut [f64]) {{
+{}{}}}",
+            position(&scratch("h", nc), &scratch("j", nc * n)),
+            velocity("t", "qd", "", "", "", &scratch("c", nc))
+        ),
+        "constraint" => format!(
+            "fn constraint(&self, q: &[f64], h: &mut [f64]) {{
+{}}}",
+            position("", &scratch("j", nc * n))
+        ),
+        "constraint_jacobian" => format!(
+            "fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {{
+{}}}",
+            position(&scratch("h", nc), "")
+        ),
+        "constraint_bias" => format!(
+            "fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {{
+{}{}}}",
+            position(&scratch("h", nc), &scratch("j", nc * n)),
+            velocity(
+                "0.0",
+                "qd",
+                &scratch("m", n * n),
+                &scratch("f", n),
+                &scratch("applied", n),
+                ""
+            )
+        ),
+        "constraint_terms" => format!(
+            "fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64])              {{
+{}{}}}",
+            position(&scratch("h", nc), ""),
+            velocity(
+                "0.0",
+                "qd",
+                &scratch("m", n * n),
+                &scratch("f", n),
+                &scratch("applied", n),
+                ""
+            )
+        ),
+        _ => return None,
+    };
+    Some(format!(
+        "{doc}{body}
+"
+    ))
 }
 
 fn geometry_spec(d: &Derivation, _nc: usize) -> FunctionSpec {

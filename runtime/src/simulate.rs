@@ -1392,6 +1392,7 @@ fn load_state<D: Dynamics + ?Sized>(
         // Newton ends with an evaluation of h, J and the cache at the returned q.
         solve_positions_with_restart(model, partition.dependent(), ws, t)?;
         ws.factor_current_jacobian(partition.dependent(), t)?;
+        ws.polish_positions(partition.dependent());
     }
     ws.solve_velocities(partition.dependent());
     Ok(())

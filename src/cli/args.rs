@@ -103,6 +103,9 @@ pub struct BenchArgs {
     /// Directory of the figures
     #[arg(long, value_name = "DIR", default_value = "docs")]
     pub figures: PathBuf,
+    /// The CSV of the scaling example (for `scaling-figure`)
+    #[arg(long, value_name = "FILE")]
+    pub scaling_csv: Option<PathBuf>,
 }
 
 /// The benchmarks of `bench`.
@@ -114,6 +117,8 @@ pub enum BenchWhat {
     WorkPrecision,
     /// One evaluation of each term, generated against numeric, side by side.
     Evaluations,
+    /// Draw the scaling figure from the scaling example's CSV (--scaling-csv).
+    ScalingFigure,
 }
 
 /// Options of `stress`.

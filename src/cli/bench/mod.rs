@@ -4,13 +4,16 @@
 //! - `work-precision`: run time against error for every integrator over a ladder of steps
 //!   and tolerances, on the reference models, against a checked reference solution;
 //! - `evaluations`: one evaluation of M+F+Q, the constraint terms, the reduced right-hand
-//!   side and one RK4 step, generated code against the numeric recursion, on the same states.
+//!   side and one RK4 step, generated code against the numeric recursion, on the same states;
+//! - `scaling-figure`: the figure of the scaling study from the CSV of
+//!   `cargo run --release -p camchain-codegen --example scaling -- OUTDIR --build`.
 //!
 //! Timings are medians over batches, generated and numeric batches interleaved so that
 //! machine noise hits both alike. No timing is asserted anywhere (see the tests).
 
 mod evaluations;
 mod markdown;
+mod scaling;
 mod timing;
 mod work_precision;
 
@@ -24,6 +27,16 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         let section = evaluations::run(args.quick)?;
         markdown::replace_section(report, "evaluations", &section)?;
         println!("updated {} (section evaluations)", report.display());
+    }
+    if let BenchWhat::ScalingFigure = args.what {
+        let csv = args.scaling_csv.as_deref().ok_or_else(|| {
+            CliError::Usage(
+                "scaling-figure needs --scaling-csv FILE (written by the scaling example)".into(),
+            )
+        })?;
+        scaling::run(csv, &args.figures)?;
+        println!("wrote {}/scaling.png and .svg", args.figures.display());
+        return Ok(());
     }
     if matches!(args.what, BenchWhat::WorkPrecision | BenchWhat::All) {
         let section = work_precision::run(args.quick, &args.figures)?;
