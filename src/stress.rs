@@ -399,8 +399,17 @@ mod tests {
     fn sweeps_list_rk4_then_each_adaptive_integrator() {
         let list = sweep(1.0, 0.1, &[1e-3, 0.02], &[1e-6]);
         let labels: Vec<&str> = list.iter().map(|i| i.label.as_str()).collect();
-        assert_eq!(labels, ["rk4 dt=1e-3", "rk4 dt=0.02", "dopri5 rtol=1e-6"]);
+        assert_eq!(
+            labels,
+            [
+                "rk4 dt=1e-3",
+                "rk4 dt=0.02",
+                "dopri5 rtol=1e-6",
+                "dop853 rtol=1e-6"
+            ]
+        );
         assert_eq!(list[2].settings.atol, 1e-8);
+        assert_eq!(list[3].settings.integrator, IntegratorKind::Dop853);
     }
 
     #[test]

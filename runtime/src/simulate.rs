@@ -798,11 +798,17 @@ impl Phase<'_, '_> {
             let t_old = state.t;
             let t_new = adaptive_step(model, state, settings.t_end, settings)?;
             steps_since_output += 1;
-            interpolate_last_step(model, state, settings, t_new, &mut y_out)?;
             sample_ws
                 .v_anchor
                 .copy_from_slice(&state.engine.ws.v_anchor);
-            let now = self.watch_values(model, state, &mut sample_ws, t_new, &y_out)?;
+            let now = if matches!(self.watch, Watch::Nothing) {
+                Vec::new()
+            } else {
+                // The step's end through the interpolant: in the step's own partition (the
+                // state may re-partition when the step is finished).
+                interpolate_last_step(model, state, settings, t_new, &mut y_out)?;
+                self.watch_values(model, state, &mut sample_ws, t_new, &y_out)?
+            };
             let stop = self.locate_events(
                 model,
                 state,
