@@ -92,7 +92,23 @@ fn state_only_sampling_gives_the_same_motion() {
     let full = run(model, &settings);
     let state = model.assemble(0.0).expect("assembly");
     let states = model.simulate_states(state, &settings).expect("run");
-    assert_eq!(full.stats, states.stats);
+    // Same steps; a full run also watches the normal force at every step's end through
+    // the dense output, which costs DOP853 three more right-hand sides on the steps that
+    // hold no output time (the interpolant is otherwise made for the outputs anyway).
+    assert_eq!(
+        (
+            full.stats.steps,
+            full.stats.rejected,
+            full.stats.repartitions
+        ),
+        (
+            states.stats.steps,
+            states.stats.rejected,
+            states.stats.repartitions
+        )
+    );
+    let extra = full.stats.rhs_evaluations - states.stats.rhs_evaluations;
+    assert!(extra <= 3 * full.stats.steps, "{extra}");
     for (a, b) in full.samples.iter().zip(&states.samples) {
         // Same steps, same interpolation, same Newton: identical numbers.
         assert_eq!((a.t, &a.q, &a.qd), (b.t, &b.q, &b.qd));

@@ -24,7 +24,7 @@
 //!     contacts: [(marker: "A", profile: "-0.595*x + 0.5*x*x",
 //!                 frame: (origin: (0, 0, 0), x_axis: (1, 0, 0), y_axis: (0, 1, 0)))],
 //!     initial: (q: {"q1": -1.67}, qd: {}, hold: ["q1"]),
-//!     simulation: (t_end: 10.0, dt_out: 0.01, integrator: Dopri5,
+//!     simulation: (t_end: 10.0, dt_out: 0.01, integrator: Dop853, // or Rk4, Dopri5
 //!                  dt: 1e-3, rtol: 1e-10, atol: 1e-12),
 //! )
 //! ```

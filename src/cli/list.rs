@@ -72,6 +72,6 @@ mod tests {
             }
         }
         assert!(text.contains("q1 [rad, driven]"));
-        assert!(text.contains("--t-end 10 --dt-out 0.01 --integrator dopri5"));
+        assert!(text.contains("--t-end 10 --dt-out 0.01 --integrator dop853"));
     }
 }

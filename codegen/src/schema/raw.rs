@@ -163,7 +163,7 @@ impl Default for Simulation {
         Simulation {
             t_end: 10.0,
             dt_out: 0.01,
-            integrator: Integrator::Dopri5,
+            integrator: Integrator::Dop853,
             dt: 1e-3,
             rtol: 1e-10,
             atol: 1e-12,
