@@ -617,10 +617,9 @@ impl Workspace {
         self.eliminate_dependent(partition);
         self.set_particular_acceleration(partition);
         self.project_dynamics(partition);
-        if !cholesky_factor(&mut self.reduced_mass, self.nu) {
+        if !solve_reduced(&mut self.reduced_mass, self.nu, &mut self.udd) {
             return Err(self.not_positive_definite(t));
         }
-        cholesky_solve(&self.reduced_mass, self.nu, &mut self.udd);
         self.expand_accelerations(partition);
         if self.qdd.iter().any(|x| !x.is_finite()) {
             return Err(self.non_finite(t, "q̈"));
@@ -863,6 +862,11 @@ fn euclidean(x: &[f64]) -> f64 {
 /// unit lower, both stored in `a`; `pivots[k]` is the row swapped with row k at step k).
 /// Returns false when a pivot is zero or not finite.
 fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize) -> bool {
+    if n == 1 {
+        // One contact (the paper's case): J_v is a number.
+        pivots[0] = 0;
+        return a[0] != 0.0 && a[0].is_finite();
+    }
     for k in 0..n {
         let p = (k..n).fold(k, |best, r| {
             if a[r * n + k].abs() > a[best * n + k].abs() {
@@ -894,6 +898,10 @@ fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize) -> bool {
 
 /// Solves A x = b in place (`x` holds b on entry), A factored by [`lu_factor`].
 fn lu_solve(lu: &[f64], pivots: &[usize], n: usize, x: &mut [f64]) {
+    if n == 1 {
+        x[0] /= lu[0];
+        return;
+    }
     for (k, &p) in pivots.iter().enumerate().take(n) {
         x.swap(k, p);
     }
@@ -927,6 +935,78 @@ fn lu_determinant(lu: &[f64], pivots: &[usize], n: usize) -> f64 {
     let swaps = (0..n).filter(|&k| pivots[k] != k).count();
     let product: f64 = (0..n).map(|k| lu[k * n + k]).product();
     if swaps % 2 == 0 { product } else { -product }
+}
+
+/// Solves the n×n SPD system `a` x = `x` (lower triangle of `a` read, overwritten by its
+/// factor) in place; false when `a` is not positive definite. Sizes up to 6 (every
+/// reference model) go through fixed-size code the compiler unrolls: for these 2×2 … 6×6
+/// systems the loop and bounds-check bookkeeping of the general code costs more than the
+/// arithmetic (callgrind: ~500 instructions for a 3×3 solve).
+fn solve_reduced(a: &mut [f64], n: usize, x: &mut [f64]) -> bool {
+    match n {
+        1 => solve_fixed::<1>(a, x),
+        2 => solve_fixed::<2>(a, x),
+        3 => solve_fixed::<3>(a, x),
+        4 => solve_fixed::<4>(a, x),
+        5 => solve_fixed::<5>(a, x),
+        6 => solve_fixed::<6>(a, x),
+        _ => {
+            let ok = cholesky_factor(a, n);
+            if ok {
+                cholesky_solve(a, n, x);
+            }
+            ok
+        }
+    }
+}
+
+/// [`solve_reduced`] for a size known at compile time: the same L D Lᵀ as
+/// [`cholesky_factor`] and [`cholesky_solve`], on arrays.
+fn solve_fixed<const N: usize>(a: &mut [f64], x: &mut [f64]) -> bool {
+    let mut l = [[0.0; N]; N];
+    for (i, row) in l.iter_mut().enumerate() {
+        row[..=i].copy_from_slice(&a[i * N..i * N + i + 1]);
+    }
+    let mut d = [0.0; N];
+    for j in 0..N {
+        let mut diagonal = l[j][j];
+        for k in 0..j {
+            diagonal -= l[j][k] * l[j][k] * d[k];
+        }
+        if !(diagonal > 0.0 && diagonal.is_finite()) {
+            return false;
+        }
+        d[j] = diagonal;
+        let inverse = 1.0 / diagonal;
+        for i in j + 1..N {
+            let mut sum = l[i][j];
+            for k in 0..j {
+                sum -= l[i][k] * l[j][k] * d[k];
+            }
+            l[i][j] = sum * inverse;
+        }
+    }
+    let mut y = [0.0; N];
+    y.copy_from_slice(&x[..N]);
+    for i in 0..N {
+        for k in 0..i {
+            y[i] -= l[i][k] * y[k];
+        }
+    }
+    for i in 0..N {
+        y[i] /= d[i];
+    }
+    for i in (0..N).rev() {
+        for k in i + 1..N {
+            y[i] -= l[k][i] * y[k];
+        }
+    }
+    x[..N].copy_from_slice(&y);
+    for (i, row) in l.iter().enumerate() {
+        a[i * N..i * N + i].copy_from_slice(&row[..i]);
+        a[i * N + i] = d[i];
+    }
+    true
 }
 
 /// In-place square-root-free Cholesky A = L D Lᵀ of the n×n row-major `a` (L unit lower),
