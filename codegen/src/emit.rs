@@ -60,9 +60,9 @@ const SECTION_MACRO: &str = "__section__";
 
 /// Generates the module for `model`; `source` is the model file as shown in the header.
 pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
-    let d = Derivation::new(model);
+    let mut d = Derivation::new(model);
     let specs = function_specs(model, &d);
-    let fused = FusedTerms::new(&d);
+    let fused = FusedTerms::new(&mut d);
     let fused_specs = fused.specs(&d);
     let fused_ops: usize = fused_specs
         .iter()
@@ -438,6 +438,132 @@ fn function_specs(model: &Model, d: &Derivation) -> Vec<FunctionSpec> {
     specs
 }
 
+/// The coordinates summed in an angle `q_a + q_b + …` (sorted variable indices), if `id` is
+/// such a sum.
+fn angle_vars(g: &Graph, id: Id, out: &mut Vec<u32>) -> bool {
+    match g.node(id) {
+        Node::Var(k) => {
+            out.push(k);
+            true
+        }
+        Node::Add(a, b) => angle_vars(g, a, out) && angle_vars(g, b, out),
+        _ => false,
+    }
+}
+
+/// Rewrites, in the velocity-level outputs, the sine and cosine of every angle the position
+/// level does not compute but can be written as the sum or difference of two angles whose
+/// sine and cosine it does (the relative joint angles of M and F, from the absolute angles
+/// of the contact kinematics): sin(A − B) = sA cB − cA sB and so on. Four multiplications and
+/// two additions replace a sine and a cosine, and the velocity level then reads every
+/// trigonometric value from the cache.
+fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(String, Id)]) {
+    let in_position = g.reachable(position);
+    // Angles whose sine and cosine the position level both computes.
+    let mut known: HashMap<Vec<u32>, (Id, Id)> = HashMap::new();
+    let mut half: HashMap<Vec<u32>, (Option<Id>, Option<Id>)> = HashMap::new();
+    for i in 0..g.len() {
+        let id = id_at(g, i);
+        let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+            continue;
+        };
+        let mut vars = Vec::new();
+        if !in_position[i] || !angle_vars(g, arg, &mut vars) {
+            continue;
+        }
+        vars.sort_unstable();
+        let entry = half.entry(vars).or_default();
+        if f == Func::Sin {
+            entry.0 = Some(id);
+        } else {
+            entry.1 = Some(id);
+        }
+    }
+    for (vars, pair) in half {
+        if let (Some(s), Some(c)) = pair {
+            known.insert(vars, (s, c));
+        }
+    }
+    let roots: Vec<Id> = velocity.iter().map(|o| o.1).collect();
+    let in_velocity = g.reachable(&roots);
+    let mut replacements = Vec::new();
+    for i in 0..g.len() {
+        let id = id_at(g, i);
+        let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+            continue;
+        };
+        let mut vars = Vec::new();
+        if !in_velocity[i] || in_position[i] || !angle_vars(g, arg, &mut vars) {
+            continue;
+        }
+        vars.sort_unstable();
+        if let Some(expression) = trig_from_known(g, f, &vars, &known) {
+            replacements.push((id, expression));
+        }
+    }
+    let map: HashMap<Id, Id> = replacements.into_iter().collect();
+    let mut roots: Vec<Id> = velocity.iter().map(|o| o.1).collect();
+    g.replace_nodes(&mut roots, &map);
+    for (output, root) in velocity.iter_mut().zip(roots) {
+        output.1 = root;
+    }
+}
+
+/// sin or cos of the angle `vars` from two known angles P, R with vars = P − R or P + R.
+fn trig_from_known(
+    g: &mut Graph,
+    f: Func,
+    vars: &[u32],
+    known: &HashMap<Vec<u32>, (Id, Id)>,
+) -> Option<Id> {
+    let mut keys: Vec<&Vec<u32>> = known.keys().collect();
+    keys.sort();
+    for p in &keys {
+        for r in &keys {
+            let (sp, cp) = known[*p];
+            let (sr, cr) = known[*r];
+            if multiset_difference(p, r).as_deref() == Some(vars) {
+                // A − B
+                let (x, y) = (g.mul(sp, cr), g.mul(cp, sr));
+                let (u, w) = (g.mul(cp, cr), g.mul(sp, sr));
+                return Some(if f == Func::Sin {
+                    g.sub(x, y)
+                } else {
+                    g.add(u, w)
+                });
+            }
+            if p <= r && multiset_sum(p, r) == vars {
+                // A + B
+                let (x, y) = (g.mul(sp, cr), g.mul(cp, sr));
+                let (u, w) = (g.mul(cp, cr), g.mul(sp, sr));
+                return Some(if f == Func::Sin {
+                    g.add(x, y)
+                } else {
+                    g.sub(u, w)
+                });
+            }
+        }
+    }
+    None
+}
+
+/// p − r as sorted multisets, when r ⊆ p and the difference is not empty.
+fn multiset_difference(p: &[u32], r: &[u32]) -> Option<Vec<u32>> {
+    let mut rest = p.to_vec();
+    for x in r {
+        let at = rest.iter().position(|y| y == x)?;
+        rest.remove(at);
+    }
+    (!rest.is_empty()).then_some(rest)
+}
+
+/// p + r as a sorted multiset.
+fn multiset_sum(p: &[u32], r: &[u32]) -> Vec<u32> {
+    let mut all = [p, r].concat();
+    all.sort_unstable();
+    all
+}
+
 /// The two functions a right-hand side calls, position level (h, J) then velocity level
 /// (M, F, Q, c), and the q-only values the first hands to the second through `cache`.
 struct FusedTerms {
@@ -449,7 +575,7 @@ struct FusedTerms {
 }
 
 impl FusedTerms {
-    fn new(d: &Derivation) -> Self {
+    fn new(d: &mut Derivation) -> Self {
         let n = d.symbols.q.len();
         let dy = &d.dynamics;
         let mut position = Vec::new();
@@ -476,8 +602,9 @@ impl FusedTerms {
         for (k, c) in d.contacts.iter().enumerate() {
             velocity.push((format!("out.bias[{k}]"), c.bias));
         }
-        let g = &d.graph;
         let roots = |outputs: &[(String, Id)]| -> Vec<Id> { outputs.iter().map(|o| o.1).collect() };
+        reuse_position_trigonometry(&mut d.graph, &roots(&position), &mut velocity);
+        let g = &d.graph;
         let in_position = g.reachable(&roots(&position));
         let in_velocity = g.reachable(&roots(&velocity));
         let cached = (0..g.len())

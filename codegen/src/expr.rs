@@ -567,6 +567,36 @@ impl Graph {
         }
     }
 
+    /// Rewrites `roots` with every node of `map` replaced by its image, in one pass over the
+    /// graph in id (topological) order: nodes whose children did not change keep their id.
+    pub fn replace_nodes(&mut self, roots: &mut [Id], map: &HashMap<Id, Id>) {
+        let last = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
+        let mut image: Vec<Id> = Vec::with_capacity(last);
+        for i in 0..last {
+            let id = Id(i as u32);
+            if let Some(&to) = map.get(&id) {
+                image.push(to);
+                continue;
+            }
+            let new = |c: Id| image[c.index()];
+            let rebuilt = match self.node(id) {
+                Node::Const(_) | Node::Var(_) => id,
+                Node::Add(a, b) if new(a) != a || new(b) != b => self.add(new(a), new(b)),
+                Node::Mul(a, b) if new(a) != a || new(b) != b => self.mul(new(a), new(b)),
+                Node::Div(a, b) if new(a) != a || new(b) != b => self.div(new(a), new(b)),
+                Node::Powf(a, b) if new(a) != a || new(b) != b => self.powf(new(a), new(b)),
+                Node::Neg(a) if new(a) != a => self.neg(new(a)),
+                Node::Powi(a, n) if new(a) != a => self.powi(new(a), n),
+                Node::Call(f, a) if new(a) != a => self.call(f, new(a)),
+                _ => id,
+            };
+            image.push(rebuilt);
+        }
+        for r in roots.iter_mut() {
+            *r = image[r.index()];
+        }
+    }
+
     /// e with the variable `x` replaced by the expression `by`.
     pub fn substitute(&mut self, e: Id, x: Id, by: Id) -> Id {
         let mut memo = HashMap::new();
