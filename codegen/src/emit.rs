@@ -462,13 +462,13 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
     // Angles whose sine and cosine the position level both computes.
     let mut known: HashMap<Vec<u32>, (Id, Id)> = HashMap::new();
     let mut half: HashMap<Vec<u32>, (Option<Id>, Option<Id>)> = HashMap::new();
-    for i in 0..g.len() {
+    for (i, &needed) in in_position.iter().enumerate() {
         let id = id_at(g, i);
         let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
             continue;
         };
         let mut vars = Vec::new();
-        if !in_position[i] || !angle_vars(g, arg, &mut vars) {
+        if !needed || !angle_vars(g, arg, &mut vars) {
             continue;
         }
         vars.sort_unstable();
@@ -487,13 +487,13 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
     let roots: Vec<Id> = velocity.iter().map(|o| o.1).collect();
     let in_velocity = g.reachable(&roots);
     let mut replacements = Vec::new();
-    for i in 0..g.len() {
+    for (i, (&velocity_needs, &position_has)) in in_velocity.iter().zip(&in_position).enumerate() {
         let id = id_at(g, i);
         let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
             continue;
         };
         let mut vars = Vec::new();
-        if !in_velocity[i] || in_position[i] || !angle_vars(g, arg, &mut vars) {
+        if !velocity_needs || position_has || !angle_vars(g, arg, &mut vars) {
             continue;
         }
         vars.sort_unstable();
