@@ -614,6 +614,26 @@ impl Workspace {
 
     /// The linear algebra of (16)–(18) on M, F, Q, J, c already in the workspace.
     fn reduce_and_solve(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
+        let single = match self.nu {
+            _ if self.nc != 1 => None,
+            1 => Some(self.reduce_single::<1>(partition)),
+            2 => Some(self.reduce_single::<2>(partition)),
+            3 => Some(self.reduce_single::<3>(partition)),
+            4 => Some(self.reduce_single::<4>(partition)),
+            5 => Some(self.reduce_single::<5>(partition)),
+            6 => Some(self.reduce_single::<6>(partition)),
+            _ => None,
+        };
+        match single {
+            Some(false) => return Err(self.not_positive_definite(t)),
+            Some(true) => {
+                if self.qdd.iter().any(|x| !x.is_finite()) {
+                    return Err(self.non_finite(t, "q̈"));
+                }
+                return Ok(());
+            }
+            None => {}
+        }
         self.eliminate_dependent(partition);
         self.set_particular_acceleration(partition);
         self.project_dynamics(partition);
@@ -625,6 +645,75 @@ impl Workspace {
             return Err(self.non_finite(t, "q̈"));
         }
         Ok(())
+    }
+
+    /// Eqs. (16)–(18) for one contact and `NU` independent coordinates in one pass on
+    /// fixed-size arrays (the paper's case: NU = 3): B = −J_u / J_v, b = −(c + J_d q̈_d) / J_v,
+    /// the residual r = M g + F + Q on the rows that enter, M* = Tᵀ M T entry by entry,
+    /// L D Lᵀ, then q̈ = T ü + g. The same arithmetic as the general path, without its
+    /// loop and index bookkeeping (which cost more than the arithmetic at these sizes).
+    /// Returns false when M* is not positive definite (M* is then left in `reduced_mass`).
+    // Indices mirror the formulas (M*_ac, B_a, u_a); iterator forms would hide them.
+    #[allow(clippy::needless_range_loop)]
+    fn reduce_single<const NU: usize>(&mut self, partition: &Partition) -> bool {
+        let n = self.n;
+        let v = partition.dependent()[0];
+        let mut u = [0usize; NU];
+        u.copy_from_slice(&partition.independent()[..NU]);
+        let row = &self.jacobian[..n];
+        let inverse = 1.0 / self.jv_lu[0];
+        let mut driven_sum = 0.0;
+        for &d in partition.driven() {
+            driven_sum += row[d] * self.qdd[d];
+        }
+        let b = -(self.bias[0] + driven_sum) * inverse;
+        let mut coupling = [0.0; NU];
+        for a in 0..NU {
+            coupling[a] = -row[u[a]] * inverse;
+        }
+        for &ua in &u {
+            self.qdd[ua] = 0.0;
+        }
+        self.qdd[v] = b;
+        let mass = &self.mass;
+        let residual = |i: usize, qdd: &[f64]| {
+            let m_row = &mass[i * n..(i + 1) * n];
+            let mut r = self.inertial[i] + self.applied[i] + m_row[v] * qdd[v];
+            for &d in partition.driven() {
+                r += m_row[d] * qdd[d];
+            }
+            r
+        };
+        let r_v = residual(v, &self.qdd);
+        let m_vv = mass[v * n + v];
+        let mut reduced = [[0.0; NU]; NU];
+        let mut rhs = [0.0; NU];
+        for a in 0..NU {
+            let m_row = &mass[u[a] * n..(u[a] + 1) * n];
+            let (b_a, m_av) = (coupling[a], m_row[v]);
+            for c in 0..=a {
+                let m_vc = mass[v * n + u[c]];
+                reduced[a][c] =
+                    m_row[u[c]] + m_av * coupling[c] + b_a * (m_vc + m_vv * coupling[c]);
+            }
+            rhs[a] = -(residual(u[a], &self.qdd) + b_a * r_v);
+        }
+        let Some(udd) = solve_ldlt::<NU>(&mut reduced, rhs) else {
+            for a in 0..NU {
+                for c in 0..=a {
+                    self.reduced_mass[a * NU + c] = reduced[a][c];
+                }
+            }
+            return false;
+        };
+        let mut qdd_v = b;
+        for a in 0..NU {
+            self.qdd[u[a]] = udd[a];
+            qdd_v += coupling[a] * udd[a];
+        }
+        self.qdd[v] = qdd_v;
+        self.udd[..NU].copy_from_slice(&udd);
+        true
     }
 
     fn not_positive_definite(&self, t: f64) -> SimError {
@@ -1007,6 +1096,46 @@ fn solve_fixed<const N: usize>(a: &mut [f64], x: &mut [f64]) -> bool {
         a[i * N + i] = d[i];
     }
     true
+}
+
+/// Solves `a` x = `rhs` for the SPD `a` (lower triangle read) by L D Lᵀ on arrays; `None`
+/// when `a` is not positive definite.
+#[allow(clippy::needless_range_loop)] // the indices of the factorisation's formulas
+fn solve_ldlt<const N: usize>(a: &mut [[f64; N]; N], rhs: [f64; N]) -> Option<[f64; N]> {
+    let mut d = [0.0; N];
+    for j in 0..N {
+        let mut diagonal = a[j][j];
+        for k in 0..j {
+            diagonal -= a[j][k] * a[j][k] * d[k];
+        }
+        if !(diagonal > 0.0 && diagonal.is_finite()) {
+            return None;
+        }
+        d[j] = diagonal;
+        let inverse = 1.0 / diagonal;
+        for i in j + 1..N {
+            let mut sum = a[i][j];
+            for k in 0..j {
+                sum -= a[i][k] * a[j][k] * d[k];
+            }
+            a[i][j] = sum * inverse;
+        }
+    }
+    let mut y = rhs;
+    for i in 0..N {
+        for k in 0..i {
+            y[i] -= a[i][k] * y[k];
+        }
+    }
+    for i in 0..N {
+        y[i] /= d[i];
+    }
+    for i in (0..N).rev() {
+        for k in i + 1..N {
+            y[i] -= a[k][i] * y[k];
+        }
+    }
+    Some(y)
 }
 
 /// In-place square-root-free Cholesky A = L D Lᵀ of the n×n row-major `a` (L unit lower),
