@@ -379,7 +379,14 @@ impl Workspace {
         let mut iterations = 0;
         loop {
             let residual = self.constraint_residual(model, t)?;
-            if self.converged(residual, last_correction, dependent) {
+            // At the first evaluation there is no correction to check (the common case:
+            // the integrated v is an accurate starting point).
+            let done = if iterations == 0 {
+                residual <= NEWTON_RESIDUAL_TOLERANCE
+            } else {
+                self.converged(residual, last_correction, dependent)
+            };
+            if done {
                 return Ok(iterations);
             }
             if iterations == NEWTON_MAX_ITERATIONS {
@@ -505,6 +512,12 @@ impl Workspace {
 
     /// v ← v − J_v⁻¹ h (J_v factored, h evaluated); returns the correction's size.
     fn newton_correction(&mut self, dependent: &[usize]) -> f64 {
+        if let ([v], [h], [j_v]) = (dependent, &self.h[..], &self.jv_lu[..]) {
+            // One contact: J_v is a number.
+            let dv = h / j_v;
+            self.q[*v] -= dv;
+            return dv.abs();
+        }
         self.scratch.copy_from_slice(&self.h);
         lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
         for (&dv, &v) in self.scratch.iter().zip(dependent) {
@@ -576,6 +589,18 @@ impl Workspace {
     /// Eq. (16), velocity level: v̇ = −J_v⁻¹ (J_u u̇ + J_d q̇_d), i.e. the v̇ making J q̇ = 0.
     /// Needs [`Self::factor_jacobian`] at the current q.
     pub fn solve_velocities(&mut self, dependent: &[usize]) {
+        if let [v] = dependent {
+            // One contact: v̇ = −(Σ_{i≠v} J_i q̇_i) / J_v.
+            let row = &self.jacobian[..self.n];
+            let mut sum = 0.0;
+            for (i, (&j, &qd)) in row.iter().zip(&self.qd).enumerate() {
+                if i != *v {
+                    sum += j * qd;
+                }
+            }
+            self.qd[*v] = -sum / self.jv_lu[0];
+            return;
+        }
         for &v in dependent {
             self.qd[v] = 0.0;
         }
