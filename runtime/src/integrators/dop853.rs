@@ -10,7 +10,7 @@
 // The coefficients are quoted with the digits of the published tables.
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
-use super::{AcceptedStep, Counters, FAILURE_FACTOR, MAX_FAILED_ATTEMPTS, STEP_FLOOR, Tolerances};
+use super::{AcceptedStep, Adaptive, Counters, Tolerances, controlled_step};
 use crate::error::SimError;
 
 /// Number of stage derivatives kept: k1…k12, k13 = f(t + h, y_new), k14…k16 (dense output).
@@ -283,77 +283,6 @@ impl Dop853 {
         }
     }
 
-    /// Forget the cached derivative at the current point (after the state was changed
-    /// outside this integrator).
-    pub fn invalidate_fsal(&mut self) {
-        self.fsal_valid = false;
-        self.fsal_pending = false;
-    }
-
-    /// One accepted step from `(t, y)` trying `h_try` first (see [`super::Dopri5::step`]
-    /// for the handling of rejections and failing right-hand sides).
-    pub fn step<F>(
-        &mut self,
-        rhs: &mut F,
-        t: f64,
-        y: &mut [f64],
-        h_try: f64,
-        tolerances: Tolerances,
-    ) -> Result<AcceptedStep, SimError>
-    where
-        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
-    {
-        if self.fsal_pending {
-            self.k.swap(0, 12);
-            self.fsal_pending = false;
-        }
-        if !self.fsal_valid {
-            self.counters.rhs_evaluations += 1;
-            rhs(t, y, &mut self.k[0])?;
-            self.fsal_valid = true;
-        }
-        self.dense_ready = false;
-        let floor = STEP_FLOOR * t.abs().max(1.0);
-        let mut h = h_try;
-        let mut was_rejected = false;
-        let mut failed_attempts = 0;
-        let mut last_failure = None;
-        loop {
-            if h.is_nan() || h < floor {
-                // Steps shrinking onto a point where the right-hand side fails (e.g. the
-                // chain cannot follow the cam beyond it): that failure is the cause.
-                return Err(last_failure.unwrap_or(SimError::StepSizeTooSmall { t, h }));
-            }
-            match self.attempt(rhs, t, y, h, tolerances) {
-                Ok(error) if error <= 1.0 => {
-                    let max_factor = if was_rejected { 1.0 } else { MAX_FACTOR };
-                    let h_next = h * step_factor(error).min(max_factor);
-                    self.y_old.copy_from_slice(y);
-                    y.copy_from_slice(&self.y_new);
-                    self.t_old = t;
-                    self.h_old = h;
-                    self.fsal_pending = true;
-                    self.counters.steps += 1;
-                    return Ok(AcceptedStep { h, h_next });
-                }
-                Ok(error) => {
-                    last_failure = None;
-                    h *= step_factor(error).min(1.0);
-                }
-                Err(failure) => {
-                    failed_attempts += 1;
-                    if failed_attempts > MAX_FAILED_ATTEMPTS {
-                        return Err(failure);
-                    }
-                    last_failure = Some(failure);
-                    h *= FAILURE_FACTOR;
-                }
-            }
-            was_rejected = true;
-            self.counters.rejected += 1;
-        }
-    }
-
     /// Stages 2–13 of a step of size `h`; leaves the eighth-order solution in `y_new` and
     /// f(t + h, y_new) in k13; returns the scaled error estimate (≤ 1: acceptable).
     fn attempt<F>(
@@ -415,10 +344,55 @@ impl Dop853 {
         let norm = h.abs() * err5 * (1.0 / (self.controlled as f64 * denominator)).sqrt();
         if norm.is_nan() { f64::INFINITY } else { norm }
     }
+}
+
+impl Adaptive for Dop853 {
+    /// One accepted step from `(t, y)` trying `h_try` first (see [`super::Dopri5::step`]
+    /// for the handling of rejections and failing right-hand sides).
+    fn step<F>(
+        &mut self,
+        rhs: &mut F,
+        t: f64,
+        y: &mut [f64],
+        h_try: f64,
+        tolerances: Tolerances,
+    ) -> Result<AcceptedStep, SimError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
+    {
+        if self.fsal_pending {
+            self.k.swap(0, 12);
+            self.fsal_pending = false;
+        }
+        if !self.fsal_valid {
+            self.counters.rhs_evaluations += 1;
+            rhs(t, y, &mut self.k[0])?;
+            self.fsal_valid = true;
+        }
+        self.dense_ready = false;
+        let (outcome, rejected) = controlled_step(t, h_try, step_factor, MAX_FACTOR, |h| {
+            self.attempt(rhs, t, y, h, tolerances)
+        });
+        self.counters.rejected += rejected;
+        let accepted = outcome?;
+        self.y_old.copy_from_slice(y);
+        y.copy_from_slice(&self.y_new);
+        (self.t_old, self.h_old) = (t, accepted.h);
+        self.fsal_pending = true;
+        self.counters.steps += 1;
+        Ok(accepted)
+    }
+
+    /// Forget the cached derivative at the current point (after the state was changed
+    /// outside this integrator).
+    fn invalidate_fsal(&mut self) {
+        self.fsal_valid = false;
+        self.fsal_pending = false;
+    }
 
     /// Prepares the interpolant of the last accepted step (three more right-hand sides, on
     /// the first call after a step only). `rhs` must be the one the step used.
-    pub fn prepare_dense<F>(&mut self, rhs: &mut F) -> Result<(), SimError>
+    fn prepare_dense<F>(&mut self, rhs: &mut F) -> Result<(), SimError>
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
     {
@@ -450,7 +424,7 @@ impl Dop853 {
 
     /// y(t) inside the last accepted step, from the interpolant [`Self::prepare_dense`]
     /// made (order 7). `t` outside the step extrapolates.
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
         let s = (t - self.t_old) / self.h_old;
         let s1 = 1.0 - s;
         let r = &self.dense;
@@ -465,9 +439,8 @@ impl Dop853 {
         }
     }
 
-    /// Start time and size of the last accepted step.
-    pub fn last_step(&self) -> (f64, f64) {
-        (self.t_old, self.h_old)
+    fn counters(&self) -> Counters {
+        self.counters
     }
 }
 

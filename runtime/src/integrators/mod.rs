@@ -195,98 +195,6 @@ impl Dopri5 {
         }
     }
 
-    /// Forget the cached derivative at the current point (call after the state was changed
-    /// outside this integrator, e.g. a re-partition or another integrator's step).
-    pub fn invalidate_fsal(&mut self) {
-        self.fsal_valid = false;
-        self.fsal_pending = false;
-    }
-
-    /// Start time and size of the last accepted step.
-    pub fn last_step(&self) -> (f64, f64) {
-        (self.t_old, self.h_old)
-    }
-
-    /// y(t) inside the last accepted step by Shampine's fourth-order continuous extension
-    /// (Hairer's `contd5`); needs no further right-hand side. Valid until the next step.
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let (h, s) = (self.h_old, (t - self.t_old) / self.h_old);
-        let s1 = 1.0 - s;
-        let k = &self.k;
-        for (i, o) in out.iter_mut().enumerate() {
-            let y0 = self.y_old[i];
-            let difference = self.y_new[i] - y0;
-            let r3 = h * k[0][i] - difference;
-            let r4 = difference - h * k[6][i] - r3;
-            let r5 = h
-                * (D1 * k[0][i]
-                    + D3 * k[2][i]
-                    + D4 * k[3][i]
-                    + D5 * k[4][i]
-                    + D6 * k[5][i]
-                    + D7 * k[6][i]);
-            *o = y0 + s * (difference + s1 * (r3 + s * (r4 + s1 * r5)));
-        }
-    }
-
-    /// One accepted step from `(t, y)` trying `h_try` first; rejected attempts are retried
-    /// with smaller steps. `y` is overwritten with the new state only on success.
-    ///
-    /// A failing right-hand side at a trial stage (never at the initial point) is treated
-    /// as a rejection and retried with a step five times smaller, at most
-    /// `MAX_FAILED_ATTEMPTS` times in a row; then its error is returned.
-    pub fn step<F>(
-        &mut self,
-        rhs: &mut F,
-        t: f64,
-        y: &mut [f64],
-        h_try: f64,
-        tolerances: Tolerances,
-    ) -> Result<AcceptedStep, SimError>
-    where
-        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
-    {
-        if self.fsal_pending {
-            self.k.swap(0, 6);
-            self.fsal_pending = false;
-        }
-        self.ensure_first_stage(rhs, t, y)?;
-        let floor = STEP_FLOOR * t.abs().max(1.0);
-        let mut h = h_try;
-        let mut was_rejected = false;
-        let mut failed_attempts = 0;
-        let mut last_failure = None;
-        loop {
-            if h.is_nan() || h < floor {
-                // Steps shrinking onto a point where the right-hand side fails (e.g. the
-                // chain cannot follow the cam beyond it): that failure is the cause.
-                return Err(last_failure.unwrap_or(SimError::StepSizeTooSmall { t, h }));
-            }
-            match self.attempt(rhs, t, y, h, tolerances) {
-                Ok(error) if error <= 1.0 => {
-                    let max_factor = if was_rejected { 1.0 } else { MAX_FACTOR };
-                    let h_next = h * step_factor(error).min(max_factor);
-                    self.accept(t, h, y);
-                    return Ok(AcceptedStep { h, h_next });
-                }
-                Ok(error) => {
-                    last_failure = None;
-                    h *= step_factor(error).min(1.0);
-                }
-                Err(failure) => {
-                    failed_attempts += 1;
-                    if failed_attempts > MAX_FAILED_ATTEMPTS {
-                        return Err(failure);
-                    }
-                    last_failure = Some(failure);
-                    h *= FAILURE_FACTOR;
-                }
-            }
-            was_rejected = true;
-            self.counters.rejected += 1;
-        }
-    }
-
     fn ensure_first_stage<F>(&mut self, rhs: &mut F, t: f64, y: &[f64]) -> Result<(), SimError>
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
@@ -415,6 +323,12 @@ pub trait Adaptive {
 }
 
 impl Adaptive for Dopri5 {
+    /// One accepted step from `(t, y)` trying `h_try` first; rejected attempts are retried
+    /// with smaller steps. `y` is overwritten with the new state only on success.
+    ///
+    /// A failing right-hand side at a trial stage (never at the initial point) is treated
+    /// as a rejection and retried with a step five times smaller, at most
+    /// `MAX_FAILED_ATTEMPTS` times in a row; then its error is returned.
     fn step<F>(
         &mut self,
         rhs: &mut F,
@@ -426,11 +340,25 @@ impl Adaptive for Dopri5 {
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
     {
-        Dopri5::step(self, rhs, t, y, h_try, tolerances)
+        if self.fsal_pending {
+            self.k.swap(0, 6);
+            self.fsal_pending = false;
+        }
+        self.ensure_first_stage(rhs, t, y)?;
+        let (outcome, rejected) = controlled_step(t, h_try, step_factor, MAX_FACTOR, |h| {
+            self.attempt(rhs, t, y, h, tolerances)
+        });
+        self.counters.rejected += rejected;
+        let accepted = outcome?;
+        self.accept(t, accepted.h, y);
+        Ok(accepted)
     }
 
+    /// Forget the cached derivative at the current point (call after the state was changed
+    /// outside this integrator, e.g. a re-partition or another integrator's step).
     fn invalidate_fsal(&mut self) {
-        Dopri5::invalidate_fsal(self);
+        self.fsal_valid = false;
+        self.fsal_pending = false;
     }
 
     fn prepare_dense<F>(&mut self, _rhs: &mut F) -> Result<(), SimError>
@@ -440,8 +368,26 @@ impl Adaptive for Dopri5 {
         Ok(())
     }
 
+    /// y(t) inside the last accepted step by Shampine's fourth-order continuous extension
+    /// (Hairer's `contd5`); needs no further right-hand side. Valid until the next step.
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        Dopri5::interpolate(self, t, out);
+        let (h, s) = (self.h_old, (t - self.t_old) / self.h_old);
+        let s1 = 1.0 - s;
+        let k = &self.k;
+        for (i, o) in out.iter_mut().enumerate() {
+            let y0 = self.y_old[i];
+            let difference = self.y_new[i] - y0;
+            let r3 = h * k[0][i] - difference;
+            let r4 = difference - h * k[6][i] - r3;
+            let r5 = h
+                * (D1 * k[0][i]
+                    + D3 * k[2][i]
+                    + D4 * k[3][i]
+                    + D5 * k[4][i]
+                    + D6 * k[5][i]
+                    + D7 * k[6][i]);
+            *o = y0 + s * (difference + s1 * (r3 + s * (r4 + s1 * r5)));
+        }
     }
 
     fn counters(&self) -> Counters {
@@ -449,38 +395,51 @@ impl Adaptive for Dopri5 {
     }
 }
 
-impl Adaptive for Dop853 {
-    fn step<F>(
-        &mut self,
-        rhs: &mut F,
-        t: f64,
-        y: &mut [f64],
-        h_try: f64,
-        tolerances: Tolerances,
-    ) -> Result<AcceptedStep, SimError>
-    where
-        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
-    {
-        Dop853::step(self, rhs, t, y, h_try, tolerances)
-    }
-
-    fn invalidate_fsal(&mut self) {
-        Dop853::invalidate_fsal(self);
-    }
-
-    fn prepare_dense<F>(&mut self, rhs: &mut F) -> Result<(), SimError>
-    where
-        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), SimError>,
-    {
-        Dop853::prepare_dense(self, rhs)
-    }
-
-    fn interpolate(&self, t: f64, out: &mut [f64]) {
-        Dop853::interpolate(self, t, out);
-    }
-
-    fn counters(&self) -> Counters {
-        self.counters
+/// The step-size loop of the adaptive integrators: tries `h_try`, shrinks the step by
+/// `factor(error)` (≤ 1) after a rejection or by [`FAILURE_FACTOR`] after a failing
+/// right-hand side, and returns the accepted step with the next proposal (growth limited
+/// to `max_factor`, and to 1 right after a rejection), plus the number of rejections.
+/// `attempt(h)` computes a trial step and returns its scaled error (≤ 1: acceptable).
+///
+/// At most [`MAX_FAILED_ATTEMPTS`] failures in a row, then the failure is returned; below
+/// the step floor the last failure, if any, is the cause (steps shrinking onto a point
+/// where the right-hand side fails, e.g. the chain cannot follow the cam beyond it),
+/// otherwise [`SimError::StepSizeTooSmall`].
+fn controlled_step(
+    t: f64,
+    h_try: f64,
+    factor: fn(f64) -> f64,
+    max_factor: f64,
+    mut attempt: impl FnMut(f64) -> Result<f64, SimError>,
+) -> (Result<AcceptedStep, SimError>, usize) {
+    let floor = STEP_FLOOR * t.abs().max(1.0);
+    let (mut h, mut rejected, mut failed_attempts) = (h_try, 0, 0);
+    let mut last_failure = None;
+    loop {
+        if h.is_nan() || h < floor {
+            let error = last_failure.unwrap_or(SimError::StepSizeTooSmall { t, h });
+            return (Err(error), rejected);
+        }
+        match attempt(h) {
+            Ok(error) if error <= 1.0 => {
+                let growth = if rejected > 0 { 1.0 } else { max_factor };
+                let h_next = h * factor(error).min(growth);
+                return (Ok(AcceptedStep { h, h_next }), rejected);
+            }
+            Ok(error) => {
+                last_failure = None;
+                h *= factor(error).min(1.0);
+            }
+            Err(failure) => {
+                failed_attempts += 1;
+                if failed_attempts > MAX_FAILED_ATTEMPTS {
+                    return (Err(failure), rejected);
+                }
+                last_failure = Some(failure);
+                h *= FAILURE_FACTOR;
+            }
+        }
+        rejected += 1;
     }
 }
 
