@@ -422,6 +422,34 @@ fn bad_options_and_files_name_the_flag_and_the_problem() {
             vec!["unexpected argument 'extra'"],
         ),
         (
+            vec!["simulate", "driven_convex", "--restitution", "1.5"],
+            2,
+            vec!["'--restitution <E>'", "not in [0, 1]"],
+        ),
+        (
+            vec![
+                "simulate",
+                "double_pendulum",
+                "--restitution",
+                "0.5",
+                "--out",
+                "runs",
+                "-q",
+            ],
+            1,
+            vec!["exactly one cam contact"],
+        ),
+        (
+            vec!["bench", "evaluations", "--report", "/nonexistent/dir/B.md"],
+            2,
+            vec!["--report", "the directory does not exist"],
+        ),
+        (
+            vec!["bench", "scaling-figure"],
+            2,
+            vec!["needs --scaling-csv"],
+        ),
+        (
             vec!["simulate", "--t-end"],
             2,
             vec!["a value is required for '--t-end"],

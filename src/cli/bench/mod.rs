@@ -23,6 +23,14 @@ use super::args::{BenchArgs, BenchWhat};
 /// Runs the benchmarks `args` asks for and updates their sections of the report.
 pub fn run(args: &BenchArgs) -> Result<(), CliError> {
     let report = &args.report;
+    // Say so before minutes of measuring rather than after.
+    let directory = report.parent().filter(|d| !d.as_os_str().is_empty());
+    if directory.is_some_and(|d| !d.is_dir()) {
+        return Err(CliError::Usage(format!(
+            "--report {}: the directory does not exist",
+            report.display()
+        )));
+    }
     if matches!(args.what, BenchWhat::Evaluations | BenchWhat::All) {
         let section = evaluations::run(args.quick)?;
         markdown::replace_section(report, "evaluations", &section)?;
