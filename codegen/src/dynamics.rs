@@ -243,11 +243,21 @@ fn mass_matrix(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Vec<
     mass
 }
 
+/// A body's inertial loads about its joint point, own frame, waiting to be moved to the
+/// parent: the force is kept as m·a plus the rest, so that the parent receives m·a from the
+/// kinematics' parent-frame acceleration instead of rotating it there and back.
+struct Loads {
+    moment: V3,
+    /// The force minus the body's own m·a (own frame).
+    force_rest: V3,
+    mass: Id,
+}
+
 /// F: inertial loads at q̈ = 0, summed from the tip.
 fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Id> {
     let n = model.n();
     let kids = children(model);
-    let mut loads: Vec<Option<(V3, V3)>> = vec![None; n];
+    let mut loads: Vec<Option<Loads>> = (0..n).map(|_| None).collect();
     let mut out = vec![g.zero(); n];
     for i in (0..n).rev() {
         g.set_section(format!(
@@ -257,11 +267,9 @@ fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<
         let k = &kin[i];
         let b = body_inertia(g, &model.bodies[i]);
         // Own loads about the joint point (no centre-of-mass acceleration needed).
-        let ma = vec3::scale(g, b.mass, k.accel);
         let a_h = vec3::cross(g, k.alpha, b.first);
         let w_w_h = vec3::omega_omega(g, k.omega, b.first);
-        let f = vec3::add(g, ma, a_h);
-        let mut force = vec3::add(g, f, w_w_h);
+        let mut force_rest = vec3::add(g, a_h, w_w_h);
         let i_a = mat_vec(g, &b.tensor, k.alpha);
         let i_w = mat_vec(g, &b.tensor, k.omega);
         let gyro = vec3::cross(g, k.omega, i_w);
@@ -269,16 +277,38 @@ fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<
         let m = vec3::add(g, i_a, gyro);
         let mut moment = vec3::add(g, m, h_a);
         for &c in &kids[i] {
-            if let Some((nc, fc)) = loads[c].take() {
-                let (nc, fc) = force_to_parent(g, &kin[c], nc, fc);
+            if let Some(child) = loads[c].take() {
+                let (nc, fc) = child_loads_to_parent(g, &kin[c], &child);
                 moment = vec3::add(g, moment, nc);
-                force = vec3::add(g, force, fc);
+                force_rest = vec3::add(g, force_rest, fc);
             }
         }
-        out[i] = project(g, model, kin, i, moment, force);
-        loads[i] = Some((moment, force));
+        out[i] = match model.bodies[i].joint.kind {
+            JointKind::Revolute => vec3::dot(g, k.axis, moment),
+            JointKind::Prismatic => {
+                let ma = vec3::scale(g, b.mass, k.accel);
+                let force = vec3::add(g, ma, force_rest);
+                vec3::dot(g, k.axis, force)
+            }
+        };
+        loads[i] = Some(Loads {
+            moment,
+            force_rest,
+            mass: b.mass,
+        });
     }
     out
+}
+
+/// A child's loads in its parent's frame, about the parent's origin: f' = m a' + R f_rest
+/// (a' the child's acceleration already in the parent's frame), n' = R n + r × f'.
+fn child_loads_to_parent(g: &mut Graph, child: &BodyKinematics, l: &Loads) -> (V3, V3) {
+    let ma = vec3::scale(g, l.mass, child.accel_in_parent);
+    let rest = child.relative.apply(g, l.force_rest);
+    let f = vec3::add(g, ma, rest);
+    let n = child.relative.apply(g, l.moment);
+    let r_f = vec3::cross(g, child.offset, f);
+    (vec3::add(g, n, r_f), f)
 }
 
 /// The gravity part of Q: moments of the subtrees' weights about the joints.

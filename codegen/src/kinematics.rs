@@ -264,6 +264,10 @@ pub struct BodyKinematics {
     pub alpha: V3,
     /// Velocity-product part of the origin's acceleration (q̈ = 0), body frame.
     pub accel: V3,
+    /// The same acceleration in the parent's frame (`accel` = Rᵀ · this): the backward
+    /// recursion moves a body's m·a to its parent with this vector instead of rotating
+    /// `accel` back (R Rᵀ = I is an identity the expression engine cannot see).
+    pub accel_in_parent: V3,
     /// −g (gravity enters as an acceleration of the ground) seen in the body frame.
     pub gravity: V3,
 }
@@ -303,6 +307,7 @@ fn ground_kinematics(g: &mut Graph, model: &Model) -> BodyKinematics {
         velocity: zero,
         alpha: zero,
         accel: zero,
+        accel_in_parent: zero,
         gravity: vec3::constant(g, model.gravity.map(|x| -x)),
     }
 }
@@ -344,27 +349,28 @@ fn child_kinematics(
     let alpha_p = relative.apply_transpose(g, p.alpha);
     let v_p = relative.apply_transpose(g, v_joint);
     let a_p = relative.apply_transpose(g, a_joint);
-    let gravity = relative.apply_transpose(g, p.gravity);
     let axis_rate = vec3::scale(g, qd, axis);
-    let (omega, velocity, alpha, accel) = match joint.kind {
+    let (omega, velocity, alpha, accel, accel_in_parent) = match joint.kind {
         JointKind::Revolute => {
             // ω = ω_p + e q̇;  α = α_p + ω_p × e q̇ (+ e q̈).
             let omega = vec3::add(g, omega_p, axis_rate);
             let coriolis = vec3::cross(g, omega_p, axis_rate);
             let alpha = vec3::add(g, alpha_p, coriolis);
-            (omega, v_p, alpha, a_p)
+            (omega, v_p, alpha, a_p, a_joint)
         }
         JointKind::Prismatic => {
-            // v = v_p + e q̇;  a = a_p + 2 ω_p × e q̇ (+ e q̈).
+            // v = v_p + e q̇;  a = a_p + 2 ω_p × e q̇ (+ e q̈). No rotation: the body's
+            // frame is its parent's, so the acceleration is the same vector in both.
             let velocity = vec3::add(g, v_p, axis_rate);
             let two = g.constant(2.0);
             let w_e = vec3::cross(g, omega_p, axis_rate);
             let coriolis = vec3::scale(g, two, w_e);
             let accel = vec3::add(g, a_p, coriolis);
-            (omega_p, velocity, alpha_p, accel)
+            (omega_p, velocity, alpha_p, accel, accel)
         }
     };
     let rotation = p.rotation.compose(g, &relative);
+    let gravity = gravity_in_body(g, model, &rotation, &relative, p);
     let step = p.rotation.apply(g, offset);
     let origin = vec3::add(g, p.origin, step);
     let axis_ground = p.rotation.apply(g, axis);
@@ -380,7 +386,28 @@ fn child_kinematics(
         velocity,
         alpha,
         accel,
+        accel_in_parent,
         gravity,
+    }
+}
+
+/// −g in the body frame. While the absolute rotation is one angle about a fixed axis (a
+/// planar chain), −g is rotated from the ground with that angle's sine and cosine, which the
+/// contact point needs anyway (and which the generated right-hand side computes once);
+/// otherwise it is carried down from the parent with the joint's rotation.
+fn gravity_in_body(
+    g: &mut Graph,
+    model: &Model,
+    rotation: &Rotation,
+    relative: &Rotation,
+    p: &BodyKinematics,
+) -> V3 {
+    match rotation {
+        Rotation::Axis { .. } => {
+            let ground = vec3::constant(g, model.gravity.map(|x| -x));
+            rotation.apply_transpose(g, ground)
+        }
+        _ => relative.apply_transpose(g, p.gravity),
     }
 }
 
