@@ -5,6 +5,7 @@ use crate::constraint::{ContactTerms, contact_terms, value_and_derivatives};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{Symbols, forward};
+use crate::linear;
 use crate::model::Model;
 
 /// q(t), q̇(t), q̈(t) of a driven coordinate.
@@ -56,13 +57,67 @@ impl Derivation {
                 })
             })
             .collect();
-        Derivation {
+        let mut d = Derivation {
             graph: g,
             symbols,
             dynamics,
             contacts,
             energy,
             drives,
+        };
+        d.collect_linear();
+        d
+    }
+
+    /// Runs [`linear::collect_linear`] over every term at once (so a node another term
+    /// also uses is never expanded into one of them).
+    fn collect_linear(&mut self) {
+        let mut roots: Vec<Id> = Vec::new();
+        self.visit_roots(|id| roots.push(*id));
+        linear::collect_linear(&mut self.graph, &mut roots);
+        let mut it = roots.into_iter();
+        self.visit_roots(|id| {
+            if let Some(new) = it.next() {
+                *id = new;
+            }
+        });
+    }
+
+    /// Every expression the derivation holds, in a fixed order.
+    fn visit_roots(&mut self, mut f: impl FnMut(&mut Id)) {
+        let dy = &mut self.dynamics;
+        dy.mass.iter_mut().flatten().for_each(&mut f);
+        dy.inertial.iter_mut().for_each(&mut f);
+        dy.applied.iter_mut().for_each(&mut f);
+        for c in &mut self.contacts {
+            c.position.iter_mut().for_each(&mut f);
+            for id in [
+                &mut c.f1,
+                &mut c.f2,
+                &mut c.conv1,
+                &mut c.conv2,
+                &mut c.slope,
+                &mut c.curvature,
+                &mut c.h,
+                &mut c.bias,
+            ] {
+                f(id);
+            }
+            c.j1.iter_mut().for_each(&mut f);
+            c.j2.iter_mut().for_each(&mut f);
+            c.jacobian.iter_mut().for_each(&mut f);
+        }
+        let e = &mut self.energy;
+        for id in [
+            &mut e.kinetic,
+            &mut e.gravity,
+            &mut e.spring,
+            &mut e.damper_power,
+        ] {
+            f(id);
+        }
+        for d in &mut self.drives {
+            d.motion.iter_mut().for_each(&mut f);
         }
     }
 

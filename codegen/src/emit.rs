@@ -1268,10 +1268,7 @@ impl<'g> Emitter<'g> {
             taken.insert(word.to_string());
         }
         let mut section: Option<String> = None;
-        for i in 0..self.g.len() {
-            if !self.reachable[i] {
-                continue;
-            }
+        for i in self.emission_order() {
             let id = id_at(self.g, i);
             if matches!(self.g.node(id), Node::Var(_)) && !self.given.contains_key(&id) {
                 used_vars.insert(id);
@@ -1296,6 +1293,49 @@ impl<'g> Emitter<'g> {
             self.names.insert(id, name);
         }
         (text, used_vars)
+    }
+
+    /// The reachable nodes, children before parents, each section's nodes kept together
+    /// where the dependencies allow (a topological order preferring the earliest section,
+    /// then creation order): a node rebuilt by a rewriting pass is printed under its
+    /// original heading, not after everything else.
+    fn emission_order(&self) -> Vec<usize> {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        let n = self.g.len();
+        let deps = |i: usize| -> Vec<usize> {
+            let id = id_at(self.g, i);
+            if self.given.contains_key(&id) {
+                return Vec::new();
+            }
+            let mut c: Vec<usize> = self.g.children(id).iter().map(|c| c.index()).collect();
+            c.dedup();
+            c
+        };
+        let mut waiting = vec![0usize; n];
+        let mut parents: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let mut ready = BinaryHeap::new();
+        for i in (0..n).filter(|&i| self.reachable[i]) {
+            let d = deps(i);
+            waiting[i] = d.len();
+            for c in d {
+                parents[c].push(i);
+            }
+            if waiting[i] == 0 {
+                ready.push(Reverse((self.g.section_index(id_at(self.g, i)), i)));
+            }
+        }
+        let mut order = Vec::with_capacity(n);
+        while let Some(Reverse((_, i))) = ready.pop() {
+            order.push(i);
+            for &p in &parents[i] {
+                waiting[p] -= 1;
+                if waiting[p] == 0 {
+                    ready.push(Reverse((self.g.section_index(id_at(self.g, p)), p)));
+                }
+            }
+        }
+        order
     }
 
     fn fresh_name(&self, id: Id, taken: &mut HashSet<String>) -> String {

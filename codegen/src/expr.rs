@@ -108,6 +108,9 @@ pub struct Graph {
     labels: HashMap<Id, String>,
     sections: Vec<u32>,
     section_names: Vec<String>,
+    /// While set, new nodes go into this section instead of the latest one (rewriting
+    /// passes keep a rebuilt node under its original heading).
+    section_override: Option<u32>,
 }
 
 fn const_bits(value: f64) -> u64 {
@@ -151,8 +154,10 @@ impl Graph {
         }
         let id = Id(self.nodes.len() as u32);
         self.nodes.push(node);
-        self.sections
-            .push(self.section_names.len().saturating_sub(1) as u32);
+        let section = self
+            .section_override
+            .unwrap_or(self.section_names.len().saturating_sub(1) as u32);
+        self.sections.push(section);
         self.index.insert(node, id);
         id
     }
@@ -214,10 +219,30 @@ impl Graph {
         self.section_names.push(name.into());
     }
 
+    /// The index of the section a node belongs to (sections are numbered as started).
+    pub fn section_index(&self, id: Id) -> u32 {
+        self.sections.get(id.index()).copied().unwrap_or(0)
+    }
+
     /// The section a node was created in.
     pub fn section_of(&self, id: Id) -> Option<&str> {
         let k = *self.sections.get(id.index())? as usize;
         self.section_names.get(k).map(String::as_str)
+    }
+
+    /// Runs `build` with new nodes placed in the section of `like`, and gives its result
+    /// `like`'s label: a rewritten node keeps the heading and name of the one it replaces.
+    pub(crate) fn rebuild_as(&mut self, like: Id, build: impl FnOnce(&mut Self) -> Id) -> Id {
+        let saved = self.section_override;
+        self.section_override = self.sections.get(like.index()).copied();
+        let new = build(self);
+        self.section_override = saved;
+        if new != like {
+            if let Some(name) = self.labels.get(&like).cloned() {
+                self.label(new, name);
+            }
+        }
+        new
     }
 
     /// Gives a node a readable name for the emitted code (first label wins).
@@ -394,9 +419,15 @@ impl Graph {
         match n {
             0 => self.one(),
             1 => a,
-            _ => match self.as_const(a) {
-                Some(x) => self.constant(x.powi(n)),
-                None => self.intern(Node::Powi(a, n)),
+            _ => match (self.as_const(a), self.node(a)) {
+                (Some(x), _) => self.constant(x.powi(n)),
+                // (−x)ⁿ = ±xⁿ: the sign goes out (and vanishes for even n).
+                (None, Node::Neg(x)) if n % 2 == 0 => self.powi(x, n),
+                (None, Node::Neg(x)) => {
+                    let p = self.powi(x, n);
+                    self.neg(p)
+                }
+                (None, _) => self.intern(Node::Powi(a, n)),
             },
         }
     }

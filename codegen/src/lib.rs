@@ -6,6 +6,7 @@
 //! - [`profile`]: one-variable expressions (cam profiles, drives) parsed with `syn`.
 //! - [`expr`]: the hash-consed symbolic expression DAG: folding, differentiation,
 //!   interpretation and operation counts.
+//! - [`linear`]: the pass that collects nested sums into linear combinations.
 //! - [`kinematics`]: forward recursion of rotations, positions, velocities, accelerations (9).
 //! - [`constraint`]: contact point f1, f2, J1, J2, convective terms and h, J, c (1–8).
 //! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (10–13), and energies.
@@ -20,6 +21,7 @@ pub mod emit;
 pub mod error;
 pub mod expr;
 pub mod kinematics;
+pub mod linear;
 pub mod model;
 pub mod profile;
 pub mod schema;

@@ -89,7 +89,10 @@ fn removing_gravity_removes_its_operations_and_constants() {
         .iter()
         .find(|(n, _)| n == "applied_forces");
     assert_eq!(c.map(|(_, c)| c.sin_cos), Some(0));
-    assert!(function(&full, "applied_forces").contains("9.81"));
+    // (With gravity, Q needs the sines and cosines of the body angles; g itself is folded
+    // into the mass factors, so it is the trigonometry that shows it.)
+    let with = full.op_counts.iter().find(|(n, _)| n == "applied_forces");
+    assert!(with.is_some_and(|(_, c)| c.sin_cos > 0));
     assert!(!without.code.contains("9.81"), "no gravity constant left");
 }
 
