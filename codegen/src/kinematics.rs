@@ -392,9 +392,11 @@ fn child_kinematics(
 }
 
 /// −g in the body frame. While the absolute rotation is one angle about a fixed axis (a
-/// planar chain), −g is rotated from the ground with that angle's sine and cosine, which the
-/// contact point needs anyway (and which the generated right-hand side computes once);
-/// otherwise it is carried down from the parent with the joint's rotation.
+/// planar chain), −g is rotated from the ground with that angle's sine and cosine: two
+/// products per body instead of rotating the parent's vector (four products and two
+/// additions), and the same sine and cosine a contact point on the chain needs anyway (the
+/// generated right-hand side computes them once, at the position level). Otherwise −g is
+/// carried down from the parent with the joint's rotation.
 fn gravity_in_body(
     g: &mut Graph,
     model: &Model,
