@@ -366,34 +366,37 @@ impl Workspace {
     }
 
     /// Eq. (15): Newton on the dependent coordinates, v ← v − J_v⁻¹ h(q), from the v held
-    /// in `q`. Converged when max |h| ≤ [`NEWTON_RESIDUAL_TOLERANCE`] and the last
-    /// correction ≤ [`NEWTON_STEP_TOLERANCE`]·(1 + ‖v‖∞); at most
-    /// [`NEWTON_MAX_ITERATIONS`] corrections. Returns the number of corrections.
+    /// in `q`. Converged when, at the current iterate, max |h| ≤
+    /// [`NEWTON_RESIDUAL_TOLERANCE`] and the correction Newton would make next is at most
+    /// [`NEWTON_STEP_TOLERANCE`]·(1 + ‖v‖∞); at most [`NEWTON_MAX_ITERATIONS`]
+    /// corrections. Returns the number of corrections made.
+    ///
+    /// Testing the *next* correction (J_v is factored at every iterate anyway, for the
+    /// correction or for the velocity level) rather than the last one saves the evaluation
+    /// that would only confirm convergence: from a start 1e-8 off, one correction and two
+    /// evaluations instead of two and three. On return h, J, the cache and the factored J_v
+    /// are those of the returned q, and the pending correction is the one
+    /// [`Self::polish_positions`] applies.
     pub fn solve_positions<D: Dynamics + ?Sized>(
         &mut self,
         model: &D,
         dependent: &[usize],
         t: f64,
     ) -> Result<usize, SimError> {
-        let mut last_correction = 0.0;
         let mut iterations = 0;
         loop {
             let residual = self.constraint_residual(model, t)?;
-            // At the first evaluation there is no correction to check (the common case:
-            // the integrated v is an accurate starting point).
-            let done = if iterations == 0 {
-                residual <= NEWTON_RESIDUAL_TOLERANCE
-            } else {
-                self.converged(residual, last_correction, dependent)
-            };
-            if done {
+            self.factor_jacobian_for_newton(model, dependent, t, residual, iterations)?;
+            let next = self.pending_correction(dependent);
+            if residual <= NEWTON_RESIDUAL_TOLERANCE
+                && next <= NEWTON_STEP_TOLERANCE * (1.0 + self.v_size(dependent))
+            {
                 return Ok(iterations);
             }
             if iterations == NEWTON_MAX_ITERATIONS {
                 return Err(self.newton_failure(t, residual, iterations));
             }
-            self.factor_jacobian_for_newton(model, dependent, t, residual, iterations)?;
-            last_correction = self.newton_correction(dependent);
+            self.apply_correction(dependent);
             iterations += 1;
         }
     }
@@ -457,9 +460,11 @@ impl Workspace {
         Err(self.newton_failure(t, residual, iterations))
     }
 
-    /// [`Self::factor_jacobian`] inside Newton: a singular J_v at an iterate means that
-    /// Newton cannot go on (typically the point has been asked to go where the cam is
-    /// not), reported as [`SimError::NewtonFailed`].
+    /// [`Self::factor_current_jacobian`] inside Newton: a singular J_v at an iterate that
+    /// does not yet satisfy the constraint means that Newton cannot go on (typically the
+    /// point has been asked to go where the cam is not), reported as
+    /// [`SimError::NewtonFailed`]; at a point already on the cam it is the configuration
+    /// itself that is singular ([`SimError::SingularConstraint`]).
     fn factor_jacobian_for_newton<D: Dynamics + ?Sized>(
         &mut self,
         _model: &D,
@@ -469,7 +474,7 @@ impl Workspace {
         iterations: usize,
     ) -> Result<(), SimError> {
         match self.factor_current_jacobian(dependent, t) {
-            Err(SimError::SingularConstraint { .. }) => {
+            Err(SimError::SingularConstraint { .. }) if residual > NEWTON_RESIDUAL_TOLERANCE => {
                 Err(self.newton_failure(t, residual, iterations))
             }
             other => other,
@@ -493,37 +498,46 @@ impl Workspace {
     }
 
     fn converged(&self, residual: f64, last_correction: f64, dependent: &[usize]) -> bool {
-        let v_size = dependent
-            .iter()
-            .fold(0.0_f64, |m, &v| m.max(self.q[v].abs()));
         residual <= NEWTON_RESIDUAL_TOLERANCE
-            && last_correction <= NEWTON_STEP_TOLERANCE * (1.0 + v_size)
+            && last_correction <= NEWTON_STEP_TOLERANCE * (1.0 + self.v_size(dependent))
+    }
+
+    /// ‖v‖∞, the scale of the step tolerance.
+    fn v_size(&self, dependent: &[usize]) -> f64 {
+        dependent
+            .iter()
+            .fold(0.0_f64, |m, &v| m.max(self.q[v].abs()))
     }
 
     /// One last Newton correction v ← v − J_v⁻¹ h with the h and J_v of the converged
     /// iterate, without evaluating again: Newton stops at |h| ≤ 1e-12, which would leave v
     /// up to ~1e-12 off and put a floor under the accuracy of tight integrations; the
     /// correction makes the residual quadratically small (~1e-24) for the price of a
-    /// division. The J, cache and h kept in the workspace are those of the iterate before
-    /// it, 1e-12 away, which the velocity and acceleration levels tolerate.
+    /// subtraction (it was computed by [`Self::solve_positions`]'s convergence test). The
+    /// J, cache and h kept in the workspace are those of the iterate before it, 1e-12
+    /// away, which the velocity and acceleration levels tolerate.
     pub fn polish_positions(&mut self, dependent: &[usize]) {
-        self.newton_correction(dependent);
+        self.apply_correction(dependent);
     }
 
-    /// v ← v − J_v⁻¹ h (J_v factored, h evaluated); returns the correction's size.
-    fn newton_correction(&mut self, dependent: &[usize]) -> f64 {
-        if let ([v], [h], [j_v]) = (dependent, &self.h[..], &self.jv_lu[..]) {
+    /// J_v⁻¹ h (J_v factored, h evaluated) into the scratch vector, not applied yet;
+    /// returns its size max |Δv|.
+    fn pending_correction(&mut self, dependent: &[usize]) -> f64 {
+        if let ([_], [h], [j_v]) = (dependent, &self.h[..], &self.jv_lu[..]) {
             // One contact: J_v is a number.
-            let dv = h / j_v;
-            self.q[*v] -= dv;
-            return dv.abs();
+            self.scratch[0] = h / j_v;
+            return self.scratch[0].abs();
         }
         self.scratch.copy_from_slice(&self.h);
         lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        max_abs(&self.scratch)
+    }
+
+    /// v ← v − Δv with the correction of [`Self::pending_correction`].
+    fn apply_correction(&mut self, dependent: &[usize]) {
         for (&dv, &v) in self.scratch.iter().zip(dependent) {
             self.q[v] -= dv;
         }
-        max_abs(&self.scratch)
     }
 
     fn newton_failure(&self, t: f64, residual: f64, iterations: usize) -> SimError {

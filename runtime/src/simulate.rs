@@ -1395,9 +1395,8 @@ fn load_state<D: Dynamics + ?Sized>(
     if nc == 0 {
         ws.factor_jacobian(model, partition.dependent(), t)?;
     } else {
-        // Newton ends with an evaluation of h, J and the cache at the returned q.
+        // Newton ends with h, J, the cache and the factored J_v of the returned q.
         solve_positions_with_restart(model, partition.dependent(), ws, t)?;
-        ws.factor_current_jacobian(partition.dependent(), t)?;
         ws.polish_positions(partition.dependent());
     }
     ws.solve_velocities(partition.dependent());
