@@ -10,7 +10,9 @@
 // The coefficients are quoted with the digits of the published tables.
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
-use super::{AcceptedStep, Adaptive, Counters, Tolerances, controlled_step};
+use super::{
+    AcceptedStep, Adaptive, CONTROLLER_BETA, Controller, Counters, Tolerances, controlled_step,
+};
 use crate::error::SimError;
 
 /// Number of stage derivatives kept: k1…k12, k13 = f(t + h, y_new), k14…k16 (dense output).
@@ -235,8 +237,8 @@ const D: [[f64; 12]; 4] = [
     ],
 ];
 
-/// Controller of DOP853: safety 0.9, exponent 1/8, step ratio within [1/3, 6].
-const SAFETY: f64 = 0.9;
+/// Step-ratio bounds of the DOP853 controller (Hairer's 1/3 and 6; safety 0.9 and the
+/// exponents are in [`Controller`]).
 const MIN_FACTOR: f64 = 1.0 / 3.0;
 const MAX_FACTOR: f64 = 6.0;
 
@@ -259,6 +261,7 @@ pub struct Dop853 {
     /// k13 of the last accepted step is the next step's k1 (moved when that step starts, so
     /// that dense output can still be prepared until then).
     fsal_pending: bool,
+    controller: Controller,
     /// Work done so far.
     pub counters: Counters,
 }
@@ -279,6 +282,12 @@ impl Dop853 {
             controlled: controlled.min(dim),
             fsal_valid: false,
             fsal_pending: false,
+            controller: Controller::new(
+                0.125 - 0.2 * CONTROLLER_BETA,
+                CONTROLLER_BETA,
+                MIN_FACTOR,
+                MAX_FACTOR,
+            ),
             counters: Counters::default(),
         }
     }
@@ -370,9 +379,11 @@ impl Adaptive for Dop853 {
             self.fsal_valid = true;
         }
         self.dense_ready = false;
-        let (outcome, rejected) = controlled_step(t, h_try, step_factor, MAX_FACTOR, |h| {
+        let mut controller = self.controller;
+        let (outcome, rejected) = controlled_step(t, h_try, &mut controller, |h| {
             self.attempt(rhs, t, y, h, tolerances)
         });
+        self.controller = controller;
         self.counters.rejected += rejected;
         let accepted = outcome?;
         self.y_old.copy_from_slice(y);
@@ -386,6 +397,7 @@ impl Adaptive for Dop853 {
     /// Forget the cached derivative at the current point (after the state was changed
     /// outside this integrator).
     fn invalidate_fsal(&mut self) {
+        self.controller.reset();
         self.fsal_valid = false;
         self.fsal_pending = false;
     }
@@ -453,14 +465,6 @@ fn combine(out: &mut [f64], y: &[f64], h: f64, weights: &[(usize, f64)], k: &[Ve
             *o += scale * kj;
         }
     }
-}
-
-/// Controller factor 0.9·err^(−1/8), bounded to [1/3, 6] (err = 0 gives 6).
-fn step_factor(error: f64) -> f64 {
-    if error <= 0.0 {
-        return MAX_FACTOR;
-    }
-    (SAFETY * error.powf(-0.125)).clamp(MIN_FACTOR, MAX_FACTOR)
 }
 
 #[cfg(test)]
