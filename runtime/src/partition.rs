@@ -18,6 +18,7 @@
 
 use crate::dynamics::{Dynamics, VelocityTerms};
 use crate::error::SimError;
+use std::sync::Arc;
 
 /// Re-partition threshold on [`conditioning`]: the dependent coordinates are re-chosen after
 /// a step when the ratio falls below it.
@@ -185,7 +186,9 @@ pub struct Partition {
     contacts: usize,
     driven: Vec<usize>,
     independent: Vec<usize>,
-    dependent: Vec<usize>,
+    /// Shared with every sample taken under this partition (a counter increment per
+    /// sample instead of an allocation).
+    dependent: Arc<[usize]>,
     eligible: Vec<bool>,
 }
 
@@ -200,7 +203,7 @@ impl Partition {
                 .filter(|&i| driven_flags[i])
                 .collect(),
             independent: Vec::with_capacity(driven_flags.len()),
-            dependent: Vec::with_capacity(dependent.len()),
+            dependent: Arc::from(dependent),
             eligible: driven_flags.iter().map(|d| !d).collect(),
         };
         partition.set_dependent(dependent)?;
@@ -211,8 +214,7 @@ impl Partition {
     /// Fails when an index is out of range, repeated or driven.
     pub fn set_dependent(&mut self, dependent: &[usize]) -> Result<(), SimError> {
         self.validate_dependent(dependent)?;
-        self.dependent.clear();
-        self.dependent.extend_from_slice(dependent);
+        self.dependent = Arc::from(dependent);
         self.independent.clear();
         let n = self.eligible.len();
         let is_free = |i: &usize| self.eligible[*i] && !dependent.contains(i);
@@ -258,6 +260,11 @@ impl Partition {
     /// Dependent coordinates v, one per contact: recovered by (15), (16).
     pub fn dependent(&self) -> &[usize] {
         &self.dependent
+    }
+
+    /// The dependent coordinates as a shared slice (what a [`crate::Sample`] records).
+    pub fn dependent_shared(&self) -> Arc<[usize]> {
+        Arc::clone(&self.dependent)
     }
 
     /// `eligible()[i]`: coordinate i may be dependent (it is not driven).

@@ -227,8 +227,8 @@ pub struct Sample {
     pub dissipated: f64,
     /// Work done by the drives since assembly (J).
     pub driven_work: f64,
-    /// Dependent coordinates at this instant.
-    pub dependent: Vec<usize>,
+    /// Dependent coordinates at this instant (shared by the samples of one partition).
+    pub dependent: std::sync::Arc<[usize]>,
 }
 
 /// Samples at the output times and the work done.
@@ -583,6 +583,14 @@ fn run<D: Dynamics + ?Sized>(
     observe: &mut dyn FnMut(&Sample),
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
+    if settings.dt_out > 0.0 && settings.t_end.is_finite() && state.t.is_finite() {
+        // One sample per output time plus the start (the count is checked below; a
+        // reservation that fails the checks is harmless).
+        let expected = output_intervals(state.t, settings).min(MAX_OUTPUT_INTERVALS as usize);
+        trajectory
+            .samples
+            .reserve_exact(expected.saturating_add(1).min(1 << 16));
+    }
     let mut events = Vec::new();
     let checks = validate_run(model, &state, settings);
     let outcome = checks.map_err(|e| (e, Stats::default())).and_then(|()| {
@@ -1085,7 +1093,7 @@ fn complete_sample<D: Dynamics + ?Sized>(
         },
         dissipated,
         driven_work,
-        dependent: partition.dependent().to_vec(),
+        dependent: partition.dependent_shared(),
     };
     if level == SampleLevel::State {
         return Ok(sample);
@@ -2134,7 +2142,7 @@ mod tests {
             first.samples.last().unwrap(),
             second.samples.last().unwrap(),
         );
-        assert_eq!(a.dependent, vec![1]);
+        assert_eq!(a.dependent[..], [1]);
         assert!(a.q[0] < -0.3, "the bead is past the top: x = {}", a.q[0]);
         // The runs integrate different coordinates (x, then y, against y throughout), so
         // they differ by the sum of their global errors: ~10·rtol each over ~100 steps

@@ -315,7 +315,7 @@ mod tests {
             energy: Energy::default(),
             dissipated: 0.0,
             driven_work: 0.0,
-            dependent: vec![0],
+            dependent: vec![0].into(),
         }
     }
 
