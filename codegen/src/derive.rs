@@ -35,8 +35,16 @@ pub struct Derivation {
 }
 
 impl Derivation {
-    /// Derives every term of `model`.
+    /// Derives every term of `model` (with the linear combinations collected).
     pub fn new(model: &Model) -> Self {
+        let mut d = Self::uncollected(model);
+        d.collect_linear();
+        d
+    }
+
+    /// The derivation before [`linear::collect_linear`]: what the recursions build, for
+    /// comparisons (the pass must never cost operations).
+    pub fn uncollected(model: &Model) -> Self {
         let mut g = Graph::new();
         let symbols = Symbols::new(&mut g, model);
         let kin = forward(&mut g, model, &symbols);
@@ -57,40 +65,72 @@ impl Derivation {
                 })
             })
             .collect();
-        let mut d = Derivation {
+        Derivation {
             graph: g,
             symbols,
             dynamics,
             contacts,
             energy,
             drives,
-        };
-        d.collect_linear();
-        d
+        }
     }
 
     /// Runs [`linear::collect_linear`] over every term at once (so a node another term
-    /// also uses is never expanded into one of them).
+    /// also uses is never expanded into one of them), then keeps, term group by term group
+    /// (M, F, Q, energies, each contact's position level, each contact's J and c, each
+    /// drive), the rewritten expressions only where they need fewer operations: the pass
+    /// pulls shared factors out greedily, which on long contact Jacobians of spatial chains
+    /// can cost a few percent more than it saves.
     fn collect_linear(&mut self) {
         let mut roots: Vec<Id> = Vec::new();
-        self.visit_roots(|id| roots.push(*id));
-        linear::collect_linear(&mut self.graph, &mut roots);
-        let mut it = roots.into_iter();
-        self.visit_roots(|id| {
-            if let Some(new) = it.next() {
-                *id = new;
+        let mut group_of: Vec<usize> = Vec::new();
+        self.visit_roots(|group, id| {
+            roots.push(*id);
+            group_of.push(group);
+        });
+        let mut collected = roots.clone();
+        linear::collect_linear(&mut self.graph, &mut collected);
+        let groups = group_of.iter().copied().max().map_or(0, |g| g + 1);
+        let mut keep_new = vec![false; groups];
+        for (group, keep) in keep_new.iter_mut().enumerate() {
+            let pick = |ids: &[Id]| -> Vec<Id> {
+                ids.iter()
+                    .zip(&group_of)
+                    .filter(|&(_, &g)| g == group)
+                    .map(|(&id, _)| id)
+                    .collect()
+            };
+            let before = self.graph.op_count(&pick(&roots)).total();
+            let after = self.graph.op_count(&pick(&collected)).total();
+            *keep = after <= before;
+        }
+        let mut it = roots.into_iter().zip(collected);
+        self.visit_roots(|group, id| {
+            if let Some((old, new)) = it.next() {
+                *id = if keep_new[group] { new } else { old };
             }
         });
     }
 
-    /// Every expression the derivation holds, in a fixed order.
-    fn visit_roots(&mut self, mut f: impl FnMut(&mut Id)) {
+    /// Every expression the derivation holds, in a fixed order, with the index of its term
+    /// group.
+    fn visit_roots(&mut self, mut f: impl FnMut(usize, &mut Id)) {
         let dy = &mut self.dynamics;
-        dy.mass.iter_mut().flatten().for_each(&mut f);
-        dy.inertial.iter_mut().for_each(&mut f);
-        dy.applied.iter_mut().for_each(&mut f);
+        dy.mass.iter_mut().flatten().for_each(|id| f(0, id));
+        dy.inertial.iter_mut().for_each(|id| f(1, id));
+        dy.applied.iter_mut().for_each(|id| f(2, id));
+        let e = &mut self.energy;
+        for id in [
+            &mut e.kinetic,
+            &mut e.gravity,
+            &mut e.spring,
+            &mut e.damper_power,
+        ] {
+            f(3, id);
+        }
+        let mut group = 4;
         for c in &mut self.contacts {
-            c.position.iter_mut().for_each(&mut f);
+            c.position.iter_mut().for_each(|id| f(group, id));
             for id in [
                 &mut c.f1,
                 &mut c.f2,
@@ -99,25 +139,18 @@ impl Derivation {
                 &mut c.slope,
                 &mut c.curvature,
                 &mut c.h,
-                &mut c.bias,
             ] {
-                f(id);
+                f(group, id);
             }
-            c.j1.iter_mut().for_each(&mut f);
-            c.j2.iter_mut().for_each(&mut f);
-            c.jacobian.iter_mut().for_each(&mut f);
-        }
-        let e = &mut self.energy;
-        for id in [
-            &mut e.kinetic,
-            &mut e.gravity,
-            &mut e.spring,
-            &mut e.damper_power,
-        ] {
-            f(id);
+            c.j1.iter_mut().for_each(|id| f(group, id));
+            c.j2.iter_mut().for_each(|id| f(group, id));
+            c.jacobian.iter_mut().for_each(|id| f(group + 1, id));
+            f(group + 1, &mut c.bias);
+            group += 2;
         }
         for d in &mut self.drives {
-            d.motion.iter_mut().for_each(&mut f);
+            d.motion.iter_mut().for_each(|id| f(group, id));
+            group += 1;
         }
     }
 

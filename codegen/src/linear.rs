@@ -8,9 +8,13 @@
 //! multiplication per distinct |kⱼ| (terms sharing a factor are summed first):
 //! `0.34625 + 0.6·x`. A node used more than once stays a term, so nothing is computed twice.
 //!
-//! It never costs operations: a tree with n distinct terms needed at least n − 1 additions,
-//! and each distinct coefficient is the product of the factors above its terms, so there are
-//! no more coefficients than the tree had constant factors.
+//! Flattening and merging never cost operations: a tree with n distinct terms needed at least
+//! n − 1 additions, and each distinct coefficient is the product of the factors above its
+//! terms, so there are no more coefficients than the tree had constant factors. Pulling
+//! shared factors out is greedy and can, on long sums of products (the contact Jacobians of
+//! spatial chains), cost a few operations more than it saves; [`crate::Derivation`] therefore
+//! keeps the rewritten expressions of a term group only where they need fewer operations
+//! (`codegen/tests/linear_pass.rs` checks every model file and the scaling chains).
 
 use crate::expr::{Graph, Id, Node};
 use std::collections::BTreeMap;
