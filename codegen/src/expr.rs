@@ -389,12 +389,6 @@ impl Graph {
                 let d = self.as_const(x).unwrap_or(1.0);
                 self.scale(c * d, y)
             }
-            // c·(k + x) → ck + c·x: the same two operations, and the constant can merge.
-            Node::Add(x, y) if self.as_const(x).is_some() => {
-                let k = self.constant(c * self.as_const(x).unwrap_or(0.0));
-                let cy = self.scale(c, y);
-                self.add(k, cy)
-            }
             _ => {
                 let cid = self.constant(c);
                 self.intern(Node::Mul(cid, b))
