@@ -603,22 +603,30 @@ impl Graph {
                 image.push(to);
                 continue;
             }
-            let new = |c: Id| image[c.index()];
-            let rebuilt = match self.node(id) {
-                Node::Const(_) | Node::Var(_) => id,
-                Node::Add(a, b) if new(a) != a || new(b) != b => self.add(new(a), new(b)),
-                Node::Mul(a, b) if new(a) != a || new(b) != b => self.mul(new(a), new(b)),
-                Node::Div(a, b) if new(a) != a || new(b) != b => self.div(new(a), new(b)),
-                Node::Powf(a, b) if new(a) != a || new(b) != b => self.powf(new(a), new(b)),
-                Node::Neg(a) if new(a) != a => self.neg(new(a)),
-                Node::Powi(a, n) if new(a) != a => self.powi(new(a), n),
-                Node::Call(f, a) if new(a) != a => self.call(f, new(a)),
-                _ => id,
+            let changed = self.children(id).iter().any(|&c| image[c.index()] != c);
+            let rebuilt = if changed {
+                self.rebuild_with(id, |c| image[c.index()])
+            } else {
+                id
             };
             image.push(rebuilt);
         }
         for r in roots.iter_mut() {
             *r = image[r.index()];
+        }
+    }
+
+    /// The node `id` built again, with folding, from its children mapped by `new`.
+    pub(crate) fn rebuild_with(&mut self, id: Id, new: impl Fn(Id) -> Id) -> Id {
+        match self.node(id) {
+            Node::Const(_) | Node::Var(_) => id,
+            Node::Add(a, b) => self.add(new(a), new(b)),
+            Node::Mul(a, b) => self.mul(new(a), new(b)),
+            Node::Div(a, b) => self.div(new(a), new(b)),
+            Node::Powf(a, b) => self.powf(new(a), new(b)),
+            Node::Neg(a) => self.neg(new(a)),
+            Node::Powi(a, n) => self.powi(new(a), n),
+            Node::Call(f, a) => self.call(f, new(a)),
         }
     }
 

@@ -584,12 +584,10 @@ fn run<D: Dynamics + ?Sized>(
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
     if settings.dt_out > 0.0 && settings.t_end.is_finite() && state.t.is_finite() {
-        // One sample per output time plus the start (the count is checked below; a
-        // reservation that fails the checks is harmless).
-        let expected = output_intervals(state.t, settings).min(MAX_OUTPUT_INTERVALS as usize);
-        trajectory
-            .samples
-            .reserve_exact(expected.saturating_add(1).min(1 << 16));
+        // One sample per output time plus the start, capped (the count itself is checked
+        // below; a reservation for a run that then fails the checks is harmless).
+        let expected = output_intervals(state.t, settings).saturating_add(1);
+        trajectory.samples.reserve_exact(expected.min(1 << 16));
     }
     let mut events = Vec::new();
     let checks = validate_run(model, &state, settings);
