@@ -46,11 +46,61 @@ pub struct Generated {
     pub name: String,
     /// Model file the module was generated from, as shown in messages.
     pub source: String,
-    /// The formatted Rust module.
+    /// The formatted Rust module: items only (no inner attributes), so that it can be
+    /// included with `include!` inside a `mod` of the user's choosing.
     pub code: String,
     /// Operation count of every generated function, in emission order.
     pub op_counts: Vec<(String, OpCount)>,
 }
+
+/// How the standalone entry points (`mass_matrix`, `equations`, `constraint`, … every
+/// [`Dynamics`] function besides the fused pair `position_terms`/`velocity_terms` that a
+/// right-hand side calls) are emitted.
+///
+/// [`Dynamics`]: https://docs.rs/camchain-runtime
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EntryPoints {
+    /// Each with its own expressions below [`LARGE_MODEL_OPS`] operations in the fused
+    /// pair, as calls of the pair above (the default).
+    #[default]
+    Auto,
+    /// Always with their own expressions: each holds only the operations its outputs need
+    /// (the fewest operations per call; more code to compile).
+    Standalone,
+    /// Always as calls of the fused pair: every expression is compiled once (the least code
+    /// and the fastest build; a standalone call computes everything the pair computes).
+    ViaFusedPair,
+}
+
+/// Options of the emitted module.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EmitOptions {
+    /// How the generated code names the runtime crate (`camchain-runtime`). The default,
+    /// `::camchain::runtime`, is right for a crate that depends on the `camchain` facade; a
+    /// crate that depends on `camchain-runtime` directly uses `::camchain_runtime`. The module
+    /// imports it once as `rt`.
+    pub runtime_path: String,
+    /// How the standalone entry points are emitted.
+    pub entry_points: EntryPoints,
+    /// When set, the model file's text, embedded as `pub const MODEL_SOURCE: &str` (for
+    /// programs that also want the model description at run time, e.g. to draw it or to run
+    /// the numeric reference on it).
+    pub embedded_source: Option<String>,
+}
+
+impl Default for EmitOptions {
+    fn default() -> Self {
+        EmitOptions {
+            runtime_path: DEFAULT_RUNTIME_PATH.to_string(),
+            entry_points: EntryPoints::Auto,
+            embedded_source: None,
+        }
+    }
+}
+
+/// The path of the runtime that generated code uses unless told otherwise: the `camchain`
+/// facade's re-export.
+pub const DEFAULT_RUNTIME_PATH: &str = "::camchain::runtime";
 
 /// Output target meaning "the function's value" (written last, without a semicolon).
 const RETURN: &str = "return";
@@ -58,8 +108,18 @@ const RETURN: &str = "return";
 /// Prefix of the statements that become section comments after formatting.
 const SECTION_MACRO: &str = "__section__";
 
-/// Generates the module for `model`; `source` is the model file as shown in the header.
+/// Generates the module for `model` with the default options; `source` is the model file as
+/// shown in the header.
 pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
+    generate_with(model, source, &EmitOptions::default())
+}
+
+/// Generates the module for `model`; `source` is the model file as shown in the header.
+pub fn generate_with(
+    model: &Model,
+    source: &str,
+    options: &EmitOptions,
+) -> Result<Generated, String> {
     let mut d = Derivation::new(model);
     let specs = function_specs(model, &d);
     let fused = FusedTerms::new(&mut d);
@@ -68,7 +128,11 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
         .iter()
         .map(|(spec, given)| fused_count(&d, spec, given))
         .sum();
-    let wrap = fused_ops > LARGE_MODEL_OPS;
+    let wrap = match options.entry_points {
+        EntryPoints::Auto => fused_ops > LARGE_MODEL_OPS,
+        EntryPoints::Standalone => false,
+        EntryPoints::ViaFusedPair => true,
+    };
     let mut functions = String::new();
     let mut op_counts = Vec::new();
     for spec in &specs {
@@ -90,29 +154,32 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
          fn cache_len(&self) -> usize {{ {} }}",
         fused.cached.len()
     );
+    let helpers = contact_kinematics_helpers(model, &d, &mut op_counts);
     let mut file = String::new();
-    header(&mut file, model, source, &op_counts);
-    if wrap {
+    let _ = writeln!(
+        file,
+        "/// The runtime this module implements (`camchain-runtime`).\n\
+         use {} as rt;",
+        options.runtime_path
+    );
+    file.push_str(&model_type(model, source));
+    if let Some(text) = &options.embedded_source {
         let _ = writeln!(
             file,
-            "//!\n//! Large model: `mass_matrix`, `inertial_forces`, `applied_forces`, `equations`, \
-             `constraint`, `constraint_jacobian`, `constraint_bias` and `constraint_terms` call \
-             `position_terms` and `velocity_terms` (every expression is compiled once); their \
-             counts above are those of the outputs they return."
+            "/// The model file this module was generated from (`{source}`), as it was read.\n\
+             pub const MODEL_SOURCE: &str = {};",
+            raw_string(text)
         );
     }
-    // Literals come verbatim from the model file (e.g. −π/2 written out in full).
-    file.push_str("#![allow(clippy::approx_constant, clippy::excessive_precision)]\n");
-    file.push_str(&model_type(model));
     file.push_str(&info_static(model));
     let _ = write!(
         file,
-        "impl ::camchain_runtime::Dynamics for Model {{\n\
-         fn info(&self) -> &::camchain_runtime::ModelInfo {{ &INFO }}\n\
+        "{ALLOW_LITERALS}\nimpl rt::Dynamics for Model {{\n\
+         fn info(&self) -> &rt::ModelInfo {{ &INFO }}\n\
          {functions}\n{}\n}}\n",
         contact_kinematics_dispatch(model)
     );
-    file.push_str(&contact_kinematics_helpers(model, &d, &mut op_counts));
+    file.push_str(&helpers);
     file.push_str(&op_count_table(&op_counts));
     let syntax =
         syn::parse_file(&file).map_err(|e| format!("generated code does not parse: {e}"))?;
@@ -120,10 +187,28 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
     Ok(Generated {
         name: model.name.clone(),
         source: source.to_string(),
-        code: restore_comments(&formatted),
+        code: format!(
+            "{}\n{}",
+            header(model, source, &op_counts, wrap),
+            restore_comments(&formatted)
+        ),
         op_counts,
     })
 }
+
+/// `text` as a raw string literal (`r#"…"#` with enough `#`s), so that embedded model text
+/// reads as written.
+fn raw_string(text: &str) -> String {
+    let mut hashes = String::from("#");
+    while text.contains(&format!("\"{hashes}")) {
+        hashes.push('#');
+    }
+    format!("r{hashes}\"{text}\"{hashes}")
+}
+
+/// Literals come verbatim from the model file (e.g. −π/2 written out in full): the lints
+/// about them do not apply to generated code.
+const ALLOW_LITERALS: &str = "#[allow(clippy::approx_constant, clippy::excessive_precision)]";
 
 impl Generated {
     /// One-line description for the module index.
@@ -132,31 +217,34 @@ impl Generated {
     }
 }
 
-fn header(out: &mut String, model: &Model, source: &str, counts: &[(String, OpCount)]) {
+/// The module's header: `//` comments (a file meant for `include!` cannot start with inner
+/// `//!` doc comments), written above the formatted code.
+fn header(model: &Model, source: &str, counts: &[(String, OpCount)], wrapped: bool) -> String {
+    let mut out = String::new();
     let _ = writeln!(
         out,
-        "//! Model `{}`, generated by camchain-codegen from `{source}`.",
+        "// Model `{}`, generated by camchain-build from `{source}`.",
         model.name
     );
-    let _ = writeln!(out, "//! Do not edit: change the model file and rebuild.");
+    let _ = writeln!(out, "// Do not edit: change the model file and rebuild.");
     if !model.description.is_empty() {
-        let _ = writeln!(out, "//!");
+        let _ = writeln!(out, "//");
         for line in model.description.lines() {
-            let _ = writeln!(out, "//! {line}");
+            let _ = writeln!(out, "// {line}");
         }
     }
-    let _ = writeln!(out, "//!");
-    let _ = writeln!(out, "//! Operation counts per generated function:");
-    let _ = writeln!(out, "//!");
+    let _ = writeln!(out, "//");
+    let _ = writeln!(out, "// Operation counts per generated function:");
+    let _ = writeln!(out, "//");
     let _ = writeln!(
         out,
-        "//! | function | add/sub | mul | div | sin/cos | sqrt | other | total |"
+        "// | function | add/sub | mul | div | sin/cos | sqrt | other | total |"
     );
-    let _ = writeln!(out, "//! |---|---|---|---|---|---|---|---|");
+    let _ = writeln!(out, "// |---|---|---|---|---|---|---|---|");
     for (name, c) in counts {
         let _ = writeln!(
             out,
-            "//! | `{name}` | {} | {} | {} | {} | {} | {} | {} |",
+            "// | `{name}` | {} | {} | {} | {} | {} | {} | {} |",
             c.add_sub,
             c.mul,
             c.div,
@@ -166,6 +254,17 @@ fn header(out: &mut String, model: &Model, source: &str, counts: &[(String, OpCo
             c.total()
         );
     }
+    if wrapped {
+        let _ = writeln!(
+            out,
+            "//\n// `mass_matrix`, `inertial_forces`, `applied_forces`, `equations`, \
+             `constraint`, `constraint_jacobian`, `constraint_bias` and `constraint_terms` call\n\
+             // `position_terms` and `velocity_terms` (every expression is compiled once); their \
+             counts above\n// are those of the outputs they return."
+        );
+    }
+    // Trailing spaces of empty description lines would fail `cargo fmt --check` of a copy.
+    out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
 }
 
 /// `pub const OP_COUNTS`: the header's table as data, for `camchain ops`.
@@ -187,28 +286,36 @@ fn op_count_table(counts: &[(String, OpCount)]) -> String {
     )
 }
 
-fn model_type(model: &Model) -> String {
+fn model_type(model: &Model, source: &str) -> String {
+    let mut doc = format!(
+        "/// The model `{}`, generated from `{source}`: implements [`rt::Dynamics`]; simulate it \
+         with\n/// [`Model::assemble`], [`Model::step`] and [`Model::simulate`].\n",
+        model.name
+    );
+    if !model.description.is_empty() {
+        doc.push_str("///\n");
+        for line in model.description.lines() {
+            let _ = writeln!(doc, "/// {}", line.trim_end());
+        }
+    }
     format!(
-        "/// The generated model `{name}`: implements [`::camchain_runtime::Dynamics`]; \
-         simulate it with [`Model::assemble`], [`Model::step`] and [`Model::simulate`].\n\
-         #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]\n\
+        "{doc}#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]\n\
          pub struct Model;\n\
          impl Model {{\n\
-         /// Assembles the initial state from the model file's guess (§6): held coordinates\n\
-         /// keep their values, the dependent one is solved so that the point is on the cam.\n\
-         pub fn assemble(&self) -> Result<::camchain_runtime::State, ::camchain_runtime::SimError> {{\n\
-         ::camchain_runtime::Simulate::assemble(self, 0.0)\n}}\n\
+         /// Assembles the initial state from the model file's guess: held coordinates keep\n\
+         /// their values, the dependent ones are solved so that every contact point is on its cam.\n\
+         pub fn assemble(&self) -> Result<rt::State, rt::SimError> {{\n\
+         rt::Simulate::assemble(self, 0.0)\n}}\n\
          /// Advances `state` by `dt` seconds with the model's default integrator settings.\n\
-         pub fn step(&self, state: &mut ::camchain_runtime::State, dt: f64) -> Result<::camchain_runtime::Stats, ::camchain_runtime::SimError> {{\n\
-         ::camchain_runtime::Simulate::step(self, state, dt)\n}}\n\
+         pub fn step(&self, state: &mut rt::State, dt: f64) -> Result<rt::Stats, rt::SimError> {{\n\
+         rt::Simulate::step(self, state, dt)\n}}\n\
          /// Simulates from `state` with `settings`, sampling every `settings.dt_out`.\n\
-         pub fn simulate(&self, state: ::camchain_runtime::State, settings: &::camchain_runtime::SimSettings) -> Result<::camchain_runtime::Trajectory, Box<::camchain_runtime::SimFailure>> {{\n\
-         ::camchain_runtime::Simulate::simulate(self, state, settings)\n}}\n\
+         pub fn simulate(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::Trajectory, Box<rt::SimFailure>> {{\n\
+         rt::Simulate::simulate(self, state, settings)\n}}\n\
          /// The default settings from the model file.\n\
-         pub fn default_settings(&self) -> ::camchain_runtime::SimSettings {{\n\
+         pub fn default_settings(&self) -> rt::SimSettings {{\n\
          INFO.defaults.clone()\n}}\n\
-         }}\n",
-        name = model.name
+         }}\n"
     )
 }
 
@@ -222,7 +329,7 @@ fn info_static(model: &Model) -> String {
                 JointKind::Prismatic => "Prismatic",
             };
             format!(
-                "::camchain_runtime::CoordinateInfo {{ name: {:?}.to_string(), kind: ::camchain_runtime::CoordinateKind::{kind}, driven: {} }}",
+                "rt::CoordinateInfo {{ name: {:?}.to_string(), kind: rt::CoordinateKind::{kind}, driven: {} }}",
                 b.joint.coordinate,
                 b.joint.prescribed.is_some()
             )
@@ -241,14 +348,15 @@ fn info_static(model: &Model) -> String {
     };
     format!(
         "/// Static description of the model.\n\
-         static INFO: ::std::sync::LazyLock<::camchain_runtime::ModelInfo> = ::std::sync::LazyLock::new(|| ::camchain_runtime::ModelInfo {{\n\
+         {ALLOW_LITERALS}\n\
+         static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|| rt::ModelInfo {{\n\
          name: {name:?}.to_string(),\n\
          description: {desc:?}.to_string(),\n\
-         coordinates: vec![{coords}],\n\
-         contacts: vec![{contacts}],\n\
+         coordinates: Vec::from([{coords}]),\n\
+         contacts: Vec::from([{contacts}]),\n\
          spatial: {spatial},\n\
-         initial: ::camchain_runtime::InitialGuess {{ q: vec!{q}, qd: vec!{qd}, hold: vec!{hold:?} }},\n\
-         defaults: ::camchain_runtime::SimSettings {{ t_end: {t_end}, dt_out: {dt_out}, integrator: ::camchain_runtime::IntegratorKind::{integrator}, dt: {dt}, rtol: {rtol}, atol: {atol} }},\n\
+         initial: rt::InitialGuess {{ q: Vec::from({q}), qd: Vec::from({qd}), hold: Vec::from({hold:?}) }},\n\
+         defaults: rt::SimSettings {{ t_end: {t_end}, dt_out: {dt_out}, integrator: rt::IntegratorKind::{integrator}, dt: {dt}, rtol: {rtol}, atol: {atol} }},\n\
          }});\n",
         name = model.name,
         desc = model.description,
@@ -659,7 +767,7 @@ impl FusedTerms {
                 cache_param("&[f64]"),
                 Param {
                     name: "out",
-                    ty: "::camchain_runtime::VelocityTerms<'_>",
+                    ty: "rt::VelocityTerms<'_>",
                     always_used: true,
                 },
             ],
@@ -685,7 +793,7 @@ impl FusedTerms {
 /// three times). Below it, each function keeps only the operations it needs. (The paper
 /// models need about 200, `spatial_arm` 1800; `tests/random_models/chain16.ron`, about
 /// 8000, is above and checks the calls against the numeric recursion.)
-const LARGE_MODEL_OPS: usize = 4000;
+pub const LARGE_MODEL_OPS: usize = 4000;
 
 /// Operation count of a function's outputs (what it computes when emitted on its own).
 fn function_count(d: &Derivation, spec: &FunctionSpec) -> OpCount {
@@ -719,7 +827,7 @@ fn wrapper(model: &Model, fused: &FusedTerms, name: &str) -> Option<String> {
     };
     let velocity = |t: &str, qd: &str, m: &str, f: &str, a: &str, c: &str| {
         format!(
-            "{m}{f}{a}{c}self.velocity_terms({t}, q, {qd}, &cache,              ::camchain_runtime::VelocityTerms {{ mass: m, inertial: f, applied, bias: c }});
+            "{m}{f}{a}{c}self.velocity_terms({t}, q, {qd}, &cache,              rt::VelocityTerms {{ mass: m, inertial: f, applied, bias: c }});
 "
         )
     };
@@ -832,7 +940,7 @@ fn geometry_spec(d: &Derivation, _nc: usize) -> FunctionSpec {
         name: "contact_geometry".into(),
         params: vec![
             param("q", "&[f64]"),
-            param("out", "&mut [::camchain_runtime::ContactGeometry]"),
+            param("out", "&mut [rt::ContactGeometry]"),
         ],
         ret: None,
         outputs,
@@ -869,35 +977,35 @@ fn energy_spec(d: &Derivation) -> FunctionSpec {
         doc: "Kinetic energy from the body velocities; gravity and spring potentials.".into(),
         name: "energy".into(),
         params: vec![param("q", "&[f64]"), param("qd", "&[f64]")],
-        ret: Some("::camchain_runtime::Energy"),
+        ret: Some("rt::Energy"),
         outputs: vec![
             ("let kinetic".into(), e.kinetic),
             ("let gravity".into(), e.gravity),
             ("let spring".into(), e.spring),
         ],
-        tail: "::camchain_runtime::Energy { kinetic, gravity, spring }".into(),
+        tail: "rt::Energy { kinetic, gravity, spring }".into(),
     }
 }
 
 fn contact_kinematics_dispatch(model: &Model) -> String {
     if model.contacts.is_empty() {
-        return "/// No contact: the default (empty) kinematics.\n\
-                fn contact_kinematics(&self, _q: &[f64], _qd: &[f64], _k: usize) -> ::camchain_runtime::ContactKinematics {\n\
-                ::camchain_runtime::ContactKinematics::default()\n}\n"
+        return "/// No contact: nothing to write.\n\
+                fn contact_kinematics_into(&self, _q: &[f64], _qd: &[f64], _k: usize, _out: &mut rt::ContactKinematics) {}\n"
             .to_string();
     }
-    let arms: String = (0..model.contacts.len())
-        .map(|k| format!("{k} => contact_kinematics_{k}(q, qd),\n"))
-        .collect();
-    let (q, qd) = if model.contacts.is_empty() {
-        ("_q", "_qd")
+    let body = if model.contacts.len() == 1 {
+        "if k == 0 { contact_kinematics_0(q, qd, out); }".to_string()
     } else {
-        ("q", "qd")
+        let arms: String = (0..model.contacts.len())
+            .map(|k| format!("{k} => contact_kinematics_{k}(q, qd, out),\n"))
+            .collect();
+        format!("match k {{\n{arms}_ => {{}}\n}}")
     };
     format!(
-        "/// f1, f2, J1, J2 and the convective terms of contact `k` (default for an unknown k).\n\
-         fn contact_kinematics(&self, {q}: &[f64], {qd}: &[f64], k: usize) -> ::camchain_runtime::ContactKinematics {{\n\
-         match k {{\n{arms}_ => ::camchain_runtime::ContactKinematics::default(),\n}}\n}}\n"
+        "/// f1, f2, J1, J2 and the convective terms of contact `k` into `out` (unchanged for an \
+         unknown k).\n\
+         fn contact_kinematics_into(&self, q: &[f64], qd: &[f64], k: usize, out: &mut rt::ContactKinematics) {{\n\
+         {body}\n}}\n"
     )
 }
 
@@ -909,35 +1017,46 @@ fn contact_kinematics_helpers(
     let n = model.n();
     let mut out = String::new();
     for (k, c) in d.contacts.iter().enumerate() {
-        let mut outputs = vec![
-            ("let x".to_string(), c.f1),
-            ("let y".to_string(), c.f2),
-            ("let slope".to_string(), c.slope),
-            ("let curvature".to_string(), c.curvature),
-            ("let conv1".to_string(), c.conv1),
-            ("let conv2".to_string(), c.conv2),
-        ];
+        let mut outputs = Vec::new();
         for a in 0..3 {
-            outputs.push((format!("let p{a}"), c.position[a]));
+            outputs.push((format!("out.geometry.position[{a}]"), c.position[a]));
+        }
+        outputs.extend([
+            ("out.geometry.x".to_string(), c.f1),
+            ("out.geometry.y".to_string(), c.f2),
+            ("out.geometry.slope".to_string(), c.slope),
+            ("out.geometry.curvature".to_string(), c.curvature),
+        ]);
+        for i in 0..n {
+            outputs.push((format!("out.j1[{i}]"), c.j1[i]));
         }
         for i in 0..n {
-            outputs.push((format!("j1[{i}]"), c.j1[i]));
-            outputs.push((format!("j2[{i}]"), c.j2[i]));
+            outputs.push((format!("out.j2[{i}]"), c.j2[i]));
         }
+        outputs.push(("out.conv1".to_string(), c.conv1));
+        outputs.push(("out.conv2".to_string(), c.conv2));
         let spec = FunctionSpec {
-            doc: format!("Kinematics of contact `{}`.", c_name(model, k)),
+            doc: format!(
+                "Kinematics of contact `{}` into `out` (J1 and J2 of length {n}).",
+                c_name(model, k)
+            ),
             name: format!("contact_kinematics_{k}"),
-            params: vec![param("q", "&[f64]"), param("qd", "&[f64]")],
-            ret: Some("::camchain_runtime::ContactKinematics"),
+            params: vec![
+                param("q", "&[f64]"),
+                param("qd", "&[f64]"),
+                Param {
+                    name: "out",
+                    ty: "&mut rt::ContactKinematics",
+                    always_used: true,
+                },
+            ],
+            ret: None,
             outputs,
-            tail: "::camchain_runtime::ContactKinematics { geometry: ::camchain_runtime::ContactGeometry { position: [p0, p1, p2], x, y, slope, curvature }, j1: j1.to_vec(), j2: j2.to_vec(), conv1, conv2 }".to_string(),
+            tail: String::new(),
         };
-        let (text, count) = emit_function_with_prelude(
-            d,
-            &spec,
-            &format!("let mut j1 = [0.0f64; {n}];\nlet mut j2 = [0.0f64; {n}];\n"),
-            false,
-        );
+        let (text, count) = emit_function_with_prelude(d, &spec, "", false);
+        out.push_str(ALLOW_LITERALS);
+        out.push('\n');
         out.push_str(&text);
         counts.push((spec.name.clone(), count));
     }
@@ -1098,6 +1217,7 @@ fn is_reserved(name: &str) -> bool {
         "c",
         "h",
         "out",
+        "rt",
         "applied",
         "power",
         "cache",

@@ -1,4 +1,5 @@
-//! camchain-codegen: from a RON chain description to specialised Rust.
+//! camchain-codegen: from a RON chain description to specialised Rust (build time only: a
+//! build script reaches it through `camchain-build`).
 //!
 //! Module map:
 //! - [`schema`]: the RON file format, parsing and validation with file/line/field errors.
@@ -30,27 +31,47 @@ pub use derive::Derivation;
 pub use error::ModelError;
 pub use model::Model;
 
+pub use emit::{EmitOptions, EntryPoints, Generated};
+
 use std::path::Path;
 
-/// Reads, validates and checks a model file and generates its Rust module.
+/// Reads, validates and checks a model file and generates its Rust module with the default
+/// [`EmitOptions`].
 ///
 /// `display` is the path shown in messages and in the generated header (e.g.
 /// `models/paper_concave.ron`). Every failure is a [`ModelError`] naming the file, line,
 /// column and field.
-pub fn generate_file(path: &Path, display: &Path) -> Result<emit::Generated, ModelError> {
-    let source = std::fs::read_to_string(path).map_err(|e| ModelError {
+pub fn generate_file(path: &Path, display: &Path) -> Result<Generated, ModelError> {
+    let source = read_model_file(path, display)?;
+    generate_source(&source, display, &EmitOptions::default())
+}
+
+/// Reads a model file; a failure is a [`ModelError`] on `display` (line 0: not located).
+pub fn read_model_file(path: &Path, display: &Path) -> Result<String, ModelError> {
+    std::fs::read_to_string(path).map_err(|e| ModelError {
         file: display.to_path_buf(),
         line: 0,
         column: 0,
         field: String::new(),
         message: format!("cannot read the file: {e}"),
-    })?;
-    let model = schema::parse_model(&source, display)?;
+    })
+}
+
+/// Validates and checks the text of a model file and generates its Rust module: parsing and
+/// validation ([`schema::parse_model`]), the symbolic derivation ([`Derivation`]), the
+/// assembly check of the initial state ([`assembly::assemble`]) and the emission
+/// ([`emit::generate_with`]). `display` names the file in messages and in the header.
+pub fn generate_source(
+    source: &str,
+    display: &Path,
+    options: &EmitOptions,
+) -> Result<Generated, ModelError> {
+    let model = schema::parse_model(source, display)?;
     let derivation = Derivation::new(&model);
     assembly::assemble(&model, &derivation)
-        .map_err(|message| schema::field_error(display, &source, "initial", message))?;
+        .map_err(|message| schema::field_error(display, source, "initial", message))?;
     let shown = display.to_string_lossy().replace('\\', "/");
-    emit::generate(&model, &shown).map_err(|message| ModelError {
+    emit::generate_with(&model, &shown, options).map_err(|message| ModelError {
         file: display.to_path_buf(),
         line: 0,
         column: 0,

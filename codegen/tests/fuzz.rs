@@ -48,8 +48,8 @@ const MODELS: [&str; 9] = [
     include_str!("../../models/driven_convex.ron"),
     include_str!("../../models/double_pendulum.ron"),
     include_str!("../../models/spatial_arm.ron"),
-    include_str!("../../tests/fixtures/unreachable.ron"),
-    include_str!("../../tests/fixtures/repartition.ron"),
+    include_str!("../../cli/scenarios/unreachable.ron"),
+    include_str!("../../cli/scenarios/repartition.ron"),
 ];
 
 /// Pieces of RON and of the model format, including troublesome ones.

@@ -140,6 +140,18 @@ pub struct ContactKinematics {
     pub conv2: f64,
 }
 
+impl ContactKinematics {
+    /// Zero kinematics with J1 and J2 of length `n` (the number of coordinates), ready for
+    /// [`Dynamics::contact_kinematics_into`].
+    pub fn new(n: usize) -> Self {
+        ContactKinematics {
+            j1: vec![0.0; n],
+            j2: vec![0.0; n],
+            ..Default::default()
+        }
+    }
+}
+
 /// Mechanical energy split by origin.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Energy {
@@ -160,8 +172,9 @@ impl Energy {
 
 /// The functions a model provides to the runtime.
 ///
-/// Implemented by every generated model (`camchain::models::*::Model`) and by the numeric
-/// reference [`crate::reference::NumericModel`], so both run through the same integrators.
+/// Implemented by every generated model (the `Model` type of a module that `camchain-build`
+/// generated) and by the numeric reference (`camchain_reference::NumericModel`), so both run
+/// through the same integrators.
 /// Slices have the lengths given by [`ModelInfo`]: `n` coordinates, `nc` contacts.
 pub trait Dynamics {
     /// Static description.
@@ -190,8 +203,17 @@ pub trait Dynamics {
     /// Geometry of every contact point at q (length nc).
     fn contact_geometry(&self, q: &[f64], out: &mut [ContactGeometry]);
 
-    /// f1, f2, J1, J2 and the convective terms of contact `k` (diagnostics, tests).
-    fn contact_kinematics(&self, q: &[f64], qd: &[f64], k: usize) -> ContactKinematics;
+    /// f1, f2, J1, J2 and the convective terms of contact `k` (diagnostics, tests), written
+    /// into `out` without allocating: `out.j1` and `out.j2` must have length n (as made by
+    /// [`ContactKinematics::new`]). For `k` ≥ nc, `out` is left unchanged.
+    fn contact_kinematics_into(&self, q: &[f64], qd: &[f64], k: usize, out: &mut ContactKinematics);
+
+    /// [`Dynamics::contact_kinematics_into`] into a new value (allocates J1 and J2).
+    fn contact_kinematics(&self, q: &[f64], qd: &[f64], k: usize) -> ContactKinematics {
+        let mut out = ContactKinematics::new(self.info().n());
+        self.contact_kinematics_into(q, qd, k, &mut out);
+        out
+    }
 
     /// Prescribed motion at time t: for every driven coordinate i, writes `q[i]`, `qd[i]` and
     /// `qdd[i]`; other entries are left untouched.

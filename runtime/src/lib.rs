@@ -1,15 +1,17 @@
-//! Runtime of camchain: links a model's dynamics (generated at build time, or the numeric
-//! recursive reference loaded from RON at run time) with the cam constraint, generalised
-//! coordinate partitioning (Haug & Yen) and the integrators.
+//! Runtime of camchain: links a model's dynamics (generated at build time by
+//! `camchain-build`, or the numeric recursive reference of `camchain-reference`) with the cam
+//! constraints, generalised coordinate partitioning (Haug & Yen) and the integrators.
+//!
+//! This is the crate a program that simulates links; its only dependencies are nalgebra and
+//! thiserror. Most programs reach it through the `camchain` facade as `camchain::runtime`.
 //!
 //! Module map:
 //! - [`dynamics`]: the [`Dynamics`] trait every model implements (eqs. 3–8, 13).
 //! - [`partition`]: choice of the dependent coordinates and the reduced dynamics (15–18).
-//! - [`integrators`]: fixed-step RK4 and adaptive Dormand–Prince 5(4).
+//! - [`integrators`]: fixed-step RK4, adaptive Dormand–Prince 5(4) and 8(5,3) with dense
+//!   output.
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
 //! - [`unilateral`]: one-sided contact: lift-off, flight, impact with restitution.
-//! - [`reference`](mod@reference): the numeric recursive Newton–Euler reference (nalgebra).
-//! - [`jet`]: second-order forward-mode evaluation of profile expressions.
 //! - [`events`]: contact events (force sign changes, lift-off, impact) and their location.
 //! - [`error`]: simulation errors with time and state.
 
@@ -17,9 +19,7 @@ pub mod dynamics;
 pub mod error;
 pub mod events;
 pub mod integrators;
-pub mod jet;
 pub mod partition;
-pub mod reference;
 pub mod simulate;
 pub mod unilateral;
 

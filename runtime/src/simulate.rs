@@ -1634,16 +1634,22 @@ mod tests {
                 curvature,
             };
         }
-        fn contact_kinematics(&self, q: &[f64], _qd: &[f64], _k: usize) -> ContactKinematics {
+        fn contact_kinematics_into(
+            &self,
+            q: &[f64],
+            _qd: &[f64],
+            _k: usize,
+            out: &mut ContactKinematics,
+        ) {
             let mut geometry = [ContactGeometry::default()];
             self.contact_geometry(q, &mut geometry);
-            ContactKinematics {
+            *out = ContactKinematics {
                 geometry: geometry[0],
                 j1: vec![1.0, 0.0],
                 j2: vec![0.0, 1.0],
                 conv1: 0.0,
                 conv2: 0.0,
-            }
+            };
         }
         fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
             if self.lifted {
@@ -1835,17 +1841,23 @@ mod tests {
                 };
             }
         }
-        fn contact_kinematics(&self, q: &[f64], qd: &[f64], _k: usize) -> ContactKinematics {
+        fn contact_kinematics_into(
+            &self,
+            q: &[f64],
+            qd: &[f64],
+            _k: usize,
+            out: &mut ContactKinematics,
+        ) {
             let p = self.points(q, qd);
             let mut geometry = [ContactGeometry::default()];
             self.contact_geometry(q, &mut geometry);
-            ContactKinematics {
+            *out = ContactKinematics {
                 geometry: geometry[0],
                 j1: p.jacobian[2][0].to_vec(),
                 j2: p.jacobian[2][1].to_vec(),
                 conv1: p.convective[2][0],
                 conv2: p.convective[2][1],
-            }
+            };
         }
         fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
             if let Some((amplitude, omega)) = self.drive {

@@ -93,8 +93,14 @@ impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
     fn constraint_jacobian(&self, _q: &[f64], _j: &mut [f64]) {}
     fn constraint_bias(&self, _q: &[f64], _qd: &[f64], _c: &mut [f64]) {}
     fn contact_geometry(&self, _q: &[f64], _out: &mut [ContactGeometry]) {}
-    fn contact_kinematics(&self, q: &[f64], qd: &[f64], k: usize) -> ContactKinematics {
-        self.inner.contact_kinematics(q, qd, k)
+    fn contact_kinematics_into(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        k: usize,
+        out: &mut ContactKinematics,
+    ) {
+        self.inner.contact_kinematics_into(q, qd, k, out);
     }
     fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
         self.inner.prescribed(t, q, qd, qdd);

@@ -1,0 +1,383 @@
+//! Command-line syntax (clap derive): `camchain [simulate [MODEL]... [OPTIONS] | list | ops [MODEL]...]`.
+//!
+//! Values are checked here, so a bad one is a usage error (exit code 2) before anything
+//! runs: times must be positive and finite, tolerances positive, the integrator one of the
+//! runtime's.
+
+use camchain_runtime::{IntegratorKind, SimSettings};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+/// The models run when `simulate` is given none: the paper's two cams.
+pub const DEFAULT_MODELS: [&str; 2] = ["paper_concave", "paper_convex"];
+
+/// The output directory used when neither `--out` nor `--csv` is given.
+pub const DEFAULT_OUT: &str = "out";
+
+/// `camchain`: simulate multibody chains whose tip slides on a fixed cam.
+#[derive(Debug, Parser)]
+#[command(
+    name = "camchain",
+    version,
+    about = "Simulate multibody chains whose tip slides on a fixed cam (Lipiński's method).",
+    long_about = "Simulate multibody chains whose tip slides on a fixed cam (Lipiński's method).\n\n\
+                  Without a command, runs `simulate` (same options): by default the paper's \
+                  concave and convex cams, a summary on the terminal, CSV and figures in out/."
+)]
+#[command(args_conflicts_with_subcommands = true, allow_negative_numbers = true)]
+pub struct Cli {
+    /// What to do (default: `simulate`).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// The options of `simulate`, for `camchain [OPTIONS] [MODEL]...` without a command.
+    #[command(flatten)]
+    pub simulate: SimulateArgs,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate models; write CSV and figures; print a summary of each run.
+    #[command(
+        long_about = "Simulate models; write CSV and figures; print a summary of each run.\n\n\
+                      Files: without --csv, each run writes DIR/<run>/<run>.csv and its figures \
+                      (histories, snapshots, contact; .png and .svg) under --out DIR (default \
+                      out/), and when both cams of a pair ran (e.g. paper_concave and \
+                      paper_convex), DIR/paper_concave_vs_convex.png/.svg side by side. A run \
+                      on the numeric path is named <model>_numeric. With --csv FILE only that \
+                      file is written, unless --out is given too.\n\n\
+                      Exit codes: 0 success, 1 a model file or a run failed or a file could not \
+                      be written, 2 a usage error (bad option or value, unknown model name).",
+        after_help = "Examples:\n  \
+                      camchain simulate                         # both paper cams, files in out/\n  \
+                      camchain simulate paper_convex --coords q4,q3 --t-end 4\n  \
+                      camchain simulate my_cam.ron --out results  # a model file, no rebuild\n  \
+                      camchain simulate paper_concave --numeric --csv -  # CSV on stdout"
+    )]
+    Simulate(SimulateArgs),
+    /// List the built-in models with their coordinates, contacts and default settings.
+    List,
+    /// Print the operation count of every generated function (add/sub, mul, div, sin/cos,
+    /// sqrt, other, total): the table of the generated file's header.
+    #[command(after_help = "Examples:\n  \
+                      camchain ops                      # every built-in model\n  \
+                      camchain ops paper_concave\n  \
+                      camchain ops my_cam.ron           # derived now, without rebuilding")]
+    Ops {
+        /// Built-in model names or paths to .ron model files [default: every built-in model]
+        #[arg(value_name = "MODEL")]
+        models: Vec<String>,
+    },
+    /// Measure: run time against error of every integrator, and generated code against
+    /// the numeric recursion; writes the sections of BENCHMARKS.md.
+    Bench(BenchArgs),
+    /// Run the numerical stability stress suite; write STRESS.md and its figures.
+    #[command(
+        long_about = "Run the numerical stability stress suite and write STRESS.md and its \
+                      figures.\n\n\
+                      Scenarios (variants of the reference models, on the numeric reference): \
+                      1000 s runs without dampers, stiff springs, tiny and large masses, fast \
+                      motion, re-partitioning, steep/flat/inflected/wavy profiles, a cam out of \
+                      reach, NaN and infinity. Each runs with RK4 at several steps and each \
+                      adaptive integrator at several tolerances; a failing run is reported in \
+                      its table. Takes a few minutes in release (--quick: under a minute).",
+        after_help = "Examples:\n  \
+                      cargo run --release -- stress                 # STRESS.md, docs/stress/\n  \
+                      cargo run --release -- stress --quick --out /tmp/STRESS.md"
+    )]
+    Stress(StressArgs),
+}
+
+/// Options of `bench`.
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// Which benchmark [default: all]
+    #[arg(value_enum, default_value = "all")]
+    pub what: BenchWhat,
+    /// Fewer models, rungs and repeats (a smoke run, not for the report)
+    #[arg(long)]
+    pub quick: bool,
+    /// The report whose sections are rewritten
+    #[arg(long, value_name = "FILE", default_value = "BENCHMARKS.md")]
+    pub report: PathBuf,
+    /// Directory of the figures
+    #[arg(long, value_name = "DIR", default_value = "docs")]
+    pub figures: PathBuf,
+    /// The CSV of the scaling example (for `scaling-figure`)
+    #[arg(long, value_name = "FILE")]
+    pub scaling_csv: Option<PathBuf>,
+}
+
+/// The benchmarks of `bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BenchWhat {
+    /// Both.
+    All,
+    /// Run time against error over a ladder of steps and tolerances, every integrator.
+    WorkPrecision,
+    /// One evaluation of each term, generated against numeric, side by side.
+    Evaluations,
+    /// Draw the scaling figure from the scaling example's CSV (--scaling-csv).
+    ScalingFigure,
+}
+
+/// Options of `stress`.
+#[derive(Debug, Clone, Args)]
+pub struct StressArgs {
+    /// Shorter long runs (100 s instead of 1000 s) and fewer RK4 steps in them
+    #[arg(long)]
+    pub quick: bool,
+
+    /// The report to write
+    #[arg(long, value_name = "FILE", default_value = "STRESS.md")]
+    pub out: PathBuf,
+
+    /// Directory of the figures (PNG and SVG) [default: docs/stress beside the report]
+    #[arg(long, value_name = "DIR")]
+    pub figures: Option<PathBuf>,
+}
+
+/// Options of `simulate`.
+#[derive(Debug, Clone, Default, Args)]
+#[command(allow_negative_numbers = true)]
+pub struct SimulateArgs {
+    /// Built-in model names (see `camchain list`) or paths to .ron model files; a path runs
+    /// on the numeric recursive reference, without rebuilding [default: paper_concave
+    /// paper_convex]
+    #[arg(value_name = "MODEL")]
+    pub models: Vec<String>,
+
+    /// Run built-in models on the numeric recursive reference instead of their generated
+    /// code (to compare the two) [default: generated code]
+    #[arg(long)]
+    pub numeric: bool,
+
+    /// End time in seconds [default: the model's, see `camchain list`]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub t_end: Option<f64>,
+
+    /// Output interval in seconds: one CSV row and one plotted point per interval
+    /// [default: the model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub dt_out: Option<f64>,
+
+    /// Integrator: rk4 (fixed step --dt) or dopri5 (adaptive, --rtol/--atol, first step
+    /// --dt) [default: the model's]
+    #[arg(long, value_enum, value_name = "NAME")]
+    pub integrator: Option<IntegratorArg>,
+
+    /// Step in seconds: fixed step of rk4, first step of dopri5 [default: the model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
+
+    /// Relative tolerance of dopri5 [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = positive_number, allow_hyphen_values = true)]
+    pub rtol: Option<f64>,
+
+    /// Absolute tolerance of dopri5 [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = positive_number, allow_hyphen_values = true)]
+    pub atol: Option<f64>,
+
+    /// One-sided contact: the follower lifts off where the normal force reaches zero and
+    /// lands with this coefficient of restitution (0 plastic … 1 elastic); needs an adaptive
+    /// integrator and one contact [default: bilateral contact, as in the paper]
+    #[arg(long, value_name = "E", value_parser = restitution)]
+    pub restitution: Option<f64>,
+
+    /// Coordinates plotted in the time-history figure, comma-separated, e.g. q4,q3 (the
+    /// paper's figures 3 and 5) [default: all, from the tip to the base]
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub coords: Vec<String>,
+
+    /// Write the CSV of the (single) model to FILE, `-` for standard output; nothing else is
+    /// written unless --out is given too [default: DIR/<run>/<run>.csv]
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+
+    /// Directory for the CSV and figures, one subdirectory per run [default: out, or none
+    /// with --csv]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Write no figures (the CSV is still written) [default: figures are written]
+    #[arg(long)]
+    pub no_plots: bool,
+
+    /// Print nothing but errors: no summary, no progress bar, no notes
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+impl SimulateArgs {
+    /// The model's default settings overridden by the options that were given.
+    pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
+        SimSettings {
+            t_end: self.t_end.unwrap_or(defaults.t_end),
+            dt_out: self.dt_out.unwrap_or(defaults.dt_out),
+            integrator: self
+                .integrator
+                .map_or(defaults.integrator, IntegratorArg::kind),
+            dt: self.dt.unwrap_or(defaults.dt),
+            rtol: self.rtol.unwrap_or(defaults.rtol),
+            atol: self.atol.unwrap_or(defaults.atol),
+        }
+    }
+
+    /// True when the CSV goes to standard output (`--csv -`).
+    pub fn csv_to_stdout(&self) -> bool {
+        self.csv.as_deref().is_some_and(|p| p.as_os_str() == "-")
+    }
+
+    /// The output directory, if files other than `--csv` are to be written.
+    pub fn out_dir(&self) -> Option<PathBuf> {
+        match (&self.out, &self.csv) {
+            (Some(dir), _) => Some(dir.clone()),
+            (None, Some(_)) => None,
+            (None, None) => Some(PathBuf::from(DEFAULT_OUT)),
+        }
+    }
+}
+
+/// The integrators the command line offers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorArg {
+    /// Classical Runge–Kutta 4 with the fixed step --dt.
+    Rk4,
+    /// Adaptive Dormand–Prince 5(4) with error control by --rtol and --atol.
+    Dopri5,
+    /// Adaptive Dormand–Prince 8(5,3) with error control by --rtol and --atol; the
+    /// fastest for tight tolerances.
+    Dop853,
+}
+
+impl IntegratorArg {
+    /// The runtime's integrator.
+    pub fn kind(self) -> IntegratorKind {
+        match self {
+            IntegratorArg::Rk4 => IntegratorKind::Rk4,
+            IntegratorArg::Dopri5 => IntegratorKind::Dopri5,
+            IntegratorArg::Dop853 => IntegratorKind::Dop853,
+        }
+    }
+}
+
+/// Name of an integrator as the command line spells it.
+pub fn integrator_name(kind: IntegratorKind) -> &'static str {
+    match kind {
+        IntegratorKind::Rk4 => "rk4",
+        IntegratorKind::Dopri5 => "dopri5",
+        IntegratorKind::Dop853 => "dop853",
+    }
+}
+
+/// A coefficient of restitution: a number in [0, 1].
+fn restitution(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    if (0.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("{value} is not in [0, 1]"))
+    }
+}
+
+/// A positive, finite number; `what` names it in messages.
+fn positive(text: &str, what: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number ({what} is expected)"))?;
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{what} must be positive and finite, got {text}"))
+    }
+}
+
+/// A positive, finite tolerance.
+fn positive_number(text: &str) -> Result<f64, String> {
+    positive(text, "a tolerance")
+}
+
+/// A positive, finite time in seconds.
+fn positive_time(text: &str) -> Result<f64, String> {
+    positive(text, "a time in seconds")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn times_must_be_positive() {
+        assert_eq!(positive_time("2.5"), Ok(2.5));
+        for bad in ["-1", "0", "nan", "inf", "abc", ""] {
+            assert!(positive_time(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn options_override_the_model_defaults() {
+        let defaults = SimSettings {
+            t_end: 10.0,
+            dt_out: 0.01,
+            integrator: IntegratorKind::Dopri5,
+            dt: 1e-3,
+            rtol: 1e-10,
+            atol: 1e-12,
+        };
+        let cli = Cli::try_parse_from([
+            "camchain",
+            "simulate",
+            "--t-end",
+            "2",
+            "--integrator",
+            "rk4",
+        ])
+        .unwrap();
+        let Some(Command::Simulate(args)) = cli.command else {
+            panic!("simulate expected");
+        };
+        let settings = args.settings(&defaults);
+        assert_eq!(settings.t_end, 2.0);
+        assert_eq!(settings.integrator, IntegratorKind::Rk4);
+        assert_eq!(settings.dt_out, 0.01);
+        assert_eq!(args.out_dir(), Some(PathBuf::from("out")));
+    }
+
+    #[test]
+    fn stress_writes_stress_md_unless_told_otherwise() {
+        let cli = Cli::try_parse_from(["camchain", "stress"]).unwrap();
+        let Some(Command::Stress(args)) = cli.command else {
+            panic!("stress expected");
+        };
+        assert!(!args.quick && args.figures.is_none());
+        assert_eq!(args.out, PathBuf::from("STRESS.md"));
+        let cli =
+            Cli::try_parse_from(["camchain", "stress", "--quick", "--out", "r/S.md"]).unwrap();
+        let Some(Command::Stress(args)) = cli.command else {
+            panic!("stress expected");
+        };
+        assert!(args.quick);
+        assert_eq!(args.out, PathBuf::from("r/S.md"));
+        assert!(Cli::try_parse_from(["camchain", "stress", "paper_concave"]).is_err());
+    }
+
+    #[test]
+    fn csv_alone_writes_no_directory() {
+        let cli = Cli::try_parse_from(["camchain", "simulate", "--csv", "-"]).unwrap();
+        let Some(Command::Simulate(args)) = cli.command else {
+            panic!("simulate expected");
+        };
+        assert!(args.csv_to_stdout());
+        assert_eq!(args.out_dir(), None);
+    }
+}

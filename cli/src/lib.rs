@@ -1,0 +1,149 @@
+//! camchain-cli: the `camchain` command line (its binary is `src/main.rs`), with every
+//! dependency only it needs (clap, plotters, png, dejavu, indicatif).
+//!
+//! Modules (private but for [`scenarios`], which the stress tests use):
+//! - `args`: the syntax (clap) and the settings it overrides;
+//! - `source`: which model a MODEL argument names, generated or numeric;
+//! - `simulate`: the `simulate` command, run by run;
+//! - `progress`, `summary`, `csv`, `output`: what a run shows and writes;
+//! - `kinematics`, `figures`, `plots`: the figures after the paper's figures 3–6;
+//! - `list`: the `list` command;
+//! - `ops`: the `ops` command (operation counts of the generated functions);
+//! - `stress`: the `stress` command (numerical stability stress suite, `STRESS.md`), over the
+//!   scenarios of [`scenarios`];
+//! - `bench`: the `bench` command (the measurements of `BENCHMARKS.md`).
+//!
+//! Every problem is reported as one line on standard error, `error: …`, with exit code 2
+//! for a usage error (bad option or value, unknown model name) and 1 for anything else (a
+//! model file missing or invalid, a failed run, a file that could not be written).
+
+mod args;
+mod bench;
+mod csv;
+mod figures;
+mod kinematics;
+mod list;
+mod ops;
+mod output;
+mod plots;
+mod progress;
+pub mod scenarios;
+mod simulate;
+mod source;
+mod stress;
+mod summary;
+
+use args::{Cli, Command};
+use clap::Parser;
+use std::io::Write;
+use std::process::ExitCode;
+
+/// Why the command failed.
+#[derive(Debug)]
+pub enum CliError {
+    /// The command line is wrong (exit code 2).
+    Usage(String),
+    /// Something else went wrong (exit code 1).
+    Failed(String),
+    /// Failures already reported as they happened (exit code 1).
+    Reported,
+}
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CliError::Usage(message) | CliError::Failed(message) => f.write_str(message),
+            CliError::Reported => f.write_str("failed (reported above)"),
+        }
+    }
+}
+
+impl CliError {
+    fn exit_code(&self) -> ExitCode {
+        match self {
+            CliError::Usage(_) => ExitCode::from(2),
+            CliError::Failed(_) | CliError::Reported => ExitCode::from(1),
+        }
+    }
+}
+
+/// Parses the command line, runs the command and returns the process's exit code.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_error(&e),
+    };
+    let result = match cli.command {
+        None => simulate::run(&cli.simulate),
+        Some(Command::Simulate(args)) => simulate::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Ops { models }) => ops::render(&models).map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+        }),
+        Some(Command::Stress(args)) => stress::run(&args),
+        Some(Command::List) => {
+            // A closed pipe (`camchain list | head`) is not an error worth a panic.
+            let _ = std::io::stdout().write_all(list::render().as_bytes());
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            match &error {
+                CliError::Usage(message) | CliError::Failed(message) => {
+                    eprintln!("error: {message}");
+                }
+                CliError::Reported => {}
+            }
+            error.exit_code()
+        }
+    }
+}
+
+/// Help and version go to standard output with exit code 0; a usage error is shortened to
+/// one line (clap's first line and the possible values, if it lists them).
+fn clap_error(e: &clap::Error) -> ExitCode {
+    if !e.use_stderr() {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    eprintln!("{}", one_line(&e.render().to_string()));
+    ExitCode::from(2)
+}
+
+/// `error: invalid value 'euler' for '--integrator <NAME>' [possible values: rk4,
+/// dopri5]`, followed by where to find help.
+fn one_line(rendered: &str) -> String {
+    let mut lines = rendered.lines().map(str::trim).filter(|l| !l.is_empty());
+    let mut text = lines
+        .next()
+        .unwrap_or("error: invalid command line")
+        .to_string();
+    if let Some(values) = lines.find(|l| l.starts_with("[possible values")) {
+        text.push(' ');
+        text.push_str(values);
+    }
+    text.push_str(" (see `camchain --help`)");
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clap_errors_fit_on_one_line() {
+        let error =
+            Cli::try_parse_from(["camchain", "simulate", "--integrator", "euler"]).unwrap_err();
+        let text = one_line(&error.render().to_string());
+        assert!(!text.contains('\n'));
+        assert!(
+            text.contains("euler") && text.contains("rk4, dopri5"),
+            "{text}"
+        );
+        let error = Cli::try_parse_from(["camchain", "simulate", "--t-end", "-1"]).unwrap_err();
+        let text = one_line(&error.render().to_string());
+        assert!(text.contains("must be positive"), "{text}");
+    }
+}

@@ -1,0 +1,81 @@
+//! `camchain list`: the built-in models with their coordinates, contacts and defaults.
+
+use super::args::integrator_name;
+use super::source::builtin_file;
+use super::summary::unit;
+use camchain_models as models;
+use camchain_runtime::{ModelInfo, SimSettings};
+use std::fmt::Write;
+
+/// The listing of every built-in model.
+pub fn render() -> String {
+    let mut text = String::from(
+        "Built-in models (run one with `camchain simulate NAME`, or a .ron file by its path):\n",
+    );
+    for (name, model) in models::ALL {
+        text.push('\n');
+        text.push_str(&describe(name, model.info()));
+    }
+    text
+}
+
+fn describe(name: &str, info: &ModelInfo) -> String {
+    let mut text = String::new();
+    let _ = writeln!(text, "{name}");
+    if !info.description.is_empty() {
+        let _ = writeln!(text, "  {}", info.description);
+    }
+    let coordinates: Vec<String> = info
+        .coordinates
+        .iter()
+        .map(|c| {
+            let driven = if c.driven { ", driven" } else { "" };
+            format!("{} [{}{driven}]", c.name, unit(c.kind))
+        })
+        .collect();
+    let _ = writeln!(text, "  coordinates: {}", coordinates.join(", "));
+    let contacts = if info.contacts.is_empty() {
+        "none".to_string()
+    } else {
+        info.contacts.join(", ")
+    };
+    let kind = if info.spatial { "spatial" } else { "planar" };
+    let _ = writeln!(text, "  contacts:    {contacts} ({kind})");
+    let _ = writeln!(text, "  defaults:    {}", defaults(&info.defaults));
+    let _ = writeln!(
+        text,
+        "  file:        {} (compiled in; `--numeric` runs it on the reference)",
+        builtin_file(name).display()
+    );
+    text
+}
+
+fn defaults(s: &SimSettings) -> String {
+    format!(
+        "--t-end {} --dt-out {} --integrator {} --dt {} --rtol {:e} --atol {:e}",
+        s.t_end,
+        s.dt_out,
+        integrator_name(s.integrator),
+        s.dt,
+        s.rtol,
+        s.atol
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_model_is_listed_with_its_coordinates() {
+        let text = render();
+        for (name, model) in models::ALL {
+            assert!(text.contains(&format!("\n{name}\n")), "{name}");
+            for c in &model.info().coordinates {
+                assert!(text.contains(&c.name));
+            }
+        }
+        assert!(text.contains("q1 [rad, driven]"));
+        assert!(text.contains("--t-end 10 --dt-out 0.01 --integrator dop853"));
+    }
+}

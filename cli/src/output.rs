@@ -1,0 +1,184 @@
+//! Files: output directories, and CSV files that are never left incomplete under their
+//! final name.
+//!
+//! A CSV is written to a hidden temporary file beside its destination and renamed only
+//! once complete. The CSV of a run that failed is saved as `<name>.partial.csv`, and an
+//! older `<name>.csv` from an earlier run is removed so that it cannot pass for this run's.
+
+use super::csv;
+use camchain_runtime::{ModelInfo, Sample};
+use std::fs;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Where a run's CSV goes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CsvTarget {
+    /// Standard output (`--csv -`); written only when the run completed.
+    Stdout,
+    /// A file.
+    File(PathBuf),
+}
+
+/// What was saved of a CSV.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Saved {
+    /// The complete CSV, at this path (`None`: standard output).
+    Complete(Option<PathBuf>),
+    /// The partial CSV of a failed run, at this path.
+    Partial(PathBuf),
+    /// Nothing (a failed run whose CSV was to go to standard output, or had no samples).
+    Nothing,
+}
+
+/// Creates `dir` and its parents and checks that files can be created in it (before a
+/// run, rather than after it), with a one-line error.
+pub fn create_dir(dir: &Path) -> Result<(), String> {
+    fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
+    let probe = dir.join(".camchain-write-test");
+    fs::write(&probe, b"")
+        .and_then(|()| fs::remove_file(&probe))
+        .map_err(|e| format!("cannot write in output directory {}: {e}", dir.display()))
+}
+
+/// Checks before a run that a CSV file can be created at `path`: it is not a directory and
+/// its directory exists.
+pub fn check_csv_destination(path: &Path) -> Result<(), String> {
+    if path.is_dir() {
+        return Err(format!(
+            "cannot write {}: it is a directory (--csv takes a file name)",
+            path.display()
+        ));
+    }
+    let dir = parent_dir(path);
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(format!(
+            "cannot write {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        ))
+    }
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// `name.csv` → `name.partial.csv` (`name` → `name.partial`).
+pub fn partial_path(path: &Path) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    let name = match path.extension() {
+        Some(ext) => format!("{stem}.partial.{}", ext.to_string_lossy()),
+        None => format!("{stem}.partial"),
+    };
+    path.with_file_name(name)
+}
+
+/// Writes a file through a temporary sibling renamed into place once complete; on error
+/// the temporary file is removed and `path` is left as it was.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<()> {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let temporary = path.with_file_name(format!(".{name}.tmp"));
+    let result = fs::File::create(&temporary).and_then(|file| {
+        let mut out = BufWriter::new(file);
+        write(&mut out)?;
+        out.into_inner().map_err(|e| e.into_error())?.sync_all()
+    });
+    match result.and_then(|()| fs::rename(&temporary, path)) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let _ = fs::remove_file(&temporary);
+            Err(e)
+        }
+    }
+}
+
+/// Saves the CSV of a run: complete under its name, or partial under
+/// [`partial_path`] when the run failed.
+pub fn save_csv(
+    target: &CsvTarget,
+    info: &ModelInfo,
+    samples: &[Sample],
+    complete: bool,
+) -> Result<Saved, String> {
+    let write = |out: &mut dyn Write| csv::write(out, info, samples);
+    match (target, complete) {
+        (CsvTarget::Stdout, true) => {
+            let stdout = io::stdout();
+            let mut lock = stdout.lock();
+            match write(&mut lock) {
+                Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
+                    Err(format!("cannot write the CSV to standard output: {e}"))
+                }
+                _ => Ok(Saved::Complete(None)),
+            }
+        }
+        (CsvTarget::Stdout, false) => Ok(Saved::Nothing),
+        (CsvTarget::File(path), true) => {
+            write_atomically(path, write)
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            let _ = fs::remove_file(partial_path(path));
+            Ok(Saved::Complete(Some(path.clone())))
+        }
+        (CsvTarget::File(path), false) => {
+            if path.is_file() {
+                fs::remove_file(path)
+                    .map_err(|e| format!("cannot remove the older {}: {e}", path.display()))?;
+            }
+            if samples.is_empty() {
+                return Ok(Saved::Nothing);
+            }
+            let partial = partial_path(path);
+            write_atomically(&partial, write)
+                .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+            Ok(Saved::Partial(partial))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("camchain-output-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn partial_names() {
+        assert_eq!(
+            partial_path(Path::new("out/a.csv")),
+            PathBuf::from("out/a.partial.csv")
+        );
+        assert_eq!(partial_path(Path::new("a")), PathBuf::from("a.partial"));
+    }
+
+    #[test]
+    fn a_failed_write_leaves_nothing_under_the_final_name() {
+        let dir = scratch("atomic");
+        let path = dir.join("x.csv");
+        let result = write_atomically(&path, |out| {
+            out.write_all(b"t,q\n0,1\n")?;
+            Err(io::Error::other("interrupted"))
+        });
+        assert!(result.is_err());
+        assert!(!path.exists());
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 0, "no temporary left");
+        write_atomically(&path, |out| out.write_all(b"t\n0\n")).unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "t\n0\n");
+        let _ = fs::remove_dir_all(&dir);
+    }
+}

@@ -1,0 +1,189 @@
+//! Which model a MODEL argument names, and on which path it runs.
+//!
+//! A MODEL is a built-in model's name (`paper_concave`) or a path to a `.ron` file (it ends
+//! in `.ron` or contains a path separator). Built-in models run their generated code unless
+//! `--numeric` is given; files always run on the numeric recursive reference, which needs no
+//! rebuild. The validated model description is kept too, for drawing the mechanism.
+
+use super::CliError;
+use super::kinematics::Geometry;
+use camchain_codegen::model::Model;
+use camchain_codegen::schema::parse_model;
+use camchain_models as models;
+use camchain_reference::NumericModel;
+use camchain_runtime::Dynamics;
+use std::path::{Path, PathBuf};
+
+/// Where a run's dynamics come from.
+pub enum Engine {
+    /// Code generated at build time (`camchain_models::<name>`).
+    Generated(&'static (dyn Dynamics + Sync)),
+    /// The numeric recursive Newton–Euler reference on a model loaded at run time.
+    Numeric(Box<NumericModel>),
+}
+
+impl Engine {
+    /// The model as the runtime sees it.
+    pub fn dynamics(&self) -> &dyn Dynamics {
+        match self {
+            Engine::Generated(model) => *model,
+            Engine::Numeric(model) => model.as_ref(),
+        }
+    }
+
+    /// True on the numeric recursive path.
+    pub fn is_numeric(&self) -> bool {
+        matches!(self, Engine::Numeric(_))
+    }
+
+    /// How the summary names the path.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            Engine::Generated(_) => "generated code",
+            Engine::Numeric(_) => "numeric recursive reference (no rebuild)",
+        }
+    }
+}
+
+/// A model ready to run.
+pub struct LoadedModel {
+    /// The model's name (from the file, or the built-in name).
+    pub name: String,
+    /// The run's name in file names and the summary: the model's name, with `_numeric`
+    /// appended on the numeric path.
+    pub label: String,
+    /// The dynamics to integrate.
+    pub engine: Engine,
+    /// The geometry for drawing snapshots, or why it is not available.
+    pub geometry: Result<Geometry, String>,
+}
+
+/// How messages name a built-in model's file (`models/<name>.ron` of the repository; its
+/// text is compiled into the binary, so the binary needs no source tree).
+pub fn builtin_file(name: &str) -> PathBuf {
+    Path::new("models").join(format!("{name}.ron"))
+}
+
+/// The validated description of a built-in model, parsed from the text compiled into the
+/// binary (for drawing it and for `--numeric`).
+pub fn builtin_description(name: &str) -> Result<Model, CliError> {
+    let source =
+        models::source(name).ok_or_else(|| CliError::Usage(format!("unknown model `{name}`")))?;
+    parse_model(source, &builtin_file(name)).map_err(|e| {
+        let text = e.to_string().replace('\n', " ");
+        CliError::Failed(format!("invalid built-in model: {text}"))
+    })
+}
+
+/// True when the argument is to be read as a path rather than a built-in name.
+fn looks_like_path(arg: &str) -> bool {
+    arg.ends_with(".ron") || arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR)
+}
+
+/// Resolves one MODEL argument. An unknown name is a usage error; a file that cannot be
+/// read or does not validate is a failure.
+pub fn load(arg: &str, numeric: bool) -> Result<LoadedModel, CliError> {
+    if !looks_like_path(arg) {
+        let Some(model) = models::by_name(arg) else {
+            return Err(CliError::Usage(format!(
+                "unknown model `{arg}`: built-in models are {} (or give a path to a .ron file)",
+                builtin_names().join(", ")
+            )));
+        };
+        return if numeric {
+            Ok(numeric_model(builtin_description(arg)?))
+        } else {
+            Ok(generated(arg, model))
+        };
+    }
+    from_file(Path::new(arg))
+}
+
+/// Names of the built-in models.
+pub fn builtin_names() -> Vec<&'static str> {
+    models::ALL.iter().map(|(name, _)| *name).collect()
+}
+
+fn generated(name: &str, model: &'static (dyn Dynamics + Sync)) -> LoadedModel {
+    let geometry = builtin_description(name)
+        .map_err(|e| e.to_string())
+        .and_then(|m| Geometry::new(&m));
+    LoadedModel {
+        name: name.to_string(),
+        label: name.to_string(),
+        engine: Engine::Generated(model),
+        geometry,
+    }
+}
+
+fn from_file(file: &Path) -> Result<LoadedModel, CliError> {
+    Ok(numeric_model(read_model(file)?))
+}
+
+/// A validated model on the numeric path.
+fn numeric_model(model: Model) -> LoadedModel {
+    let geometry = Geometry::new(&model);
+    let name = model.name.clone();
+    LoadedModel {
+        label: format!("{name}_numeric"),
+        name,
+        engine: Engine::Numeric(Box::new(NumericModel::new(model))),
+        geometry,
+    }
+}
+
+/// Reads and validates a model file; errors are one line, located in the file when the
+/// problem is in its content.
+fn read_model(file: &Path) -> Result<Model, CliError> {
+    if file.is_dir() {
+        return Err(CliError::Failed(format!(
+            "cannot read model file {}: it is a directory, not a .ron file",
+            file.display()
+        )));
+    }
+    let source = std::fs::read_to_string(file)
+        .map_err(|e| CliError::Failed(format!("cannot read model file {}: {e}", file.display())))?;
+    parse_model(&source, file).map_err(|e| {
+        let text = e.to_string().replace('\n', " ");
+        CliError::Failed(format!("invalid model file: {text}"))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_paths_are_told_apart() {
+        assert!(looks_like_path("my_cam.ron"));
+        assert!(looks_like_path("dir/model"));
+        assert!(!looks_like_path("paper_concave"));
+    }
+
+    #[test]
+    fn a_builtin_runs_generated_code_unless_numeric() {
+        let generated = load("paper_concave", false).unwrap_or_else(|_| panic!("built in"));
+        assert!(!generated.engine.is_numeric());
+        assert_eq!(generated.label, "paper_concave");
+        assert!(generated.geometry.is_ok());
+        let numeric = load("paper_concave", true).unwrap_or_else(|_| panic!("file"));
+        assert!(numeric.engine.is_numeric());
+        assert_eq!(numeric.label, "paper_concave_numeric");
+        assert_eq!(
+            numeric.engine.dynamics().info(),
+            generated.engine.dynamics().info()
+        );
+    }
+
+    #[test]
+    fn unknown_names_are_usage_errors() {
+        assert!(matches!(
+            load("no_such_model", false),
+            Err(CliError::Usage(_))
+        ));
+        assert!(matches!(
+            load("no/such/file.ron", false),
+            Err(CliError::Failed(_))
+        ));
+    }
+}

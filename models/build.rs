@@ -1,0 +1,20 @@
+//! Compiles the built-in models (`*.ron` in this directory) through `camchain-build`, the same
+//! API a user's build script calls, and, with the `random-models` feature, the random models
+//! of the property tests (`tests/random_models/*.ron`, not user-facing).
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    camchain_build::Config::new()
+        // The command line draws the mechanism and runs `--numeric` from the model text.
+        .embed_model_source(true)
+        .include_file("models.rs")
+        .compile_models(&["."])?;
+    // Set by cargo when the `random-models` feature is on (this package's own tests).
+    if std::env::var_os("CARGO_FEATURE_RANDOM_MODELS").is_some() {
+        let out = std::path::PathBuf::from(std::env::var("OUT_DIR")?).join("random_models");
+        camchain_build::Config::new()
+            .out_dir(out)
+            .include_file("random_models.rs")
+            .compile_models(&["tests/random_models"])?;
+    }
+    Ok(())
+}

@@ -1,0 +1,179 @@
+//! Shared test helpers.
+
+#![allow(dead_code)]
+
+use camchain::runtime::Dynamics;
+use camchain_reference::NumericModel;
+use std::cell::Cell;
+
+/// A tiny deterministic generator (xorshift64) so random states are reproducible.
+pub struct Rng(u64);
+
+impl Rng {
+    /// Seeded generator (seed 0 is replaced by a fixed non-zero value).
+    pub fn new(seed: u64) -> Self {
+        Rng(if seed == 0 { 0x9e3779b97f4a7c15 } else { seed })
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
+    }
+
+    /// n uniform values in [lo, hi).
+    pub fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..n).map(|_| self.uniform(lo, hi)).collect()
+    }
+}
+
+/// Asserts |a_i − b_i| ≤ tol · max(1, |b_i|) for every entry.
+pub fn assert_close(a: &[f64], b: &[f64], tol: f64, what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths differ");
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let scale = y.abs().max(1.0);
+        assert!(
+            (x - y).abs() <= tol * scale,
+            "{what}[{i}]: {x:e} vs {y:e} (difference {:e}, tolerance {:e})",
+            (x - y).abs(),
+            tol * scale
+        );
+    }
+}
+
+/// The largest relative difference max |a_i − b_i| / max(1, |b_i|).
+pub fn max_rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs() / y.abs().max(1.0))
+        .fold(0.0, f64::max)
+}
+
+/// Asserts agreement within `tol` and records the largest relative difference seen.
+fn assert_close_recorded(a: &[f64], b: &[f64], tol: f64, what: &str, worst: &Cell<f64>) {
+    assert_close(a, b, tol, what);
+    worst.set(worst.get().max(max_rel_diff(a, b)));
+}
+
+/// Compares every function of the [`Dynamics`] trait of a generated model with the numeric
+/// reference at 100 random states (q in [−1.5, 1.5], q̇ in [−2, 2], t in [0, 10]), each value
+/// within `tol` relative to max(1, |reference|) (see [`assert_close`]); returns the largest
+/// relative difference.
+pub fn compare_dynamics(
+    name: &str,
+    generated: &dyn Dynamics,
+    numeric: &NumericModel,
+    tol: f64,
+) -> f64 {
+    let worst = Cell::new(0.0);
+    let n = generated.info().n();
+    let nc = generated.info().n_contacts();
+    assert_eq!(numeric.info().n(), n);
+    let mut rng = Rng::new(name.len() as u64 * 7919 + 17);
+    for _ in 0..100 {
+        let q = rng.vec(n, -1.5, 1.5);
+        let qd = rng.vec(n, -2.0, 2.0);
+        let t = rng.uniform(0.0, 10.0);
+        let both = |f: &dyn Fn(&dyn Dynamics) -> Vec<f64>| (f(generated), f(numeric));
+        let (a, b) = both(&|m| {
+            let mut out = vec![0.0; n * n];
+            m.mass_matrix(&q, &mut out);
+            out
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: M"), &worst);
+        let (a, b) = both(&|m| {
+            let mut out = vec![0.0; n];
+            m.inertial_forces(&q, &qd, &mut out);
+            out
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: F"), &worst);
+        let (a, b) = both(&|m| {
+            let mut out = vec![0.0; n];
+            m.applied_forces(t, &q, &qd, &mut out);
+            out
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: Q"), &worst);
+        let (a, b) = both(&|m| {
+            let (mut mm, mut f, mut qa) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
+            m.equations(t, &q, &qd, &mut mm, &mut f, &mut qa);
+            [mm, f, qa].concat()
+        });
+        assert_close_recorded(
+            &a,
+            &b,
+            tol,
+            &format!("{name}: equations (M, F, Q together)"),
+            &worst,
+        );
+        let (a, b) = both(&|m| {
+            let (mut h, mut j, mut c) = (vec![0.0; nc], vec![0.0; nc * n], vec![0.0; nc]);
+            m.constraint(&q, &mut h);
+            m.constraint_jacobian(&q, &mut j);
+            m.constraint_bias(&q, &qd, &mut c);
+            [h, j, c].concat()
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: h, J, c"), &worst);
+        let (a, b) = both(&|m| {
+            let (mut j, mut c) = (vec![0.0; nc * n], vec![0.0; nc]);
+            m.constraint_terms(&q, &qd, &mut j, &mut c);
+            [j, c].concat()
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: constraint_terms"), &worst);
+        // The fused pair a right-hand side calls: the velocity level reads the cache the
+        // position level filled (the numeric model's default ignores the cache).
+        let (a, b) = both(&|m| {
+            let (mut h, mut j) = (vec![0.0; nc], vec![0.0; nc * n]);
+            let mut cache = vec![f64::NAN; m.cache_len()];
+            m.position_terms(&q, &mut h, &mut j, &mut cache);
+            let (mut mm, mut f, mut qa, mut c) =
+                (vec![0.0; n * n], vec![0.0; n], vec![0.0; n], vec![0.0; nc]);
+            let out = camchain::runtime::VelocityTerms {
+                mass: &mut mm,
+                inertial: &mut f,
+                applied: &mut qa,
+                bias: &mut c,
+            };
+            m.velocity_terms(t, &q, &qd, &cache, out);
+            [h, j, mm, f, qa, c].concat()
+        });
+        assert_close_recorded(
+            &a,
+            &b,
+            tol,
+            &format!("{name}: position_terms then velocity_terms"),
+            &worst,
+        );
+        for k in 0..nc {
+            let (a, b) = both(&|m| {
+                let ck = m.contact_kinematics(&q, &qd, k);
+                let g = ck.geometry;
+                let mut v = vec![g.x, g.y, g.slope, g.curvature, ck.conv1, ck.conv2];
+                v.extend(g.position);
+                v.extend(ck.j1);
+                v.extend(ck.j2);
+                v
+            });
+            assert_close_recorded(
+                &a,
+                &b,
+                tol,
+                &format!("{name}: contact {k} kinematics"),
+                &worst,
+            );
+        }
+        let (a, b) = both(&|m| {
+            let e = m.energy(&q, &qd);
+            vec![e.kinetic, e.gravity, e.spring, m.damper_power(&qd)]
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: energies"), &worst);
+        let (a, b) = both(&|m| {
+            let (mut pq, mut pv, mut pa) = (q.clone(), qd.clone(), vec![0.0; n]);
+            m.prescribed(t, &mut pq, &mut pv, &mut pa);
+            [pq, pv, pa].concat()
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: prescribed motion"), &worst);
+    }
+    worst.get()
+}

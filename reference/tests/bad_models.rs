@@ -1,0 +1,650 @@
+//! The bad-model corpus: every file of `tests/bad_models/` is a valid model
+//! (`models/paper_concave.ron`, `driven_concave.ron` or `spatial_arm.ron`) with one defect,
+//! named in its first comment line. The loader the build uses
+//! (`camchain_codegen::generate_file`) must reject each with an error that names the file,
+//! the line and column of the defect, the dotted field path and the problem; the numeric
+//! reference (`NumericModel::load`, what `camchain simulate file.ron` runs) must reject it
+//! too, without panicking.
+//!
+//! The expected positions below were read off the files (the text each error must point
+//! at is given in the comment of its row), not taken from the loader's output.
+
+use camchain_reference::NumericModel;
+use camchain_runtime::Simulate;
+use std::collections::BTreeSet;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+/// Where the numeric reference notices the defect.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Reference {
+    /// `NumericModel::load` fails with the loader's error (same line, column and field).
+    Load,
+    /// The file is valid as a description and loads; assembling the initial state onto the
+    /// cam fails (the build checks this, the reference when a run starts).
+    Assemble,
+}
+
+/// What the error for one corpus file must say.
+struct Case {
+    /// File name in `tests/bad_models/`.
+    file: &'static str,
+    /// 1-based line and column of the defect.
+    line: usize,
+    column: usize,
+    /// Dotted field path.
+    field: &'static str,
+    /// A phrase the message must contain.
+    phrase: &'static str,
+    reference: Reference,
+}
+
+const fn case(
+    file: &'static str,
+    line: usize,
+    column: usize,
+    field: &'static str,
+    phrase: &'static str,
+) -> Case {
+    Case {
+        file,
+        line,
+        column,
+        field,
+        phrase,
+        reference: Reference::Load,
+    }
+}
+
+/// One row per corpus file, alphabetical. Comments say what the position points at.
+const CASES: &[Case] = &[
+    // `"ground"`, the first body's name.
+    case(
+        "body_named_ground.ron",
+        9,
+        19,
+        "bodies[0].name",
+        "reserved for the fixed base",
+    ),
+    // The y_axis tuple `(0.6, 0.6, 0.8)`.
+    case(
+        "cam_axes_not_orthogonal.ron",
+        86,
+        82,
+        "contacts[0].frame.y_axis",
+        "must be orthogonal",
+    ),
+    // `"B"` after `marker:`.
+    case(
+        "contact_on_unknown_marker.ron",
+        68,
+        18,
+        "contacts[0].marker",
+        "unknown marker `B`",
+    ),
+    // The second `"body3"` name (the fourth body's).
+    case(
+        "duplicate_body_name.ron",
+        50,
+        19,
+        "bodies[3].name",
+        "duplicate body name `body3`",
+    ),
+    // body4's `coordinate: "q3"`.
+    case(
+        "duplicate_coordinate.ron",
+        59,
+        29,
+        "bodies[3].joint.coordinate",
+        "duplicate coordinate `q3`",
+    ),
+    // `[]` after `bodies:`.
+    case("empty_body_list.ron", 7, 13, "bodies", "at least one body"),
+    // The second `"q2"` of the hold list.
+    case(
+        "hold_coordinate_twice.ron",
+        72,
+        28,
+        "initial.hold[2]",
+        "`q2` is listed twice",
+    ),
+    // `inf` after `ixz:` on upper_arm's inertia line.
+    case(
+        "inertia_inf_product.ron",
+        27,
+        93,
+        "bodies[1].inertia.ixz",
+        "must be finite, got inf",
+    ),
+    // `Full(` of upper_arm's inertia.
+    case(
+        "inertia_not_positive_definite.ron",
+        27,
+        22,
+        "bodies[1].inertia",
+        "must be positive definite",
+    ),
+    // `Full(` of the turret's inertia.
+    case(
+        "inertia_triangle_inequality.ron",
+        13,
+        22,
+        "bodies[0].inertia",
+        "violate the triangle inequality",
+    ),
+    // `-inf`, the forearm anchor's z.
+    case(
+        "inf_anchor.ron",
+        45,
+        36,
+        "bodies[2].joint.anchor[2]",
+        "must be finite, got -inf",
+    ),
+    // `-inf`, gravity's y.
+    case(
+        "inf_gravity.ron",
+        6,
+        20,
+        "gravity[1]",
+        "must be finite, got -inf",
+    ),
+    // The second `"q1"` key of `initial.q`.
+    case(
+        "initial_coordinate_twice.ron",
+        71,
+        62,
+        "initial.q[\"q1\"]",
+        "`q1` is given twice",
+    ),
+    // The key `"q5"`.
+    case(
+        "initial_unknown_coordinate.ron",
+        71,
+        62,
+        "initial.q[\"q5\"]",
+        "unknown coordinate `q5`",
+    ),
+    // `"paper concave"`.
+    case(
+        "invalid_model_name.ron",
+        4,
+        11,
+        "name",
+        "not a valid Rust identifier",
+    ),
+    // `"body5"` after `body:`.
+    case(
+        "marker_on_unknown_body.ron",
+        65,
+        27,
+        "markers[0].body",
+        "unknown body `body5`",
+    ),
+    // The `(` after `joint:` of body3, the joint that lacks its axis.
+    case(
+        "missing_axis.ron",
+        42,
+        20,
+        "bodies[2].joint.axis",
+        "missing field named `axis`",
+    ),
+    // The `(` opening body2, the body that lacks its mass.
+    case(
+        "missing_mass.ron",
+        21,
+        9,
+        "bodies[1].mass",
+        "missing field named `mass`",
+    ),
+    // `NaN` in the tool's axis.
+    case(
+        "nan_axis.ron",
+        72,
+        29,
+        "bodies[4].joint.axis[1]",
+        "must be finite, got NaN",
+    ),
+    // `NaN` in upper_arm's centre of mass.
+    case(
+        "nan_com.ron",
+        26,
+        24,
+        "bodies[1].com[1]",
+        "must be finite, got NaN",
+    ),
+    // `NaN` after `mass:`.
+    case(
+        "nan_mass.ron",
+        24,
+        19,
+        "bodies[1].mass",
+        "mass must be positive and finite, got NaN",
+    ),
+    // `-0.5` after `damping:`.
+    case(
+        "negative_damping.ron",
+        19,
+        35,
+        "bodies[0].joint.spring.damping",
+        "damping must be non-negative",
+    ),
+    // `Izz(-0.01)`.
+    case(
+        "negative_inertia.ron",
+        26,
+        22,
+        "bodies[1].inertia",
+        "must be positive definite",
+    ),
+    // `-2.0` after `mass:`.
+    case(
+        "negative_mass.ron",
+        25,
+        19,
+        "bodies[1].mass",
+        "mass must be positive and finite",
+    ),
+    // `-40.0` after `stiffness:`.
+    case(
+        "negative_stiffness.ron",
+        46,
+        37,
+        "bodies[2].joint.spring.stiffness",
+        "stiffness must be non-negative",
+    ),
+    // `-10.0` after `t_end:`.
+    case(
+        "negative_t_end.ron",
+        74,
+        25,
+        "simulation.t_end",
+        "t_end must be positive",
+    ),
+    // body1's `parent: "body4"`.
+    case(
+        "parent_cycle.ron",
+        10,
+        21,
+        "bodies[0].parent",
+        "cycle: body1 -> body4 -> body3 -> body2 -> body1",
+    ),
+    // `loop` inside the drive's string.
+    case(
+        "prescribed_loop.ron",
+        19,
+        38,
+        "bodies[0].joint.prescribed",
+        "control flow is not allowed",
+    ),
+    // The `x` of `2.0*PI*x`.
+    case(
+        "prescribed_wrong_variable.ron",
+        19,
+        51,
+        "bodies[0].joint.prescribed",
+        "the only variable allowed here is `t`",
+    ),
+    // The `|` opening the closure.
+    case(
+        "profile_closure.ron",
+        68,
+        55,
+        "contacts[0].profile",
+        "closures are not allowed",
+    ),
+    // The divisor `(1.0 - 1.0)`.
+    case(
+        "profile_division_by_zero.ron",
+        68,
+        62,
+        "contacts[0].profile",
+        "division by zero",
+    ),
+    // `panic!()`.
+    case(
+        "profile_macro.ron",
+        68,
+        54,
+        "contacts[0].profile",
+        "macros are not allowed",
+    ),
+    // `(-1.0).sqrt()`.
+    case(
+        "profile_nan_constant.ron",
+        68,
+        54,
+        "contacts[0].profile",
+        "evaluates to NaN",
+    ),
+    // The 33rd of the 40 nested `(`.
+    case(
+        "profile_nested_too_deeply.ron",
+        68,
+        90,
+        "contacts[0].profile",
+        "nested too deeply",
+    ),
+    // `std::process::exit`.
+    case(
+        "profile_process_exit.ron",
+        68,
+        54,
+        "contacts[0].profile",
+        "`std::process::exit` is not a known math function",
+    ),
+    // The `(` before `x.powi(3)`.
+    case(
+        "profile_unclosed_paren.ron",
+        68,
+        58,
+        "contacts[0].profile",
+        "unclosed `(`",
+    ),
+    // `foo`.
+    case(
+        "profile_unknown_function.ron",
+        68,
+        54,
+        "contacts[0].profile",
+        "`foo` is not a known math function",
+    ),
+    // The `x` of `0.5 x`.
+    case(
+        "profile_unparsable.ron",
+        68,
+        48,
+        "contacts[0].profile",
+        "not a valid expression",
+    ),
+    // `y`.
+    case(
+        "profile_wrong_variable.ron",
+        68,
+        48,
+        "contacts[0].profile",
+        "the only variable allowed here is `x`",
+    ),
+    // The `]` closing body2's anchor.
+    case(
+        "syntax_mismatched_bracket.ron",
+        30,
+        39,
+        "bodies[1].joint.anchor",
+        "Expected closing `)`, found `]`",
+    ),
+    // Just after `mass: 0.5`, where the comma is missing.
+    case(
+        "syntax_missing_comma.ron",
+        24,
+        22,
+        "bodies[1].mass",
+        "Expected comma",
+    ),
+    // `kg`.
+    case(
+        "syntax_stray_token.ron",
+        24,
+        23,
+        "bodies[1].mass",
+        "found `kg`",
+    ),
+    // The second closing `)`.
+    case(
+        "syntax_trailing_text.ron",
+        76,
+        1,
+        "<top level>",
+        "trailing characters",
+    ),
+    // Just after `com: (0.05, 0.0, 0.0,`, where the `)` is missing.
+    case(
+        "syntax_unclosed_paren.ron",
+        25,
+        34,
+        "bodies[1].com",
+        "the group opened at 25:18 is not closed",
+    ),
+    // The opening quote of `"q4]`.
+    case(
+        "syntax_unterminated_string.ron",
+        72,
+        28,
+        "initial.hold[2]",
+        "no closing",
+    ),
+    // `"A"` of the second contact.
+    case(
+        "two_contacts_one_marker.ron",
+        69,
+        18,
+        "contacts[1].marker",
+        "already has a contact",
+    ),
+    // `[` of `["q2"]`.
+    case(
+        "type_list_for_string.ron",
+        31,
+        29,
+        "bodies[1].joint.coordinate",
+        "Expected string",
+    ),
+    // `0.05` after `com:`.
+    case(
+        "type_number_for_list.ron",
+        25,
+        18,
+        "bodies[1].com",
+        "Expected opening `(`",
+    ),
+    // The `)` where gravity's third component is missing.
+    case(
+        "type_short_vector.ron",
+        6,
+        25,
+        "gravity",
+        "array of length 3 but found 2",
+    ),
+    // `"0.5"` after `mass:`.
+    case(
+        "type_string_for_number.ron",
+        24,
+        19,
+        "bodies[1].mass",
+        "Expected float",
+    ),
+    // `colour`.
+    case(
+        "unknown_field.ron",
+        25,
+        13,
+        "bodies[1].colour",
+        "Unexpected field named `colour`",
+    ),
+    // `Ixx(0.01)`.
+    case(
+        "unknown_inertia_form.ron",
+        26,
+        22,
+        "bodies[1].inertia",
+        "variant named `Ixx`",
+    ),
+    // `Euler`.
+    case(
+        "unknown_integrator.ron",
+        74,
+        57,
+        "simulation.integrator",
+        "variant named `Euler`",
+    ),
+    // `Slider`.
+    case(
+        "unknown_joint_kind.ron",
+        42,
+        23,
+        "bodies[2].joint.kind",
+        "variant named `Slider`",
+    ),
+    // `"body7"`.
+    case(
+        "unknown_parent.ron",
+        37,
+        21,
+        "bodies[2].parent",
+        "unknown parent `body7`",
+    ),
+    // `gravty`.
+    case(
+        "unknown_top_level_field.ron",
+        6,
+        5,
+        "gravty",
+        "Unexpected field named `gravty`",
+    ),
+    // The `(` after `initial:`.
+    Case {
+        file: "unreachable_initial_state.ron",
+        line: 70,
+        column: 14,
+        field: "initial",
+        phrase: "neither held nor driven (q3) do not move the contact point",
+        reference: Reference::Assemble,
+    },
+    // body3's axis `(0.0, 0.0, 0.0)`.
+    case(
+        "zero_axis.ron",
+        43,
+        23,
+        "bodies[2].joint.axis",
+        "must be a non-zero vector",
+    ),
+    // The cam's x_axis `(0.0, 0.0, 0.0)`.
+    case(
+        "zero_cam_axis.ron",
+        86,
+        57,
+        "contacts[0].frame.x_axis",
+        "must be a non-zero vector",
+    ),
+    // `0.0` after `dt_out:`.
+    case(
+        "zero_dt_out.ron",
+        75,
+        38,
+        "simulation.dt_out",
+        "dt_out must be positive",
+    ),
+    // `0.0` after `mass:`.
+    case(
+        "zero_mass.ron",
+        24,
+        19,
+        "bodies[1].mass",
+        "mass must be positive and finite, got 0",
+    ),
+];
+
+fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_models")
+}
+
+/// Everything wrong with one case, or nothing.
+fn check(case: &Case) -> Vec<String> {
+    let mut problems = Vec::new();
+    let path = corpus().join(case.file);
+    let display = PathBuf::from("tests/bad_models").join(case.file);
+    let generated = catch_unwind(|| camchain_codegen::generate_file(&path, &display));
+    match generated {
+        Err(_) => problems.push("generate_file panicked".to_string()),
+        Ok(Ok(_)) => problems.push("generate_file accepted the file".to_string()),
+        Ok(Err(e)) => {
+            let prefix = format!(
+                "tests/bad_models/{}:{}:{}: {}: ",
+                case.file, case.line, case.column, case.field
+            );
+            let shown = e.to_string().replace('\\', "/");
+            if !shown.starts_with(&prefix) {
+                problems.push(format!("error `{shown}` does not start with `{prefix}`"));
+            }
+            if !e.message.contains(case.phrase) {
+                problems.push(format!("message `{}` lacks `{}`", e.message, case.phrase));
+            }
+        }
+    }
+    let reference = catch_unwind(AssertUnwindSafe(|| {
+        NumericModel::load(&path).map(|model| model.assemble(0.0).map(|_| ()))
+    }));
+    match (case.reference, reference) {
+        (_, Err(_)) => problems.push("the numeric reference panicked".to_string()),
+        (Reference::Load, Ok(Err(e))) => {
+            // Same error as the build's loader, with the path as given.
+            let want = (case.line, case.column, case.field);
+            if (e.line, e.column, e.field.as_str()) != want || e.file != path {
+                problems.push(format!("NumericModel::load gave `{e}`, want {want:?}"));
+            }
+        }
+        (Reference::Load, Ok(Ok(_))) => {
+            problems.push("NumericModel::load accepted the file".to_string());
+        }
+        (Reference::Assemble, Ok(Ok(Err(_)))) => {}
+        (Reference::Assemble, Ok(Ok(Ok(())))) => {
+            problems.push("the reference assembled the initial state".to_string());
+        }
+        (Reference::Assemble, Ok(Err(e))) => {
+            problems.push(format!(
+                "NumericModel::load failed (`{e}`), assembly should"
+            ));
+        }
+    }
+    problems
+}
+
+#[test]
+fn every_bad_model_is_rejected_with_its_location_and_problem() {
+    let failures: Vec<String> = CASES
+        .iter()
+        .flat_map(|case| {
+            check(case)
+                .into_iter()
+                .map(move |p| format!("{}: {p}", case.file))
+        })
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "{} problems:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn the_table_covers_the_corpus_exactly() {
+    let on_disk: BTreeSet<String> = std::fs::read_dir(corpus())
+        .expect("tests/bad_models exists")
+        .map(|entry| entry.expect("a directory entry").file_name())
+        .map(|name| name.to_string_lossy().into_owned())
+        .collect();
+    let in_table: BTreeSet<String> = CASES.iter().map(|c| c.file.to_string()).collect();
+    assert_eq!(in_table.len(), CASES.len(), "a file is listed twice");
+    let untested: Vec<&String> = on_disk.difference(&in_table).collect();
+    let missing: Vec<&String> = in_table.difference(&on_disk).collect();
+    assert!(
+        untested.is_empty(),
+        "files without an expectation: {untested:?}"
+    );
+    assert!(
+        missing.is_empty(),
+        "expectations without a file: {missing:?}"
+    );
+    assert!(
+        on_disk.len() >= 30,
+        "the corpus has {} files",
+        on_disk.len()
+    );
+    for name in &on_disk {
+        let text = std::fs::read_to_string(corpus().join(name)).expect("readable");
+        assert!(
+            text.starts_with("// Bad model: "),
+            "{name} does not start with a `// Bad model: <defect>` comment"
+        );
+    }
+}

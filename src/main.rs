@@ -1,9 +1,0 @@
-//! `camchain`: the command line. `cargo run --release` simulates the paper's two cams,
-//! prints a summary of each run and writes CSV and figures to `out/`; see `camchain --help`
-//! and the README.
-
-mod cli;
-
-fn main() -> std::process::ExitCode {
-    cli::main()
-}
