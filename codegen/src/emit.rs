@@ -167,6 +167,7 @@ pub fn generate_with(
         let _ = writeln!(
             file,
             "/// The model file this module was generated from (`{source}`), as it was read.\n\
+             {ALLOW_UNUSED}\n\
              pub const MODEL_SOURCE: &str = {};",
             raw_string(text)
         );
@@ -205,6 +206,10 @@ fn raw_string(text: &str) -> String {
     }
     format!("r{hashes}\"{text}\"{hashes}")
 }
+
+/// A program uses what it needs of the generated API (in a binary crate, unused public
+/// items of a private module would warn).
+const ALLOW_UNUSED: &str = "#[allow(dead_code)]";
 
 /// Literals come verbatim from the model file (e.g. −π/2 written out in full): the lints
 /// about them do not apply to generated code.
@@ -281,6 +286,7 @@ fn op_count_table(counts: &[(String, OpCount)]) -> String {
     format!(
         "/// Operation count of every generated function: add/sub, mul, div, sin/cos, sqrt, \
          other (the table of the header).\n\
+         {ALLOW_UNUSED}\n\
          pub const OP_COUNTS: &[(&str, [usize; 6])] = &[{}];\n",
         rows.join(", ")
     )
@@ -300,7 +306,9 @@ fn model_type(model: &Model, source: &str) -> String {
     }
     format!(
         "{doc}#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]\n\
+         {ALLOW_UNUSED}\n\
          pub struct Model;\n\
+         {ALLOW_UNUSED}\n\
          impl Model {{\n\
          /// Assembles the initial state from the model file's guess: held coordinates keep\n\
          /// their values, the dependent ones are solved so that every contact point is on its cam.\n\
@@ -309,6 +317,10 @@ fn model_type(model: &Model, source: &str) -> String {
          /// Advances `state` by `dt` seconds with the model's default integrator settings.\n\
          pub fn step(&self, state: &mut rt::State, dt: f64) -> Result<rt::Stats, rt::SimError> {{\n\
          rt::Simulate::step(self, state, dt)\n}}\n\
+         /// Everything at the state's instant: accelerations, contact points and normal forces,\n\
+         /// constraint residuals, drive loads, energies.\n\
+         pub fn sample(&self, state: &rt::State) -> Result<rt::Sample, rt::SimError> {{\n\
+         rt::Simulate::sample(self, state)\n}}\n\
          /// Simulates from `state` with `settings`, sampling every `settings.dt_out`.\n\
          pub fn simulate(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::Trajectory, Box<rt::SimFailure>> {{\n\
          rt::Simulate::simulate(self, state, settings)\n}}\n\
