@@ -12,7 +12,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sample = model.sample(&state)?;
     let tip = &sample.contacts[0];
     println!("t = {:.3} s", sample.t);
-    println!("tip at x = {:.6} m, y = {:.6} m", tip.position[0], tip.position[1]);
+    println!(
+        "tip at x = {:.6} m, y = {:.6} m",
+        tip.position[0], tip.position[1]
+    );
     println!("normal force {:.6} N", sample.normal_force[0]);
     println!("constraint residual h = {:.2e} m", sample.h[0]);
     Ok(())
