@@ -1,9 +1,16 @@
-//! Files: output directories, and CSV files that are never left incomplete under their
-//! final name.
+//! Files: output directories, and files that are never left incomplete under their final
+//! name.
 //!
-//! A CSV is written to a hidden temporary file beside its destination and renamed only
-//! once complete. The CSV of a run that failed is saved as `<name>.partial.csv`, and an
-//! older `<name>.csv` from an earlier run is removed so that it cannot pass for this run's.
+//! Every file the command line writes (CSV, figures, reports) goes through [`write_file`]:
+//! a regular file, or one that does not exist yet, is written to a hidden temporary file
+//! beside it and renamed into place once complete; anything else (a FIFO, a character
+//! device such as `/dev/stdout` or a null device, a socket) is written directly and never
+//! replaced, so that its reader gets the data and the node stays what it was. A symbolic
+//! link to a regular file is followed: its target is replaced, the link kept. The CSV of a
+//! run that failed is saved as `<name>.partial.csv` beside a regular destination, and an
+//! older `<name>.csv` from an earlier run is removed so that it cannot pass for this run's;
+//! a special destination gets nothing on failure (it is opened and closed, so that a reader
+//! waiting on a FIFO sees the end of the data instead of blocking).
 
 use super::csv;
 use camchain_runtime::{ModelInfo, Sample};
@@ -80,9 +87,70 @@ pub fn partial_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// Writes a file through a temporary sibling renamed into place once complete; on error
-/// the temporary file is removed and `path` is left as it was.
-pub fn write_atomically(
+/// What kind of file a destination is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Destination {
+    /// A regular file, or a path where nothing exists yet: written through a temporary
+    /// sibling of this path (the link's target for a symbolic link) and a rename.
+    Replaceable(PathBuf),
+    /// A FIFO, a device, a socket, or a dangling symbolic link: written directly.
+    Special,
+}
+
+/// Classifies `path` (following symbolic links).
+///
+/// # Errors
+/// A directory, or metadata that cannot be read.
+pub fn destination(path: &Path) -> io::Result<Destination> {
+    match fs::metadata(path) {
+        Ok(meta) if meta.is_file() => {
+            let is_link = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+            let real = if is_link {
+                fs::canonicalize(path)?
+            } else {
+                path.to_path_buf()
+            };
+            Ok(Destination::Replaceable(real))
+        }
+        Ok(meta) if meta.is_dir() => Err(io::Error::other("it is a directory")),
+        Ok(_) => Ok(Destination::Special),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            // A dangling link is written through (creating its target), not replaced.
+            if fs::symlink_metadata(path).is_ok() {
+                Ok(Destination::Special)
+            } else {
+                Ok(Destination::Replaceable(path.to_path_buf()))
+            }
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// True when `path` exists and is not a regular file (after links) nor a directory.
+pub fn is_special(path: &Path) -> bool {
+    matches!(destination(path), Ok(Destination::Special)) && path.exists()
+}
+
+/// Writes `path` with `write`: a regular (or new) file through a temporary sibling renamed
+/// into place once complete — on error the temporary file is removed and `path` is left as
+/// it was —, any other kind of file directly, without replacing it (see the module doc).
+pub fn write_file(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<()> {
+    match destination(path)? {
+        Destination::Special => {
+            let file = fs::OpenOptions::new().write(true).open(path)?;
+            let mut out = BufWriter::new(file);
+            write(&mut out)?;
+            out.flush()
+        }
+        Destination::Replaceable(real) => write_through_rename(&real, write),
+    }
+}
+
+/// Writes `path` through a temporary sibling renamed into place once complete.
+fn write_through_rename(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {
@@ -100,6 +168,11 @@ pub fn write_atomically(
             Err(e)
         }
     }
+}
+
+/// [`write_file`] of bytes.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_file(path, |out| out.write_all(bytes))
 }
 
 /// Saves the CSV of a run: complete under its name, or partial under
@@ -124,10 +197,18 @@ pub fn save_csv(
         }
         (CsvTarget::Stdout, false) => Ok(Saved::Nothing),
         (CsvTarget::File(path), true) => {
-            write_atomically(path, write)
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-            let _ = fs::remove_file(partial_path(path));
+            write_file(path, write).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            if !is_special(path) {
+                let _ = fs::remove_file(partial_path(path));
+            }
             Ok(Saved::Complete(Some(path.clone())))
+        }
+        (CsvTarget::File(path), false) if is_special(path) => {
+            // Nothing of a failed run goes to a FIFO or device; opening and closing it ends
+            // the data for a reader that waits on it.
+            write_file(path, |_| Ok(()))
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+            Ok(Saved::Nothing)
         }
         (CsvTarget::File(path), false) => {
             if path.is_file() {
@@ -138,7 +219,7 @@ pub fn save_csv(
                 return Ok(Saved::Nothing);
             }
             let partial = partial_path(path);
-            write_atomically(&partial, write)
+            write_file(&partial, write)
                 .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
             Ok(Saved::Partial(partial))
         }
@@ -170,14 +251,14 @@ mod tests {
     fn a_failed_write_leaves_nothing_under_the_final_name() {
         let dir = scratch("atomic");
         let path = dir.join("x.csv");
-        let result = write_atomically(&path, |out| {
+        let result = write_file(&path, |out| {
             out.write_all(b"t,q\n0,1\n")?;
             Err(io::Error::other("interrupted"))
         });
         assert!(result.is_err());
         assert!(!path.exists());
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 0, "no temporary left");
-        write_atomically(&path, |out| out.write_all(b"t\n0\n")).unwrap();
+        write_file(&path, |out| out.write_all(b"t\n0\n")).unwrap();
         assert_eq!(fs::read_to_string(&path).unwrap(), "t\n0\n");
         let _ = fs::remove_dir_all(&dir);
     }

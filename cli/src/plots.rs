@@ -10,8 +10,6 @@ use camchain_codegen::profile::Scalar;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
-use std::fs;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -186,7 +184,7 @@ impl Figure {
             self.draw(&root, Target::Vector)?;
             root.present()?;
         }
-        fs::write(&svg_path, svg)
+        crate::output::write_bytes(&svg_path, svg.as_bytes())
             .map_err(|e| PlotError(format!("cannot write {}: {e}", svg_path.display())))?;
         let png_path = dir.join(format!("{stem}.png"));
         let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
@@ -234,13 +232,16 @@ impl Figure {
 }
 
 fn write_png(path: &Path, rgb: &[u8], (width, height): (u32, u32)) -> Result<(), String> {
-    let file = fs::File::create(path).map_err(|e| e.to_string())?;
-    let mut encoder = png::Encoder::new(BufWriter::new(file), width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut bytes, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(rgb).map_err(|e| e.to_string())?;
+        writer.finish().map_err(|e| e.to_string())?;
+    }
+    crate::output::write_bytes(path, &bytes).map_err(|e| e.to_string())
 }
 
 /// Tick labels with as many decimals as the tick spacing needs (about 6 ticks per axis),

@@ -111,7 +111,7 @@ pub fn run(args: &StressArgs) -> Result<(), CliError> {
         non_finite(&ctx)?,
     ];
     let report = render(&ctx, &sections);
-    std::fs::write(&args.out, report)
+    crate::output::write_bytes(&args.out, report.as_bytes())
         .map_err(|e| CliError::Failed(format!("cannot write {}: {e}", args.out.display())))?;
     say(&format!(
         "wrote {} and its figures in {} ({:.0} s)\n",

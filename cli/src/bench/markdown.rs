@@ -5,17 +5,20 @@ use crate::CliError;
 use std::path::Path;
 
 /// Replaces the section `name` of the report at `path` by `body` (appending it when the file
-/// or the section does not exist yet). Writes a temporary file and renames it.
+/// or the section does not exist yet), through `output::write_file` (a temporary file and a
+/// rename for a regular file). A FIFO or device is not read: it gets the section alone.
 pub fn replace_section(path: &Path, name: &str, body: &str) -> Result<(), CliError> {
-    let old = match std::fs::read_to_string(path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-        Err(e) => return Err(CliError::Failed(format!("{}: {e}", path.display()))),
+    let old = if crate::output::is_special(path) {
+        String::new()
+    } else {
+        match std::fs::read_to_string(path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+            Err(e) => return Err(CliError::Failed(format!("{}: {e}", path.display()))),
+        }
     };
     let new = with_section(&old, name, body);
-    let temporary = path.with_extension("md.tmp");
-    std::fs::write(&temporary, new)
-        .and_then(|()| std::fs::rename(&temporary, path))
+    crate::output::write_bytes(path, new.as_bytes())
         .map_err(|e| CliError::Failed(format!("{}: {e}", path.display())))
 }
 
