@@ -223,9 +223,13 @@ fn one_contact(
                 coriolis = vec3::add(g, coriolis, cor);
             }
         }
+        let coordinate = &model.bodies[j].joint.coordinate;
+        vec3::label(g, w, &format!("{}_omega_{coordinate}", contact.name));
+        vec3::label(g, a, &format!("{}_alpha_{coordinate}", contact.name));
         omega[j] = w;
         alpha[j] = a;
     }
+    vec3::label(g, coriolis, &format!("{}_coriolis", contact.name));
     // From the tip down: p_A − o_j for the Jacobian columns, and the convective acceleration
     // α × s + ω × (ω × s) of each segment s. Across a prismatic joint the two bodies turn
     // together, so their segments are summed in the common frame before being rotated
@@ -243,8 +247,14 @@ fn one_contact(
         let column = match model.bodies[j].joint.kind {
             JointKind::Revolute => {
                 let seg = k.rotation.apply(g, pending);
+                let (name, coordinate) = (&contact.name, &model.bodies[j].joint.coordinate);
+                vec3::label(g, seg, &format!("{name}_segment_{coordinate}"));
                 let a_s = vec3::cross(g, alpha[j], seg);
+                vec3::label(g, a_s, &format!("{name}_tangential_{coordinate}"));
                 let w_w_s = vec3::omega_omega(g, omega[j], seg);
+                vec3::label(g, w_w_s, &format!("{name}_centripetal_{coordinate}"));
+                let w_s = vec3::dot(g, omega[j], seg);
+                g.label(w_s, format!("{name}_omega_dot_segment_{coordinate}"));
                 accel = vec3::add(g, accel, a_s);
                 accel = vec3::add(g, accel, w_w_s);
                 done = vec3::add(g, seg, done);
@@ -259,6 +269,10 @@ fn one_contact(
         };
         j1[j] = vec3::dot(g, x_axis, column);
         j2[j] = vec3::dot(g, y_axis, column);
+        let (name, coordinate) = (&contact.name, &model.bodies[j].joint.coordinate);
+        vec3::label(g, done, &format!("{name}_arm_{coordinate}"));
+        g.label(j1[j], format!("{name}_j1_{coordinate}"));
+        g.label(j2[j], format!("{name}_j2_{coordinate}"));
     }
     // The root's segment is fixed in the ground.
     let position = vec3::add(g, pending, done);
@@ -293,6 +307,10 @@ fn one_contact(
     g.label(slope, format!("{name}_slope"));
     g.label(curvature, format!("{name}_curvature"));
     g.label(j1_qd, format!("{name}_x_rate"));
+    vec3::label(g, position, &format!("{name}_pos"));
+    vec3::label(g, accel, &format!("{name}_convective"));
+    g.label(conv1, format!("{name}_conv1"));
+    g.label(conv2, format!("{name}_conv2"));
     ContactTerms {
         position,
         f1,

@@ -97,6 +97,18 @@ fn body_inertia(g: &mut Graph, body: &Body) -> Inertia {
     }
 }
 
+/// Names a composite inertia's mass, first moment and tensor after `name`.
+fn label_inertia(g: &mut Graph, c: &Inertia, name: &str) {
+    g.label(c.mass, format!("mass_{name}"));
+    vec3::label(g, c.first, &format!("first_moment_{name}"));
+    let axes = ["x", "y", "z"];
+    for (a, row) in c.tensor.iter().enumerate() {
+        for (b, &entry) in row.iter().enumerate().skip(a) {
+            g.label(entry, format!("inertia_{name}_{}{}", axes[a], axes[b]));
+        }
+    }
+}
+
 /// A child's composite inertia seen from its parent's frame and joint point.
 fn to_parent(g: &mut Graph, child: &BodyKinematics, c: &Inertia) -> Inertia {
     let h = child.relative.apply(g, c.first);
@@ -220,6 +232,7 @@ fn mass_matrix(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Vec<
         for &k in &kids[i] {
             if let Some(child) = composite[k] {
                 let moved = to_parent(g, &kin[k], &child);
+                label_inertia(g, &moved, &format!("{}_in_parent", model.bodies[k].name));
                 c = add_inertia(g, &c, &moved);
             }
         }
@@ -229,11 +242,25 @@ fn mass_matrix(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Vec<
             JointKind::Revolute => (mat_vec(g, &c.tensor, u), vec3::cross(g, u, c.first)),
             JointKind::Prismatic => (vec3::cross(g, c.first, u), vec3::scale(g, c.mass, u)),
         };
+        label_inertia(g, &c, &model.bodies[i].name);
         mass[i][i] = project(g, model, kin, i, nn, ff);
+        let coordinate = |j: usize| &model.bodies[j].joint.coordinate;
+        g.label(mass[i][i], format!("m_{}_{}", coordinate(i), coordinate(i)));
         let mut k = i;
         while let Some(p) = model.bodies[k].parent {
             (nn, ff) = force_to_parent(g, &kin[k], nn, ff);
+            vec3::label(
+                g,
+                nn,
+                &format!("momentum_moment_{}_{}", coordinate(i), coordinate(p)),
+            );
+            vec3::label(
+                g,
+                ff,
+                &format!("momentum_{}_{}", coordinate(i), coordinate(p)),
+            );
             let e = project(g, model, kin, p, nn, ff);
+            g.label(e, format!("m_{}_{}", coordinate(p), coordinate(i)));
             mass[p][i] = e;
             mass[i][p] = e;
             k = p;
@@ -267,22 +294,36 @@ fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<
         let k = &kin[i];
         let b = body_inertia(g, &model.bodies[i]);
         // Own loads about the joint point (no centre-of-mass acceleration needed).
+        let name = &model.bodies[i].name;
         let a_h = vec3::cross(g, k.alpha, b.first);
+        vec3::label(g, a_h, &format!("tangential_force_{name}"));
         let w_w_h = vec3::omega_omega(g, k.omega, b.first);
+        vec3::label(g, w_w_h, &format!("centripetal_force_{name}"));
+        let w_dot_h = vec3::dot(g, k.omega, b.first);
+        g.label(w_dot_h, format!("omega_dot_first_moment_{name}"));
         let mut force_rest = vec3::add(g, a_h, w_w_h);
         let i_a = mat_vec(g, &b.tensor, k.alpha);
+        vec3::label(g, i_a, &format!("inertia_alpha_{name}"));
         let i_w = mat_vec(g, &b.tensor, k.omega);
+        vec3::label(g, i_w, &format!("angular_momentum_{name}"));
         let gyro = vec3::cross(g, k.omega, i_w);
+        vec3::label(g, gyro, &format!("gyroscopic_{name}"));
         let h_a = vec3::cross(g, b.first, k.accel);
+        vec3::label(g, h_a, &format!("moment_of_acc_{name}"));
         let m = vec3::add(g, i_a, gyro);
         let mut moment = vec3::add(g, m, h_a);
         for &c in &kids[i] {
             if let Some(child) = loads[c].take() {
                 let (nc, fc) = child_loads_to_parent(g, &kin[c], &child);
+                let child_name = &model.bodies[c].name;
+                vec3::label(g, nc, &format!("moment_{child_name}_in_parent"));
+                vec3::label(g, fc, &format!("force_{child_name}_in_parent"));
                 moment = vec3::add(g, moment, nc);
                 force_rest = vec3::add(g, force_rest, fc);
             }
         }
+        vec3::label(g, moment, &format!("moment_{name}"));
+        vec3::label(g, force_rest, &format!("force_{name}_rest"));
         out[i] = match model.bodies[i].joint.kind {
             JointKind::Revolute => vec3::dot(g, k.axis, moment),
             JointKind::Prismatic => {
@@ -291,6 +332,7 @@ fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<
                 vec3::dot(g, k.axis, force)
             }
         };
+        g.label(out[i], format!("f_{}", model.bodies[i].joint.coordinate));
         loads[i] = Some(Loads {
             moment,
             force_rest,
@@ -350,6 +392,9 @@ fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<I
         }
         let own = vec3::cross(g, arm, k.gravity);
         let moment = vec3::add(g, own, moment);
+        let name = &model.bodies[i].name;
+        vec3::label(g, arm, &format!("weight_arm_{name}"));
+        vec3::label(g, moment, &format!("weight_moment_{name}"));
         out[i] = match model.bodies[i].joint.kind {
             JointKind::Revolute => vec3::dot(g, k.axis, moment),
             JointKind::Prismatic => {
@@ -358,6 +403,10 @@ fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<I
                 g.mul(m, ug)
             }
         };
+        g.label(
+            out[i],
+            format!("weight_{}", model.bodies[i].joint.coordinate),
+        );
         moments[i] = Some(moment);
     }
     out
@@ -402,13 +451,17 @@ pub fn energy(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics])
     for (i, body) in model.bodies.iter().enumerate() {
         let m = g.constant(body.mass);
         let v = point_velocity(g, &kin[i], body.com);
+        vec3::label(g, v, &format!("vel_com_{}", body.name));
         let vv = vec3::dot(g, v, v);
         let i_w = vec3::mat_mul(g, &body.inertia, kin[i].omega);
         let w_i_w = vec3::dot(g, kin[i].omega, i_w);
         let m_vv = g.mul(m, vv);
         let both = g.add(m_vv, w_i_w);
-        kinetic.push(g.mul(half, both));
+        let own = g.mul(half, both);
+        g.label(own, format!("kinetic_{}", body.name));
+        kinetic.push(own);
         let p = point_position(g, &kin[i], body.com);
+        vec3::label(g, p, &format!("pos_com_{}", body.name));
         let gp = vec3::dot(g, gvec, p);
         let mgp = g.mul(m, gp);
         gravity.push(g.neg(mgp));

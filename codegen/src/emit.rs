@@ -617,8 +617,13 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
             continue;
         }
         vars.sort_unstable();
-        if let Some(expression) = trig_from_known(g, f, &vars, &known) {
-            replacements.push((id, expression));
+        let rebuilt = g.rebuild_as(id, |g| trig_from_known(g, f, &vars, &known).unwrap_or(id));
+        if rebuilt != id {
+            // Named like the call it replaces (`c_q2` for cos q2).
+            if let Some(name) = trig_name(g, f, arg) {
+                g.label(rebuilt, name);
+            }
+            replacements.push((id, rebuilt));
         }
     }
     let map: HashMap<Id, Id> = replacements.into_iter().collect();
@@ -627,6 +632,37 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
     for (output, root) in velocity.iter_mut().zip(roots) {
         output.1 = root;
     }
+}
+
+/// Robotran's name of a sine or cosine of a coordinate or a sum of coordinates: `s_q1`,
+/// `c_q1_q2`.
+fn trig_name(g: &Graph, f: Func, angle: Id) -> Option<String> {
+    let prefix = match f {
+        Func::Sin => "s",
+        Func::Cos => "c",
+        _ => return None,
+    };
+    Some(format!("{prefix}_{}", angle_name(g, angle)?))
+}
+
+/// `q1_q2` for the angle q1 + q2 (the coordinates summed, in the expression's order).
+fn angle_name(g: &Graph, angle: Id) -> Option<String> {
+    fn parts(g: &Graph, id: Id, out: &mut Vec<String>) -> Option<()> {
+        match g.node(id) {
+            Node::Var(k) => {
+                out.push(sanitize(g.var_names().get(k as usize)?));
+                Some(())
+            }
+            Node::Add(a, b) => {
+                parts(g, a, out)?;
+                parts(g, b, out)
+            }
+            _ => None,
+        }
+    }
+    let mut names = Vec::new();
+    parts(g, angle, &mut names)?;
+    Some(names.join("_"))
 }
 
 /// sin or cos of the angle `vars` from two known angles P, R with vars = P − R or P + R.
@@ -1105,7 +1141,7 @@ fn emit_function_given(
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
     let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
     let count = g.op_count_until(&roots, &given_set);
-    let mut body = Emitter::new(g, &roots, given);
+    let mut body = Emitter::new(g, &spec.outputs, given);
     let (bindings, used_vars) = body.bindings();
     let inputs = input_bindings(d, &used_vars);
     let used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
@@ -1334,31 +1370,51 @@ struct Emitter<'g> {
     given: HashMap<Id, String>,
     reachable: Vec<bool>,
     uses: Vec<u32>,
+    /// The nodes of this function that use each node (its parents here).
+    users: HashMap<Id, Vec<Id>>,
+    /// Output nodes named after what they are written to (`m_3` for `m[3] = …`), for the
+    /// names of their unlabelled terms.
+    outputs: HashMap<Id, String>,
     names: HashMap<Id, String>,
     vars: Names,
 }
 
 impl<'g> Emitter<'g> {
-    fn new(g: &'g Graph, roots: &[Id], given: &[(Id, String)]) -> Self {
+    fn new(g: &'g Graph, outputs: &[(String, Id)], given: &[(Id, String)]) -> Self {
+        let roots: Vec<Id> = outputs.iter().map(|(_, id)| *id).collect();
         let given: HashMap<Id, String> = given.iter().cloned().collect();
         let stop: HashSet<Id> = given.keys().copied().collect();
-        let reachable = g.reachable_until(roots, &stop);
+        let reachable = g.reachable_until(&roots, &stop);
         let mut uses = vec![0u32; g.len()];
+        let mut users: HashMap<Id, Vec<Id>> = HashMap::new();
         for (i, &r) in reachable.iter().enumerate() {
             if r && !stop.contains(&id_at(g, i)) {
-                for c in g.children(id_at(g, i)) {
+                let mut children = g.children(id_at(g, i));
+                for &c in &children {
                     uses[c.index()] += 1;
+                }
+                children.dedup();
+                for c in children {
+                    users.entry(c).or_default().push(id_at(g, i));
                 }
             }
         }
-        for r in roots {
+        for r in &roots {
             uses[r.index()] += 1;
+        }
+        let mut output_names = HashMap::new();
+        for (target, id) in outputs {
+            output_names
+                .entry(*id)
+                .or_insert_with(|| output_name(target));
         }
         Emitter {
             g,
             given,
             reachable,
             uses,
+            users,
+            outputs: output_names,
             names: HashMap::new(),
             vars: Names::of_vars(g),
         }
@@ -1470,50 +1526,73 @@ impl<'g> Emitter<'g> {
         order
     }
 
+    /// The name of a bound node: Robotran's `s_q1`/`c_q1_q2` for sines and cosines of
+    /// joint angles, `angle_q1_q2` for a sum of joint angles, the label the derivation gave
+    /// it (`omega_body2_z`, `acc_body3_x`, `m_q1_q2`, `a_slope`, …), `<name>_sq` for the
+    /// square of a named node, else `<label>_t<k>`: the k-th unnamed term of the nearest
+    /// named expression that uses it.
     fn fresh_name(&self, id: Id, taken: &mut HashSet<String>) -> String {
-        let base = match self.g.label_of(id) {
-            Some(l) => sanitize(l),
-            None => self
-                .call_name(id)
-                .unwrap_or_else(|| format!("x{}", id.index())),
-        };
-        let mut name = base.clone();
-        let mut k = 1;
-        while !taken.insert(name.clone()) {
-            k += 1;
-            name = format!("{base}_{k}");
+        if let Some(base) = self.structural_name(id) {
+            let mut name = base.clone();
+            let mut k = 1;
+            while !taken.insert(name.clone()) {
+                k += 1;
+                name = format!("{base}_{k}");
+            }
+            return name;
         }
-        name
+        let prefix = self.term_name(id);
+        let mut k = 1;
+        loop {
+            let name = format!("{prefix}{k}");
+            if taken.insert(name.clone()) {
+                return name;
+            }
+            k += 1;
+        }
     }
 
-    /// Robotran-style names for sines and cosines of coordinates and sums of coordinates.
-    fn call_name(&self, id: Id) -> Option<String> {
-        let Node::Call(f, a) = self.g.node(id) else {
-            return None;
-        };
-        let prefix = match f {
-            Func::Sin => "s",
-            Func::Cos => "c",
-            _ => return None,
-        };
-        let mut parts = Vec::new();
-        self.angle_parts(a, &mut parts)?;
-        Some(format!("{prefix}_{}", parts.join("_")))
-    }
-
-    fn angle_parts(&self, id: Id, parts: &mut Vec<String>) -> Option<()> {
+    fn structural_name(&self, id: Id) -> Option<String> {
+        if let Node::Call(f, a) = self.g.node(id) {
+            if let Some(name) = trig_name(self.g, f, a) {
+                return Some(name);
+            }
+        }
+        if let Some(label) = self.g.label_of(id) {
+            return Some(sanitize(label));
+        }
         match self.g.node(id) {
-            Node::Var(k) => {
-                let name = self.g.var_names().get(k as usize)?;
-                parts.push(sanitize(name));
-                Some(())
-            }
-            Node::Add(a, b) => {
-                self.angle_parts(a, parts)?;
-                self.angle_parts(b, parts)
-            }
+            Node::Add(..) => angle_name(self.g, id).map(|parts| format!("angle_{parts}")),
+            Node::Mul(a, b) if a == b => self.names.get(&a).map(|name| format!("{name}_sq")),
             _ => None,
         }
+    }
+
+    /// `<label>_t` of the nearest labelled node that uses `id` (breadth first through the
+    /// function's nodes, smallest id first), or `t` when none does.
+    fn term_name(&self, id: Id) -> String {
+        let mut frontier = vec![id];
+        let mut seen = HashSet::new();
+        while !frontier.is_empty() {
+            let mut next = Vec::new();
+            for node in frontier {
+                for &user in self.users.get(&node).map(Vec::as_slice).unwrap_or(&[]) {
+                    if !seen.insert(user) {
+                        continue;
+                    }
+                    if let Some(label) = self.g.label_of(user) {
+                        return format!("{}_t", sanitize(label));
+                    }
+                    if let Some(output) = self.outputs.get(&user) {
+                        return format!("{output}_t");
+                    }
+                    next.push(user);
+                }
+            }
+            next.sort_unstable();
+            frontier = next;
+        }
+        "t".to_string()
     }
 
     /// Expression text of a node, using names of bound children. Returns the text and its
@@ -1579,6 +1658,24 @@ impl<'g> Emitter<'g> {
         } else {
             text
         }
+    }
+}
+
+/// `m_3` for the target `m[3]`, `mass_3` for `out.mass[3]`, `kinetic` for `let kinetic`.
+fn output_name(target: &str) -> String {
+    let plain = target
+        .trim_start_matches("let ")
+        .trim_start_matches("out.")
+        .trim_start_matches("out[");
+    let name: String = plain
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    let name = name.trim_matches('_').replace("__", "_");
+    if name.is_empty() {
+        "value".to_string()
+    } else {
+        name
     }
 }
 

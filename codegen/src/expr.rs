@@ -245,12 +245,24 @@ impl Graph {
         new
     }
 
-    /// Gives a node a readable name for the emitted code (first label wins).
+    /// Gives a node a readable name for the emitted code (first label wins). A negation is
+    /// never bound to a name of its own (it is printed as a subtraction), so its operand is
+    /// named `neg_<name>` instead.
     pub fn label(&mut self, id: Id, name: impl Into<String>) {
-        if matches!(self.node(id), Node::Const(_) | Node::Var(_)) {
-            return;
+        match self.node(id) {
+            Node::Const(_) | Node::Var(_) => {}
+            Node::Neg(inner) => {
+                let name = name.into();
+                let negated = match name.strip_prefix("neg_") {
+                    Some(plain) => plain.to_string(),
+                    None => format!("neg_{name}"),
+                };
+                self.label(inner, negated);
+            }
+            _ => {
+                self.labels.entry(id).or_insert_with(|| name.into());
+            }
         }
-        self.labels.entry(id).or_insert_with(|| name.into());
     }
 
     /// The label given to a node, if any.
@@ -605,7 +617,7 @@ impl Graph {
             }
             let changed = self.children(id).iter().any(|&c| image[c.index()] != c);
             let rebuilt = if changed {
-                self.rebuild_with(id, |c| image[c.index()])
+                self.rebuild_as(id, |g| g.rebuild_with(id, |c| image[c.index()]))
             } else {
                 id
             };

@@ -336,17 +336,30 @@ fn child_kinematics(
             (Rotation::Identity, vec3::add(g, anchor, slide))
         }
     };
+    let name = &model.bodies[i].name;
     // Velocity of the joint point, parent frame: v_p + ω_p × r.
     let w_r = vec3::cross(g, p.omega, offset);
+    vec3::label(g, w_r, &format!("vel_rel_{name}"));
     let v_joint = vec3::add(g, p.velocity, w_r);
+    vec3::label(g, v_joint, &format!("vel_{name}_in_parent"));
     // Acceleration of the joint point, parent frame: a_p + α_p × r + ω_p × (ω_p × r).
     let alpha_r = vec3::cross(g, p.alpha, offset);
+    vec3::label(g, alpha_r, &format!("tangential_{name}"));
     let w_w_r = vec3::omega_omega(g, p.omega, offset);
+    vec3::label(g, w_w_r, &format!("centripetal_{name}"));
+    let w_dot_r = vec3::dot(g, p.omega, offset);
+    g.label(w_dot_r, format!("omega_dot_offset_{name}"));
     let a_joint = vec3::add(g, p.accel, alpha_r);
     let a_joint = vec3::add(g, a_joint, w_w_r);
     // Parent quantities seen in the body frame.
+    if relative != Rotation::Identity {
+        let rows = relative.matrix(g);
+        label_matrix(g, &rows, &format!("rel_rot_{name}"));
+    }
     let omega_p = relative.apply_transpose(g, p.omega);
+    vec3::label(g, omega_p, &format!("omega_parent_{name}"));
     let alpha_p = relative.apply_transpose(g, p.alpha);
+    vec3::label(g, alpha_p, &format!("alpha_parent_{name}"));
     let v_p = relative.apply_transpose(g, v_joint);
     let a_p = relative.apply_transpose(g, a_joint);
     let axis_rate = vec3::scale(g, qd, axis);
@@ -355,6 +368,7 @@ fn child_kinematics(
             // ω = ω_p + e q̇;  α = α_p + ω_p × e q̇ (+ e q̈).
             let omega = vec3::add(g, omega_p, axis_rate);
             let coriolis = vec3::cross(g, omega_p, axis_rate);
+            vec3::label(g, coriolis, &format!("coriolis_{name}"));
             let alpha = vec3::add(g, alpha_p, coriolis);
             (omega, v_p, alpha, a_p, a_joint)
         }
@@ -365,6 +379,7 @@ fn child_kinematics(
             let two = g.constant(2.0);
             let w_e = vec3::cross(g, omega_p, axis_rate);
             let coriolis = vec3::scale(g, two, w_e);
+            vec3::label(g, coriolis, &format!("coriolis_{name}"));
             let accel = vec3::add(g, a_p, coriolis);
             (omega_p, velocity, alpha_p, accel, accel)
         }
@@ -413,10 +428,33 @@ fn gravity_in_body(
     }
 }
 
+/// Names the body's quantities in the emitted code (Robotran style: quantity, body, axis).
+/// Labels are only names: a node another quantity already named keeps its first name.
 fn label_body(g: &mut Graph, k: &BodyKinematics, name: &str) {
     vec3::label(g, k.omega, &format!("omega_{name}"));
+    let omega_sq = vec3::dot(g, k.omega, k.omega);
+    g.label(omega_sq, format!("omega_{name}_sq"));
     vec3::label(g, k.velocity, &format!("vel_{name}"));
+    vec3::label(g, k.alpha, &format!("alpha_{name}"));
+    vec3::label(g, k.accel, &format!("acc_{name}"));
+    vec3::label(g, k.accel_in_parent, &format!("acc_{name}_in_parent"));
+    vec3::label(g, k.offset, &format!("offset_{name}"));
+    vec3::label(g, k.gravity, &format!("minus_g_{name}"));
     vec3::label(g, k.origin, &format!("pos_{name}"));
+    vec3::label(g, k.step, &format!("step_{name}"));
+    vec3::label(g, k.axis_ground, &format!("axis_{name}"));
+    if let Rotation::Matrix(rows) = &k.rotation {
+        label_matrix(g, rows, &format!("rot_{name}"));
+    }
+}
+
+/// Labels the entries of a rotation matrix `name_11` … `name_33`.
+fn label_matrix(g: &mut Graph, rows: &[V3; 3], name: &str) {
+    for (i, row) in rows.iter().enumerate() {
+        for (j, &entry) in row.iter().enumerate() {
+            g.label(entry, format!("{name}_{}{}", i + 1, j + 1));
+        }
+    }
 }
 
 /// A point fixed on a body: its position in ground coordinates.

@@ -56,14 +56,119 @@ fn sines_and_cosines_are_computed_once_per_angle() {
         .find(|(n, _)| n == "mass_matrix")
         .expect("present");
     assert!(c.sin_cos <= 6, "mass matrix uses {} sin/cos", c.sin_cos);
+    // `q2.cos()` on the variable itself, not as the tail of a name like `angle_q1_q2.cos()`.
+    let calls = |text: &str, call: &str| {
+        text.match_indices(call)
+            .filter(|(at, _)| {
+                let before = text[..*at].chars().next_back();
+                !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+            })
+            .count()
+    };
     for function in g.code.split("\n    fn ") {
+        assert!(calls(function, "q2.cos()") <= 1, "cos q2 once per function");
+        assert!(calls(function, "q2.sin()") <= 1, "sin q2 once per function");
+    }
+}
+
+/// Every model file of the repository, generated with the default options.
+fn every_model() -> Vec<(String, camchain_codegen::emit::Generated)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("models/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 7, "the built-in models");
+    files
+        .into_iter()
+        .map(|path| {
+            let generated =
+                camchain_codegen::generate_file(&path, &path).unwrap_or_else(|e| panic!("{e}"));
+            (path.display().to_string(), generated)
+        })
+        .collect()
+}
+
+/// The `let` names of a generated module.
+fn bindings(code: &str) -> Vec<&str> {
+    code.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("let "))
+        .filter_map(|l| l.split([' ', ':']).next())
+        .collect()
+}
+
+#[test]
+fn intermediates_are_named_after_what_they_hold() {
+    for (file, g) in every_model() {
+        let names = bindings(&g.code);
+        let by_id: Vec<&&str> = names
+            .iter()
+            .filter(|n| {
+                n.strip_prefix('x').is_some_and(|rest| {
+                    !rest.is_empty() && rest.chars().all(|c| c.is_ascii_digit())
+                })
+            })
+            .collect();
+        assert!(by_id.is_empty(), "{file}: named by node id: {by_id:?}");
+        // The rest are quantities (`acc_body3_y`, `m_q1_q2`, `s_q1_q2`, …) or the k-th
+        // unnamed term of one (`a_arm_q2_x_t1`); the latter stay a small minority.
+        let terms = names.iter().filter(|n| is_term_name(n)).count();
         assert!(
-            function.matches("q2.cos()").count() <= 1,
-            "cos q2 once per function"
+            terms * 5 <= names.len(),
+            "{file}: {terms} of {} bindings are terms of a named quantity",
+            names.len()
         );
-        assert!(
-            function.matches("q2.sin()").count() <= 1,
-            "sin q2 once per function"
-        );
+    }
+}
+
+/// `<quantity>_t<k>`.
+fn is_term_name(name: &str) -> bool {
+    name.rsplit_once("_t")
+        .is_some_and(|(_, k)| !k.is_empty() && k.chars().all(|c| c.is_ascii_digit()))
+}
+
+#[test]
+fn section_comments_name_the_terms_below_them() {
+    // The energy expressions are only needed by `energy`: no other function's bindings may
+    // sit under that heading (the trigonometric rewriting once left M and F under it).
+    for (file, g) in every_model() {
+        for function in g.code.split("\n    fn ").skip(1) {
+            let name = function.split('(').next().unwrap_or_default();
+            if name != "energy" {
+                assert!(
+                    !function.contains("// energy"),
+                    "{file}: {name} has an energy section"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn functions_called_per_step_do_not_allocate() {
+    // Everything the runtime calls lives in `impl rt::Dynamics for Model` and the contact
+    // helpers after it; only the static description (`INFO`, built once) allocates.
+    for (file, g) in every_model() {
+        let (_, functions) = g
+            .code
+            .split_once("impl rt::Dynamics for Model")
+            .expect("the Dynamics impl");
+        for token in [
+            "vec!",
+            "Vec::",
+            "to_vec",
+            "Box::",
+            "String",
+            "to_string",
+            "format!",
+            "collect",
+        ] {
+            assert!(
+                !functions.contains(token),
+                "{file}: `{token}` in the generated functions"
+            );
+        }
     }
 }

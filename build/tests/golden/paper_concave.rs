@@ -123,38 +123,44 @@ impl rt::Dynamics for Model {
         let c_q2 = q2.cos();
         let s_q2 = q2.sin();
         // body3: joint q3, rotation, velocities and accelerations
-        let x52 = q3 + 0.1;
+        let offset_body3_x = q3 + 0.1;
         // body4: joint q4, rotation, velocities and accelerations
         let c_q4 = q4.cos();
         let s_q4 = q4.sin();
         // body4: composite inertia and column q4 of M
-        let x201 = 0.15 * s_q4;
-        let x203 = 0.15 * c_q4;
-        let x508 = 0.1225 + c_q4 * (0.045 + 0.15 * x52);
-        let x509 = 0.3 * (c_q2 * x203 - s_q2 * x201) + x508;
+        let neg_momentum_q4_q3_x = 0.15 * s_q4;
+        let momentum_q4_q3_y = 0.15 * c_q4;
+        let momentum_q4_q1_y = c_q2 * momentum_q4_q3_y - s_q2 * neg_momentum_q4_q3_x;
+        let momentum_moment_q4_q2_z = 0.1225 + c_q4 * (0.045 + 0.15 * offset_body3_x);
+        let momentum_moment_q4_q1_z = 0.3 * momentum_q4_q1_y + momentum_moment_q4_q2_z;
         // body3: composite inertia and column q3 of M
-        let x256 = x203 + 0.44999999999999996;
-        let x261 = 0.6 * s_q2 - x201;
+        let first_moment_body3_x = momentum_q4_q3_y + 0.44999999999999996;
+        let momentum_moment_q3_q1_z = 0.6 * s_q2 - neg_momentum_q4_q3_x;
         // body2: composite inertia and column q2 of M
-        let x267 = x256 + 2.0 * x52;
-        let x291 = c_q2 * (0.025 + x267) - s_q2 * x201;
-        let x520 = x52 * (x256 + x267) + (0.09 * c_q4 + 0.34625);
-        let x521 = 0.3 * x291 + x520;
-        m[0] = x520 + (0.6 * x291 + 0.3475);
-        m[1] = x521;
-        m[2] = x261;
-        m[3] = x509;
-        m[4] = x521;
-        m[5] = x520;
-        m[6] = -x201;
-        m[7] = x508;
-        m[8] = x261;
-        m[9] = -x201;
+        let first_moment_body3_in_parent_x = first_moment_body3_x + 2.0 * offset_body3_x;
+        let first_moment_body2_x = 0.025 + first_moment_body3_in_parent_x;
+        let momentum_q2_q1_y = c_q2 * first_moment_body2_x - s_q2 * neg_momentum_q4_q3_x;
+        let inertia_body2_zz = offset_body3_x
+            * (first_moment_body3_x + first_moment_body3_in_parent_x)
+            + (0.09 * c_q4 + 0.34625);
+        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
+        // body1: composite inertia and column q1 of M
+        let inertia_body1_zz = inertia_body2_zz + (0.6 * momentum_q2_q1_y + 0.3475);
+        m[0] = inertia_body1_zz;
+        m[1] = momentum_moment_q2_q1_z;
+        m[2] = momentum_moment_q3_q1_z;
+        m[3] = momentum_moment_q4_q1_z;
+        m[4] = momentum_moment_q2_q1_z;
+        m[5] = inertia_body2_zz;
+        m[6] = -neg_momentum_q4_q3_x;
+        m[7] = momentum_moment_q4_q2_z;
+        m[8] = momentum_moment_q3_q1_z;
+        m[9] = -neg_momentum_q4_q3_x;
         m[10] = 2.0;
-        m[11] = -x201;
-        m[12] = x509;
-        m[13] = x508;
-        m[14] = -x201;
+        m[11] = -neg_momentum_q4_q3_x;
+        m[12] = momentum_moment_q4_q1_z;
+        m[13] = momentum_moment_q4_q2_z;
+        m[14] = -neg_momentum_q4_q3_x;
         m[15] = 0.1225;
     }
     /// F(q, q̇), eq. (13).
@@ -166,35 +172,56 @@ impl rt::Dynamics for Model {
         let q2_dot = qd[1];
         let q3_dot = qd[2];
         let q4_dot = qd[3];
+        // body1: joint q1, rotation, velocities and accelerations
+        let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
-        let x25 = 0.3 * (q1_dot * q1_dot);
+        let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
         let c_q2 = q2.cos();
         let s_q2 = q2.sin();
-        let x36 = x25 * s_q2;
+        let neg_acc_body2_x = neg_centripetal_body2_x * c_q2;
+        let acc_body2_y = neg_centripetal_body2_x * s_q2;
         let omega_body2_z = q1_dot + q2_dot;
+        let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body3: joint q3, rotation, velocities and accelerations
-        let x52 = q3 + 0.1;
-        let x55 = omega_body2_z * omega_body2_z;
-        let x58 = x25 * c_q2 + x52 * x55;
-        let x64 = x36 + 2.0 * (q3_dot * omega_body2_z);
+        let offset_body3_x = q3 + 0.1;
+        let neg_centripetal_body3_x = omega_body2_sq * offset_body3_x;
+        let neg_acc_body3_x = neg_acc_body2_x + neg_centripetal_body3_x;
+        let coriolis_body3_y = 2.0 * (q3_dot * omega_body2_z);
+        let acc_body3_y = acc_body2_y + coriolis_body3_y;
         // body4: joint q4, rotation, velocities and accelerations
-        let x73 = x58 + 0.3 * x55;
+        let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
+        let neg_acc_body4_in_parent_x = neg_acc_body3_x + neg_centripetal_body4_x;
         let c_q4 = q4.cos();
         let s_q4 = q4.sin();
+        let acc_body4_y = neg_acc_body4_in_parent_x * s_q4 + acc_body3_y * c_q4;
         let omega_body4_z = q4_dot + omega_body2_z;
+        let omega_body4_sq = omega_body4_z * omega_body4_z;
         // body4: inertial loads and joint q4 load (backward recursion)
-        let x337 = 0.15 * (omega_body4_z * omega_body4_z);
-        let x340 = 0.15 * (x73 * s_q4 + x64 * c_q4);
+        let neg_centripetal_force_body4_x = 0.15 * omega_body4_sq;
+        let moment_of_acc_body4_z = 0.15 * acc_body4_y;
         // body3: inertial loads and joint q3 load (backward recursion)
-        let x351 = x64 - s_q4 * x337;
-        let x359 = x64 + x351;
-        let x535 = 0.15 * x55 + (c_q4 * x337 + (x58 + x73));
+        let neg_centripetal_force_body3_x = 0.15 * omega_body2_sq;
+        let moment_of_acc_body3_z = 0.15 * acc_body3_y;
+        let force_body4_in_parent_y = acc_body3_y - s_q4 * neg_centripetal_force_body4_x;
+        let force_body3_in_parent_y = acc_body3_y + force_body4_in_parent_y;
+        let neg_f_q3 = neg_centripetal_force_body3_x
+            + (c_q4 * neg_centripetal_force_body4_x
+                + (neg_acc_body3_x + neg_acc_body4_in_parent_x));
         // body2: inertial loads and joint q2 load (backward recursion)
-        let x542 = 0.3 * x351 + (x340 + x52 * x359 + (0.15 * x64 + 0.025 * x36));
-        f[0] = x542 + 0.3 * (c_q2 * x359 - s_q2 * (0.025 * x55 + x535));
-        f[1] = x542;
-        f[2] = -x535;
-        f[3] = x340;
+        let neg_centripetal_force_body2_x = 0.025 * omega_body2_sq;
+        let moment_of_acc_body2_z = 0.025 * acc_body2_y;
+        let moment_body2_z = 0.3 * force_body4_in_parent_y
+            + (moment_of_acc_body4_z + offset_body3_x * force_body3_in_parent_y
+                + (moment_of_acc_body3_z + moment_of_acc_body2_z));
+        let neg_force_body2_rest_x = neg_centripetal_force_body2_x + neg_f_q3;
+        // body1: inertial loads and joint q1 load (backward recursion)
+        let force_body2_in_parent_y = c_q2 * force_body3_in_parent_y
+            - s_q2 * neg_force_body2_rest_x;
+        let moment_body2_in_parent_z = moment_body2_z + 0.3 * force_body2_in_parent_y;
+        f[0] = moment_body2_in_parent_z;
+        f[1] = moment_body2_z;
+        f[2] = -neg_f_q3;
+        f[3] = moment_of_acc_body4_z;
     }
     /// Q(q, q̇, t), eq. (13): gravity, springs, dampers.
     fn applied_forces(&self, _t: f64, q: &[f64], qd: &[f64], applied: &mut [f64]) {
@@ -208,19 +235,26 @@ impl rt::Dynamics for Model {
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
         // body2: joint q2, rotation, velocities and accelerations
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        // body3: joint q3, rotation, velocities and accelerations
+        let offset_body3_x = q3 + 0.1;
         // body4: joint q4, rotation, velocities and accelerations
-        let c_q4_q1_q2 = (q4 + x39).cos();
+        let c_q4_q1_q2 = (q4 + angle_q1_q2).cos();
         // body4: gravity load of the subtree on joint q4
-        let x389 = 1.4715 * c_q4_q1_q2;
+        let weight_moment_body4_z = 1.4715 * c_q4_q1_q2;
+        // body3: gravity load of the subtree on joint q3
+        let weight_q3 = 19.62 * s_q1_q2;
         // body2: gravity load of the subtree on joint q2
-        let x553 = x389 + c_q1_q2 * (19.62 * (q3 + 0.1) + 4.65975);
-        applied[0] = 8.829 * c_q1 + x553;
-        applied[1] = 15.0 * q2 + (q2_dot + x553);
-        applied[2] = 19.62 * s_q1_q2 + (q3_dot + 40.0 * q3);
-        applied[3] = 18.0 * q4 + (q4_dot + x389);
+        let weight_moment_body2_z = weight_moment_body4_z
+            + c_q1_q2 * (19.62 * offset_body3_x + 4.65975);
+        // body1: gravity load of the subtree on joint q1
+        let weight_moment_body1_z = 8.829 * c_q1 + weight_moment_body2_z;
+        applied[0] = weight_moment_body1_z;
+        applied[1] = 15.0 * q2 + (q2_dot + weight_moment_body2_z);
+        applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
+        applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
     }
     /// M, F and Q sharing one evaluation of the kinematics.
     fn equations(
@@ -242,76 +276,107 @@ impl rt::Dynamics for Model {
         let q4_dot = qd[3];
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
+        let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
-        let x25 = 0.3 * (q1_dot * q1_dot);
+        let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
         let c_q2 = q2.cos();
         let s_q2 = q2.sin();
-        let x36 = x25 * s_q2;
+        let neg_acc_body2_x = neg_centripetal_body2_x * c_q2;
+        let acc_body2_y = neg_centripetal_body2_x * s_q2;
         let omega_body2_z = q1_dot + q2_dot;
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body3: joint q3, rotation, velocities and accelerations
-        let x52 = q3 + 0.1;
-        let x55 = omega_body2_z * omega_body2_z;
-        let x58 = x25 * c_q2 + x52 * x55;
-        let x64 = x36 + 2.0 * (q3_dot * omega_body2_z);
+        let offset_body3_x = q3 + 0.1;
+        let neg_centripetal_body3_x = omega_body2_sq * offset_body3_x;
+        let neg_acc_body3_x = neg_acc_body2_x + neg_centripetal_body3_x;
+        let coriolis_body3_y = 2.0 * (q3_dot * omega_body2_z);
+        let acc_body3_y = acc_body2_y + coriolis_body3_y;
         // body4: joint q4, rotation, velocities and accelerations
-        let x73 = x58 + 0.3 * x55;
+        let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
+        let neg_acc_body4_in_parent_x = neg_acc_body3_x + neg_centripetal_body4_x;
         let c_q4 = q4.cos();
         let s_q4 = q4.sin();
+        let acc_body4_y = neg_acc_body4_in_parent_x * s_q4 + acc_body3_y * c_q4;
         let omega_body4_z = q4_dot + omega_body2_z;
-        let c_q4_q1_q2 = (q4 + x39).cos();
+        let c_q4_q1_q2 = (q4 + angle_q1_q2).cos();
+        let omega_body4_sq = omega_body4_z * omega_body4_z;
         // body4: composite inertia and column q4 of M
-        let x201 = 0.15 * s_q4;
-        let x203 = 0.15 * c_q4;
-        let x508 = 0.1225 + c_q4 * (0.045 + 0.15 * x52);
-        let x509 = 0.3 * (c_q2 * x203 - s_q2 * x201) + x508;
+        let neg_momentum_q4_q3_x = 0.15 * s_q4;
+        let momentum_q4_q3_y = 0.15 * c_q4;
+        let momentum_q4_q1_y = c_q2 * momentum_q4_q3_y - s_q2 * neg_momentum_q4_q3_x;
+        let momentum_moment_q4_q2_z = 0.1225 + c_q4 * (0.045 + 0.15 * offset_body3_x);
+        let momentum_moment_q4_q1_z = 0.3 * momentum_q4_q1_y + momentum_moment_q4_q2_z;
         // body3: composite inertia and column q3 of M
-        let x256 = x203 + 0.44999999999999996;
-        let x261 = 0.6 * s_q2 - x201;
+        let first_moment_body3_x = momentum_q4_q3_y + 0.44999999999999996;
+        let momentum_moment_q3_q1_z = 0.6 * s_q2 - neg_momentum_q4_q3_x;
         // body2: composite inertia and column q2 of M
-        let x267 = x256 + 2.0 * x52;
-        let x291 = c_q2 * (0.025 + x267) - s_q2 * x201;
-        let x520 = x52 * (x256 + x267) + (0.09 * c_q4 + 0.34625);
-        let x521 = 0.3 * x291 + x520;
+        let first_moment_body3_in_parent_x = first_moment_body3_x + 2.0 * offset_body3_x;
+        let first_moment_body2_x = 0.025 + first_moment_body3_in_parent_x;
+        let momentum_q2_q1_y = c_q2 * first_moment_body2_x - s_q2 * neg_momentum_q4_q3_x;
+        let inertia_body2_zz = offset_body3_x
+            * (first_moment_body3_x + first_moment_body3_in_parent_x)
+            + (0.09 * c_q4 + 0.34625);
+        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
+        // body1: composite inertia and column q1 of M
+        let inertia_body1_zz = inertia_body2_zz + (0.6 * momentum_q2_q1_y + 0.3475);
         // body4: inertial loads and joint q4 load (backward recursion)
-        let x337 = 0.15 * (omega_body4_z * omega_body4_z);
-        let x340 = 0.15 * (x73 * s_q4 + x64 * c_q4);
+        let neg_centripetal_force_body4_x = 0.15 * omega_body4_sq;
+        let moment_of_acc_body4_z = 0.15 * acc_body4_y;
         // body3: inertial loads and joint q3 load (backward recursion)
-        let x351 = x64 - s_q4 * x337;
-        let x359 = x64 + x351;
-        let x535 = 0.15 * x55 + (c_q4 * x337 + (x58 + x73));
+        let neg_centripetal_force_body3_x = 0.15 * omega_body2_sq;
+        let moment_of_acc_body3_z = 0.15 * acc_body3_y;
+        let force_body4_in_parent_y = acc_body3_y - s_q4 * neg_centripetal_force_body4_x;
+        let force_body3_in_parent_y = acc_body3_y + force_body4_in_parent_y;
+        let neg_f_q3 = neg_centripetal_force_body3_x
+            + (c_q4 * neg_centripetal_force_body4_x
+                + (neg_acc_body3_x + neg_acc_body4_in_parent_x));
         // body2: inertial loads and joint q2 load (backward recursion)
-        let x542 = 0.3 * x351 + (x340 + x52 * x359 + (0.15 * x64 + 0.025 * x36));
+        let neg_centripetal_force_body2_x = 0.025 * omega_body2_sq;
+        let moment_of_acc_body2_z = 0.025 * acc_body2_y;
+        let moment_body2_z = 0.3 * force_body4_in_parent_y
+            + (moment_of_acc_body4_z + offset_body3_x * force_body3_in_parent_y
+                + (moment_of_acc_body3_z + moment_of_acc_body2_z));
+        let neg_force_body2_rest_x = neg_centripetal_force_body2_x + neg_f_q3;
+        // body1: inertial loads and joint q1 load (backward recursion)
+        let force_body2_in_parent_y = c_q2 * force_body3_in_parent_y
+            - s_q2 * neg_force_body2_rest_x;
+        let moment_body2_in_parent_z = moment_body2_z + 0.3 * force_body2_in_parent_y;
         // body4: gravity load of the subtree on joint q4
-        let x389 = 1.4715 * c_q4_q1_q2;
+        let weight_moment_body4_z = 1.4715 * c_q4_q1_q2;
+        // body3: gravity load of the subtree on joint q3
+        let weight_q3 = 19.62 * s_q1_q2;
         // body2: gravity load of the subtree on joint q2
-        let x553 = x389 + c_q1_q2 * (19.62 * x52 + 4.65975);
-        m[0] = x520 + (0.6 * x291 + 0.3475);
-        m[1] = x521;
-        m[2] = x261;
-        m[3] = x509;
-        m[4] = x521;
-        m[5] = x520;
-        m[6] = -x201;
-        m[7] = x508;
-        m[8] = x261;
-        m[9] = -x201;
+        let weight_moment_body2_z = weight_moment_body4_z
+            + c_q1_q2 * (19.62 * offset_body3_x + 4.65975);
+        // body1: gravity load of the subtree on joint q1
+        let weight_moment_body1_z = 8.829 * c_q1 + weight_moment_body2_z;
+        m[0] = inertia_body1_zz;
+        m[1] = momentum_moment_q2_q1_z;
+        m[2] = momentum_moment_q3_q1_z;
+        m[3] = momentum_moment_q4_q1_z;
+        m[4] = momentum_moment_q2_q1_z;
+        m[5] = inertia_body2_zz;
+        m[6] = -neg_momentum_q4_q3_x;
+        m[7] = momentum_moment_q4_q2_z;
+        m[8] = momentum_moment_q3_q1_z;
+        m[9] = -neg_momentum_q4_q3_x;
         m[10] = 2.0;
-        m[11] = -x201;
-        m[12] = x509;
-        m[13] = x508;
-        m[14] = -x201;
+        m[11] = -neg_momentum_q4_q3_x;
+        m[12] = momentum_moment_q4_q1_z;
+        m[13] = momentum_moment_q4_q2_z;
+        m[14] = -neg_momentum_q4_q3_x;
         m[15] = 0.1225;
-        f[0] = x542 + 0.3 * (c_q2 * x359 - s_q2 * (0.025 * x55 + x535));
-        f[1] = x542;
-        f[2] = -x535;
-        f[3] = x340;
-        applied[0] = 8.829 * c_q1 + x553;
-        applied[1] = 15.0 * q2 + (q2_dot + x553);
-        applied[2] = 19.62 * s_q1_q2 + (q3_dot + 40.0 * q3);
-        applied[3] = 18.0 * q4 + (q4_dot + x389);
+        f[0] = moment_body2_in_parent_z;
+        f[1] = moment_body2_z;
+        f[2] = -neg_f_q3;
+        f[3] = moment_of_acc_body4_z;
+        applied[0] = weight_moment_body1_z;
+        applied[1] = 15.0 * q2 + (q2_dot + weight_moment_body2_z);
+        applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
+        applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
     }
     /// h(q) = f2 − f3(f1), eq. (3).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
@@ -323,17 +388,27 @@ impl rt::Dynamics for Model {
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
         // body2: joint q2, rotation, velocities and accelerations
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
-        let x96 = q4 + x39;
-        let c_q4_q1_q2 = x96.cos();
-        let s_q4_q1_q2 = x96.sin();
+        let angle_q4_q1_q2 = q4 + angle_q1_q2;
+        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x125 = q3 + 0.4;
-        let a_x = 0.38 + (0.3 * c_q1 + (0.3 * c_q4_q1_q2 + c_q1_q2 * x125));
-        let a_y = 0.8 + (0.3 * s_q1 + (0.3 * s_q4_q1_q2 + s_q1_q2 * x125));
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
+        let a_y = 0.8 + a_arm_q1_y;
         h[0] = a_y - a_x * (a_x * (0.5 + 0.5 * a_x) - 0.595);
     }
     /// J = J2 − f3' J1, eq. (5b), row-major nc×n.
@@ -346,26 +421,31 @@ impl rt::Dynamics for Model {
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
         // body2: joint q2, rotation, velocities and accelerations
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
-        let x96 = q4 + x39;
-        let c_q4_q1_q2 = x96.cos();
-        let s_q4_q1_q2 = x96.sin();
+        let angle_q4_q1_q2 = q4 + angle_q1_q2;
+        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x113 = 0.3 * c_q4_q1_q2;
-        let x114 = 0.3 * s_q4_q1_q2;
-        let x125 = q3 + 0.4;
-        let x135 = x113 + c_q1_q2 * x125;
-        let x136 = x114 + s_q1_q2 * x125;
-        let x145 = 0.3 * c_q1 + x135;
-        let a_x = 0.38 + x145;
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
-        j[0] = x145 + (0.3 * s_q1 + x136) * a_slope;
-        j[1] = x135 + x136 * a_slope;
+        j[0] = a_arm_q1_x + a_arm_q1_y * a_slope;
+        j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
-        j[3] = x113 + x114 * a_slope;
+        j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
     }
     /// c of J q̈ + c = 0, eqs. (7, 8).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
@@ -380,37 +460,50 @@ impl rt::Dynamics for Model {
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
+        let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
-        let x24 = q1_dot * q1_dot;
         let omega_body2_z = q1_dot + q2_dot;
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
-        let x47 = 0.3 * c_q1;
-        let x48 = 0.3 * s_q1;
-        // body3: joint q3, rotation, velocities and accelerations
-        let x55 = omega_body2_z * omega_body2_z;
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
+        let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body4: joint q4, rotation, velocities and accelerations
         let omega_body4_z = q4_dot + omega_body2_z;
-        let x96 = q4 + x39;
-        let c_q4_q1_q2 = x96.cos();
-        let s_q4_q1_q2 = x96.sin();
+        let angle_q4_q1_q2 = q4 + angle_q1_q2;
+        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let omega_body4_sq = omega_body4_z * omega_body4_z;
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x109 = omega_body2_z * (2.0 * q3_dot);
-        let x113 = 0.3 * c_q4_q1_q2;
-        let x114 = 0.3 * s_q4_q1_q2;
-        let x115 = omega_body4_z * omega_body4_z;
-        let x125 = q3 + 0.4;
-        let x126 = c_q1_q2 * x125;
-        let x127 = s_q1_q2 * x125;
-        let x136 = x114 + x127;
-        let a_x = 0.38 + (x47 + (x113 + x126));
+        let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
+        let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
+        let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
+        let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
+        let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
+        let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
+        let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
+            + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
+        let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y
+            - neg_a_centripetal_q2_y - neg_a_centripetal_q1_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
         let a_curvature = 1.0 + 3.0 * a_x;
-        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * (x48 + x136) - q2_dot * x136
-            - q4_dot * x114;
-        c[0] = c_q1_q2 * x109 - x114 * x115 - x55 * x127 - x24 * x48
-            + (s_q1_q2 * x109 + x113 * x115 + x55 * x126 + x24 * x47) * a_slope
+        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
+            - q4_dot * a_segment_q4_y;
+        c[0] = a_convective_y + neg_a_convective_x * a_slope
             - a_curvature * a_x_rate.powi(2);
     }
     /// J and c sharing one evaluation of the contact kinematics.
@@ -426,43 +519,54 @@ impl rt::Dynamics for Model {
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
+        let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
-        let x24 = q1_dot * q1_dot;
         let omega_body2_z = q1_dot + q2_dot;
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
-        let x47 = 0.3 * c_q1;
-        let x48 = 0.3 * s_q1;
-        // body3: joint q3, rotation, velocities and accelerations
-        let x55 = omega_body2_z * omega_body2_z;
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
+        let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body4: joint q4, rotation, velocities and accelerations
         let omega_body4_z = q4_dot + omega_body2_z;
-        let x96 = q4 + x39;
-        let c_q4_q1_q2 = x96.cos();
-        let s_q4_q1_q2 = x96.sin();
+        let angle_q4_q1_q2 = q4 + angle_q1_q2;
+        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let omega_body4_sq = omega_body4_z * omega_body4_z;
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x109 = omega_body2_z * (2.0 * q3_dot);
-        let x113 = 0.3 * c_q4_q1_q2;
-        let x114 = 0.3 * s_q4_q1_q2;
-        let x115 = omega_body4_z * omega_body4_z;
-        let x125 = q3 + 0.4;
-        let x126 = c_q1_q2 * x125;
-        let x127 = s_q1_q2 * x125;
-        let x135 = x113 + x126;
-        let x136 = x114 + x127;
-        let x145 = x47 + x135;
-        let x146 = x48 + x136;
-        let a_x = 0.38 + x145;
+        let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
+        let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
+        let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
+        let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
+        let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
+        let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
+        let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
+            + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
+        let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y
+            - neg_a_centripetal_q2_y - neg_a_centripetal_q1_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
         let a_curvature = 1.0 + 3.0 * a_x;
-        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * x146 - q2_dot * x136 - q4_dot * x114;
-        j[0] = x145 + x146 * a_slope;
-        j[1] = x135 + x136 * a_slope;
+        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
+            - q4_dot * a_segment_q4_y;
+        j[0] = a_arm_q1_x + a_arm_q1_y * a_slope;
+        j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
-        j[3] = x113 + x114 * a_slope;
-        c[0] = c_q1_q2 * x109 - x114 * x115 - x55 * x127 - x24 * x48
-            + (s_q1_q2 * x109 + x113 * x115 + x55 * x126 + x24 * x47) * a_slope
+        j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
+        c[0] = a_convective_y + neg_a_convective_x * a_slope
             - a_curvature * a_x_rate.powi(2);
     }
     /// Contact points in ground and cam coordinates, with f3' and f3'' under them.
@@ -475,17 +579,27 @@ impl rt::Dynamics for Model {
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
         // body2: joint q2, rotation, velocities and accelerations
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
-        let x96 = q4 + x39;
-        let c_q4_q1_q2 = x96.cos();
-        let s_q4_q1_q2 = x96.sin();
+        let angle_q4_q1_q2 = q4 + angle_q1_q2;
+        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x125 = q3 + 0.4;
-        let a_x = 0.38 + (0.3 * c_q1 + (0.3 * c_q4_q1_q2 + c_q1_q2 * x125));
-        let a_y = 0.8 + (0.3 * s_q1 + (0.3 * s_q4_q1_q2 + s_q1_q2 * x125));
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
+        let a_y = 0.8 + a_arm_q1_y;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
         let a_curvature = 1.0 + 3.0 * a_x;
         out[0].position[0] = a_x;
@@ -511,39 +625,44 @@ impl rt::Dynamics for Model {
         // body1: joint q1, rotation, velocities and accelerations
         let s_q1 = q1.sin();
         // body2: joint q2, rotation, velocities and accelerations
-        let x23 = 0.3 * q1_dot;
+        let vel_rel_body2_y = 0.3 * q1_dot;
         let c_q2 = q2.cos();
         let s_q2 = q2.sin();
-        let vel_body2_x = x23 * s_q2;
-        let vel_body2_y = x23 * c_q2;
+        let vel_body2_x = vel_rel_body2_y * s_q2;
+        let vel_body2_y = vel_rel_body2_y * c_q2;
         let omega_body2_z = q1_dot + q2_dot;
-        let x39 = q1 + q2;
-        let s_q1_q2 = x39.sin();
-        let pos_body2_y = 0.8 + 0.3 * s_q1;
+        let angle_q1_q2 = q1 + q2;
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_y = 0.3 * s_q1;
+        let pos_body2_y = 0.8 + step_body2_y;
         // body3: joint q3, rotation, velocities and accelerations
-        let x52 = q3 + 0.1;
-        let vel_body3_y = vel_body2_y + omega_body2_z * x52;
+        let offset_body3_x = q3 + 0.1;
+        let vel_rel_body3_y = omega_body2_z * offset_body3_x;
+        let vel_body3_in_parent_y = vel_body2_y + vel_rel_body3_y;
         let vel_body3_x = q3_dot + vel_body2_x;
-        let pos_body3_y = pos_body2_y + s_q1_q2 * x52;
+        let step_body3_y = s_q1_q2 * offset_body3_x;
+        let pos_body3_y = pos_body2_y + step_body3_y;
         // body4: joint q4, rotation, velocities and accelerations
-        let x70 = vel_body3_y + 0.3 * omega_body2_z;
+        let vel_rel_body4_y = 0.3 * omega_body2_z;
+        let vel_body4_in_parent_y = vel_body3_in_parent_y + vel_rel_body4_y;
         let c_q4 = q4.cos();
         let s_q4 = q4.sin();
-        let vel_body4_x = vel_body3_x * c_q4 + x70 * s_q4;
-        let vel_body4_y = x70 * c_q4 - vel_body3_x * s_q4;
+        let vel_body4_x = vel_body3_x * c_q4 + vel_body4_in_parent_y * s_q4;
+        let vel_body4_y = vel_body4_in_parent_y * c_q4 - vel_body3_x * s_q4;
         let omega_body4_z = q4_dot + omega_body2_z;
-        let s_q4_q1_q2 = (q4 + x39).sin();
+        let s_q4_q1_q2 = (q4 + angle_q1_q2).sin();
         // energy
-        let x427 = vel_body2_y + 0.05 * omega_body2_z;
-        let x451 = vel_body3_y + 0.15 * omega_body2_z;
-        let x470 = vel_body4_y + 0.15 * omega_body4_z;
-        let kinetic = q1_dot * (0.06125 * q1_dot)
-            + omega_body2_z * (0.055 * omega_body2_z)
-            + (0.25 * (vel_body2_x * vel_body2_x + x427 * x427)
+        let vel_com_body2_y = vel_body2_y + 0.05 * omega_body2_z;
+        let vel_com_body3_y = vel_body3_in_parent_y + 0.15 * omega_body2_z;
+        let vel_com_body4_y = vel_body4_y + 0.15 * omega_body4_z;
+        let kinetic_body1 = q1_dot * (0.06125 * q1_dot);
+        let kinetic = kinetic_body1 + omega_body2_z * (0.055 * omega_body2_z)
+            + (0.25 * (vel_body2_x * vel_body2_x + vel_com_body2_y * vel_com_body2_y)
                 + 0.5
                     * (omega_body4_z * (0.1 * omega_body4_z)
-                        + (x470 * x470
-                            + (vel_body3_x * vel_body3_x + x451 * x451
+                        + (vel_com_body4_y * vel_com_body4_y
+                            + (vel_body3_x * vel_body3_x
+                                + vel_com_body3_y * vel_com_body3_y
                                 + vel_body4_x * vel_body4_x))));
         let gravity = 19.62 * pos_body3_y
             + (4.905 * pos_body2_y
@@ -579,29 +698,33 @@ impl rt::Dynamics for Model {
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
         // body2: joint q2, rotation, velocities and accelerations
-        let x39 = q1 + q2;
-        let c_q1_q2 = x39.cos();
-        let s_q1_q2 = x39.sin();
+        let angle_q1_q2 = q1 + q2;
+        let c_q1_q2 = angle_q1_q2.cos();
+        let s_q1_q2 = angle_q1_q2.sin();
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
-        let x96 = q4 + x39;
-        let c_q4_q1_q2 = x96.cos();
-        let s_q4_q1_q2 = x96.sin();
+        let angle_q4_q1_q2 = q4 + angle_q1_q2;
+        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x113 = 0.3 * c_q4_q1_q2;
-        let x114 = 0.3 * s_q4_q1_q2;
-        let x125 = q3 + 0.4;
-        let x135 = x113 + c_q1_q2 * x125;
-        let x136 = x114 + s_q1_q2 * x125;
-        let x145 = 0.3 * c_q1 + x135;
-        let x146 = 0.3 * s_q1 + x136;
-        let a_x = 0.38 + x145;
-        let a_y = 0.8 + x146;
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
+        let a_y = 0.8 + a_arm_q1_y;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
         h[0] = a_y - a_x * (a_x * (0.5 + 0.5 * a_x) - 0.595);
-        j[0] = x145 + x146 * a_slope;
-        j[1] = x135 + x136 * a_slope;
+        j[0] = a_arm_q1_x + a_arm_q1_y * a_slope;
+        j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
-        j[3] = x113 + x114 * a_slope;
+        j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
         cache[0] = c_q1;
         cache[1] = s_q1;
         cache[2] = c_q1_q2;
@@ -628,91 +751,143 @@ impl rt::Dynamics for Model {
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = cache[0];
         let s_q1 = cache[1];
+        let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
-        let x24 = q1_dot * q1_dot;
-        let x25 = 0.3 * x24;
+        let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
         let omega_body2_z = q1_dot + q2_dot;
         let c_q1_q2 = cache[2];
         let s_q1_q2 = cache[3];
-        let x47 = 0.3 * c_q1;
-        let x48 = 0.3 * s_q1;
+        let step_body2_x = 0.3 * c_q1;
+        let step_body2_y = 0.3 * s_q1;
+        let omega_body2_sq = omega_body2_z * omega_body2_z;
+        let rel_rot_body2_11 = c_q1 * c_q1_q2 + s_q1 * s_q1_q2;
+        let neg_rel_rot_body2_12 = c_q1 * s_q1_q2 - s_q1 * c_q1_q2;
+        let neg_acc_body2_x = neg_centripetal_body2_x * rel_rot_body2_11;
+        let acc_body2_y = neg_centripetal_body2_x * neg_rel_rot_body2_12;
         // body3: joint q3, rotation, velocities and accelerations
-        let x52 = q3 + 0.1;
-        let x55 = omega_body2_z * omega_body2_z;
+        let offset_body3_x = q3 + 0.1;
+        let neg_centripetal_body3_x = omega_body2_sq * offset_body3_x;
+        let coriolis_body3_y = 2.0 * (q3_dot * omega_body2_z);
+        let neg_acc_body3_x = neg_centripetal_body3_x + neg_acc_body2_x;
+        let acc_body3_y = coriolis_body3_y + acc_body2_y;
         // body4: joint q4, rotation, velocities and accelerations
+        let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
         let omega_body4_z = q4_dot + omega_body2_z;
         let c_q4_q1_q2 = cache[4];
         let s_q4_q1_q2 = cache[5];
+        let omega_body4_sq = omega_body4_z * omega_body4_z;
+        let rel_rot_body4_11 = c_q1_q2 * c_q4_q1_q2 + s_q1_q2 * s_q4_q1_q2;
+        let neg_rel_rot_body4_12 = c_q1_q2 * s_q4_q1_q2 - s_q1_q2 * c_q4_q1_q2;
+        let neg_acc_body4_in_parent_x = neg_centripetal_body4_x + neg_acc_body3_x;
+        let acc_body4_y = neg_rel_rot_body4_12 * neg_acc_body4_in_parent_x
+            + rel_rot_body4_11 * acc_body3_y;
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
-        let x109 = omega_body2_z * (2.0 * q3_dot);
-        let x113 = 0.3 * c_q4_q1_q2;
-        let x114 = 0.3 * s_q4_q1_q2;
-        let x115 = omega_body4_z * omega_body4_z;
-        let x125 = q3 + 0.4;
-        let x126 = c_q1_q2 * x125;
-        let x127 = s_q1_q2 * x125;
-        let x136 = x114 + x127;
-        let a_x = 0.38 + (x47 + (x113 + x126));
+        let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
+        let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
+        let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
+        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
+        let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
+        let a_segment_q2_x_t1 = q3 + 0.4;
+        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
+        let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
+        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
+        let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
+        let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
+            + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
+        let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y
+            - neg_a_centripetal_q2_y - neg_a_centripetal_q1_y;
+        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+        let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
         let a_curvature = 1.0 + 3.0 * a_x;
-        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * (x48 + x136) - q2_dot * x136
-            - q4_dot * x114;
+        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
+            - q4_dot * a_segment_q4_y;
+        // body4: composite inertia and column q4 of M
+        let neg_momentum_q4_q3_x = 0.15 * neg_rel_rot_body4_12;
+        let momentum_q4_q3_y = 0.15 * rel_rot_body4_11;
+        let momentum_q4_q1_y = rel_rot_body2_11 * momentum_q4_q3_y
+            - neg_rel_rot_body2_12 * neg_momentum_q4_q3_x;
+        let momentum_moment_q4_q2_z = 0.1225
+            + (0.045 + 0.15 * offset_body3_x) * rel_rot_body4_11;
+        let momentum_moment_q4_q1_z = 0.3 * momentum_q4_q1_y + momentum_moment_q4_q2_z;
+        // body3: composite inertia and column q3 of M
+        let first_moment_body3_x = 0.44999999999999996 + momentum_q4_q3_y;
+        let momentum_moment_q3_q1_z = 0.6 * neg_rel_rot_body2_12 - neg_momentum_q4_q3_x;
+        // body2: composite inertia and column q2 of M
+        let first_moment_body3_in_parent_x = 2.0 * offset_body3_x + first_moment_body3_x;
+        let first_moment_body2_x = 0.025 + first_moment_body3_in_parent_x;
+        let momentum_q2_q1_y = rel_rot_body2_11 * first_moment_body2_x
+            - neg_rel_rot_body2_12 * neg_momentum_q4_q3_x;
+        let inertia_body2_zz = offset_body3_x
+            * (first_moment_body3_x + first_moment_body3_in_parent_x)
+            + (0.34625 + 0.09 * rel_rot_body4_11);
+        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
+        // body1: composite inertia and column q1 of M
+        let inertia_body1_zz = inertia_body2_zz + (0.3475 + 0.6 * momentum_q2_q1_y);
         // body4: inertial loads and joint q4 load (backward recursion)
-        let x337 = 0.15 * x115;
+        let neg_centripetal_force_body4_x = 0.15 * omega_body4_sq;
+        let moment_of_acc_body4_z = 0.15 * acc_body4_y;
+        // body3: inertial loads and joint q3 load (backward recursion)
+        let neg_centripetal_force_body3_x = 0.15 * omega_body2_sq;
+        let moment_of_acc_body3_z = 0.15 * acc_body3_y;
+        let force_body4_in_parent_y = acc_body3_y
+            - neg_centripetal_force_body4_x * neg_rel_rot_body4_12;
+        let force_body3_in_parent_y = acc_body3_y + force_body4_in_parent_y;
+        let neg_f_q3 = neg_centripetal_force_body3_x
+            + (neg_centripetal_force_body4_x * rel_rot_body4_11
+                + (neg_acc_body3_x + neg_acc_body4_in_parent_x));
+        // body2: inertial loads and joint q2 load (backward recursion)
+        let neg_centripetal_force_body2_x = 0.025 * omega_body2_sq;
+        let moment_of_acc_body2_z = 0.025 * acc_body2_y;
+        let moment_body2_z = 0.3 * force_body4_in_parent_y
+            + (moment_of_acc_body4_z + offset_body3_x * force_body3_in_parent_y
+                + (moment_of_acc_body3_z + moment_of_acc_body2_z));
+        let neg_force_body2_rest_x = neg_centripetal_force_body2_x + neg_f_q3;
+        // body1: inertial loads and joint q1 load (backward recursion)
+        let force_body2_in_parent_y = rel_rot_body2_11 * force_body3_in_parent_y
+            - neg_rel_rot_body2_12 * neg_force_body2_rest_x;
+        let moment_body2_in_parent_z = moment_body2_z + 0.3 * force_body2_in_parent_y;
         // body4: gravity load of the subtree on joint q4
-        let x389 = 1.4715 * c_q4_q1_q2;
+        let weight_moment_body4_z = 1.4715 * c_q4_q1_q2;
+        // body3: gravity load of the subtree on joint q3
+        let weight_q3 = 19.62 * s_q1_q2;
         // body2: gravity load of the subtree on joint q2
-        let x553 = x389 + c_q1_q2 * (19.62 * x52 + 4.65975);
-        // energy
-        let x621 = c_q1 * c_q1_q2 + s_q1 * s_q1_q2;
-        let x623 = c_q1 * s_q1_q2 - s_q1 * c_q1_q2;
-        let x628 = c_q1_q2 * c_q4_q1_q2 + s_q1_q2 * s_q4_q1_q2;
-        let x630 = c_q1_q2 * s_q4_q1_q2 - s_q1_q2 * c_q4_q1_q2;
-        let x638 = x25 * x623;
-        let x641 = x52 * x55 + x25 * x621;
-        let x644 = 2.0 * (q3_dot * omega_body2_z) + x638;
-        let x646 = 0.3 * x55 + x641;
-        let x666 = 0.15 * x630;
-        let x668 = 0.15 * x628;
-        let x718 = 0.44999999999999996 + x668;
-        let x722 = 0.6 * x623 - x666;
-        let x723 = 2.0 * x52 + x718;
-        let x746 = x621 * (0.025 + x723) - x623 * x666;
-        let x789 = 0.15 * (x630 * x646 + x628 * x644);
-        let x797 = x644 - x337 * x630;
-        let x805 = x644 + x797;
-        let x851 = 0.1225 + (0.045 + 0.15 * x52) * x628;
-        let x852 = 0.3 * (x621 * x668 - x623 * x666) + x851;
-        let x860 = x52 * (x718 + x723) + (0.34625 + 0.09 * x628);
-        let x861 = 0.3 * x746 + x860;
-        let x873 = 0.15 * x55 + (x337 * x628 + (x641 + x646));
-        let x880 = 0.3 * x797 + (x789 + x52 * x805 + (0.15 * x644 + 0.025 * x638));
-        out.mass[0] = x860 + (0.3475 + 0.6 * x746);
-        out.mass[1] = x861;
-        out.mass[2] = x722;
-        out.mass[3] = x852;
-        out.mass[4] = x861;
-        out.mass[5] = x860;
-        out.mass[6] = -x666;
-        out.mass[7] = x851;
-        out.mass[8] = x722;
-        out.mass[9] = -x666;
+        let weight_moment_body2_z = weight_moment_body4_z
+            + c_q1_q2 * (19.62 * offset_body3_x + 4.65975);
+        // body1: gravity load of the subtree on joint q1
+        let weight_moment_body1_z = 8.829 * c_q1 + weight_moment_body2_z;
+        out.mass[0] = inertia_body1_zz;
+        out.mass[1] = momentum_moment_q2_q1_z;
+        out.mass[2] = momentum_moment_q3_q1_z;
+        out.mass[3] = momentum_moment_q4_q1_z;
+        out.mass[4] = momentum_moment_q2_q1_z;
+        out.mass[5] = inertia_body2_zz;
+        out.mass[6] = -neg_momentum_q4_q3_x;
+        out.mass[7] = momentum_moment_q4_q2_z;
+        out.mass[8] = momentum_moment_q3_q1_z;
+        out.mass[9] = -neg_momentum_q4_q3_x;
         out.mass[10] = 2.0;
-        out.mass[11] = -x666;
-        out.mass[12] = x852;
-        out.mass[13] = x851;
-        out.mass[14] = -x666;
+        out.mass[11] = -neg_momentum_q4_q3_x;
+        out.mass[12] = momentum_moment_q4_q1_z;
+        out.mass[13] = momentum_moment_q4_q2_z;
+        out.mass[14] = -neg_momentum_q4_q3_x;
         out.mass[15] = 0.1225;
-        out.inertial[0] = x880 + 0.3 * (x621 * x805 - x623 * (0.025 * x55 + x873));
-        out.inertial[1] = x880;
-        out.inertial[2] = -x873;
-        out.inertial[3] = x789;
-        out.applied[0] = 8.829 * c_q1 + x553;
-        out.applied[1] = 15.0 * q2 + (q2_dot + x553);
-        out.applied[2] = 19.62 * s_q1_q2 + (q3_dot + 40.0 * q3);
-        out.applied[3] = 18.0 * q4 + (q4_dot + x389);
-        out.bias[0] = c_q1_q2 * x109 - x114 * x115 - x55 * x127 - x24 * x48
-            + (s_q1_q2 * x109 + x113 * x115 + x55 * x126 + x24 * x47) * a_slope
+        out.inertial[0] = moment_body2_in_parent_z;
+        out.inertial[1] = moment_body2_z;
+        out.inertial[2] = -neg_f_q3;
+        out.inertial[3] = moment_of_acc_body4_z;
+        out.applied[0] = weight_moment_body1_z;
+        out.applied[1] = 15.0 * q2 + (q2_dot + weight_moment_body2_z);
+        out.applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
+        out.applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
+        out.bias[0] = a_convective_y + neg_a_convective_x * a_slope
             - a_curvature * a_x_rate.powi(2);
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
@@ -746,35 +921,46 @@ fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) 
     // body1: joint q1, rotation, velocities and accelerations
     let c_q1 = q1.cos();
     let s_q1 = q1.sin();
+    let omega_body1_sq = q1_dot * q1_dot;
     // body2: joint q2, rotation, velocities and accelerations
-    let x24 = q1_dot * q1_dot;
     let omega_body2_z = q1_dot + q2_dot;
-    let x39 = q1 + q2;
-    let c_q1_q2 = x39.cos();
-    let s_q1_q2 = x39.sin();
-    let x47 = 0.3 * c_q1;
-    let x48 = 0.3 * s_q1;
-    // body3: joint q3, rotation, velocities and accelerations
-    let x55 = omega_body2_z * omega_body2_z;
+    let angle_q1_q2 = q1 + q2;
+    let c_q1_q2 = angle_q1_q2.cos();
+    let s_q1_q2 = angle_q1_q2.sin();
+    let step_body2_x = 0.3 * c_q1;
+    let step_body2_y = 0.3 * s_q1;
+    let omega_body2_sq = omega_body2_z * omega_body2_z;
     // body4: joint q4, rotation, velocities and accelerations
     let omega_body4_z = q4_dot + omega_body2_z;
-    let x96 = q4 + x39;
-    let c_q4_q1_q2 = x96.cos();
-    let s_q4_q1_q2 = x96.sin();
+    let angle_q4_q1_q2 = q4 + angle_q1_q2;
+    let c_q4_q1_q2 = angle_q4_q1_q2.cos();
+    let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+    let omega_body4_sq = omega_body4_z * omega_body4_z;
     // contact A: position on the cam, J1, J2, convective terms, h, J, c
-    let x109 = omega_body2_z * (2.0 * q3_dot);
-    let x113 = 0.3 * c_q4_q1_q2;
-    let x114 = 0.3 * s_q4_q1_q2;
-    let x115 = omega_body4_z * omega_body4_z;
-    let x125 = q3 + 0.4;
-    let x126 = c_q1_q2 * x125;
-    let x127 = s_q1_q2 * x125;
-    let x135 = x113 + x126;
-    let x136 = x114 + x127;
-    let x145 = x47 + x135;
-    let x146 = x48 + x136;
-    let a_x = 0.38 + x145;
-    let a_y = 0.8 + x146;
+    let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
+    let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
+    let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
+    let a_segment_q4_x = 0.3 * c_q4_q1_q2;
+    let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+    let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
+    let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
+    let a_segment_q2_x_t1 = q3 + 0.4;
+    let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
+    let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+    let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
+    let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
+    let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
+    let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+    let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
+    let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
+    let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
+        + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
+    let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y - neg_a_centripetal_q2_y
+        - neg_a_centripetal_q1_y;
+    let a_arm_q1_x = step_body2_x + a_arm_q2_x;
+    let a_arm_q1_y = step_body2_y + a_arm_q2_y;
+    let a_x = 0.38 + a_arm_q1_x;
+    let a_y = 0.8 + a_arm_q1_y;
     let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
     let a_curvature = 1.0 + 3.0 * a_x;
     out.geometry.position[0] = a_x;
@@ -784,16 +970,16 @@ fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) 
     out.geometry.y = a_y;
     out.geometry.slope = a_slope;
     out.geometry.curvature = a_curvature;
-    out.j1[0] = -x146;
-    out.j1[1] = -x136;
+    out.j1[0] = -a_arm_q1_y;
+    out.j1[1] = -a_arm_q2_y;
     out.j1[2] = c_q1_q2;
-    out.j1[3] = -x114;
-    out.j2[0] = x145;
-    out.j2[1] = x135;
+    out.j1[3] = -a_segment_q4_y;
+    out.j2[0] = a_arm_q1_x;
+    out.j2[1] = a_arm_q2_x;
     out.j2[2] = s_q1_q2;
-    out.j2[3] = x113;
-    out.conv1 = -(s_q1_q2 * x109 + x113 * x115 + x55 * x126 + x24 * x47);
-    out.conv2 = c_q1_q2 * x109 - x114 * x115 - x55 * x127 - x24 * x48;
+    out.j2[3] = a_segment_q4_x;
+    out.conv1 = -neg_a_convective_x;
+    out.conv2 = a_convective_y;
 }
 /// Operation count of every generated function: add/sub, mul, div, sin/cos, sqrt, other (the table of the header).
 #[allow(dead_code)]
