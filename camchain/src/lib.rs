@@ -60,7 +60,7 @@
 //! let last = run.samples.last().expect("a 10 s run has samples");
 //! // The constraint is solved by Newton at every evaluation (tolerance 1e-12 m).
 //! assert!(last.h[0].abs() < 1e-12, "the tip stays on the cam");
-//! // The paper scenario's contact stays compressive (22–23.4 N, docs/method.md).
+//! // On the concave cam the contact stays compressive, 22.2–23.4 N (docs/method.md §7.5).
 //! assert!(last.normal_force[0] > 20.0, "the cam pushes the tip");
 //! assert_eq!(model.info().coordinates.len(), 4);
 //! # Ok::<(), Box<dyn std::error::Error>>(())

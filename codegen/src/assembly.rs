@@ -1,6 +1,6 @@
 //! Build-time check that the model's initial guess can be assembled onto its cams.
 //!
-//! The same Newton iteration the runtime performs (§6: held and driven coordinates keep
+//! The same Newton iteration the runtime performs (docs/method.md §5.9: held and driven coordinates keep
 //! their values, one free coordinate per contact is solved from h(q) = 0), run on the
 //! symbolic expressions with the interpreter, so a model whose contact point cannot reach
 //! its cam fails the build with a clear message instead of failing at run time.

@@ -1074,7 +1074,7 @@ mod tests {
     #[test]
     fn contact_models_assemble_near_their_guess() {
         // (file, root of the free coordinate): found with an independent Python script (the
-        // planar closed form of paper-model.md §6 for the paper chain, a separate rotation-
+        // planar closed form of docs/method.md §7.3 for the paper chain, a separate rotation-
         // matrix implementation for the spatial arm). The driven roots are exact:
         // q3 = -0.15 - f(0.35).
         let cases = [

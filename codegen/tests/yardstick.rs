@@ -1,7 +1,7 @@
 //! The yardstick of issue 4 §3: an expert's hand-derived planar formulas for the paper
 //! model, written once, counted with the same engine, and beaten by the generator.
 //!
-//! The paper model (`models/paper_concave.ron`, paper-model.md §5–6): q1 revolute at the
+//! The paper model (`models/paper_concave.ron`, docs/method.md §7): q1 revolute at the
 //! base B, q2 revolute, q3 prismatic along body 2, q4 revolute; every body's frame at its
 //! proximal joint, centre of mass on the local x axis. The formulas below are what one
 //! would write by hand for this planar chain, with the usual economies:
@@ -35,7 +35,7 @@ impl Rng {
     }
 }
 
-// Paper §5 and the "paper" scenario of paper-model.md §6 (the numbers of
+// The paper's Table 1 and the "paper" scenario of docs/method.md §7 (the numbers of
 // models/paper_concave.ron; the interpreter comparison below checks they are the same).
 const L1: f64 = 0.3; // body 1 length: joint 2 at (l1, 0) of body 1
 const L2: f64 = 0.1; // body 2 length: body 3 origin at (l2 + q3, 0) of body 2

@@ -148,7 +148,7 @@ fn the_paper_contrast_shows_joint_4_bends_on_the_convex_cam_only() {
     };
     let (concave, tc) = q4("paper_concave");
     let (convex, tv) = q4("paper_convex");
-    // paper-model.md §6: concave about 0.015 rad, convex about 0.16 rad.
+    // docs/method.md §7.5: concave about 0.015 rad, convex about 0.16 rad.
     assert!(concave < 0.05, "concave max |q4| = {concave}");
     assert!(convex > 0.08, "convex max |q4| = {convex}");
     assert!(convex > 5.0 * concave, "contrast {convex} vs {concave}");

@@ -1,5 +1,5 @@
 //! One-sided contact on the paper's driven scenario with the convex cam (no gravity, joint 1
-//! driven: paper-model.md §6), whose bilateral normal force dips below zero near t = 5.18 s:
+//! driven: docs/method.md §7.4), whose bilateral normal force dips below zero near t = 5.18 s:
 //! lift-off where the bilateral force changes sign, flight without penetration, impacts
 //! with the restitution law, and the energy balance through all of it.
 

@@ -1092,7 +1092,7 @@ mod tests {
     const BASE: [f64; 2] = [0.38, 0.80];
     const LENGTHS: [f64; 4] = [0.3, 0.1, 0.3, 0.3];
 
-    /// paper-model.md §5–6: revolute, revolute, prismatic, revolute; concave cam.
+    /// docs/method.md §7: revolute, revolute, prismatic, revolute; concave cam.
     fn paper_chain() -> NumericModel {
         let masses = [1.0, 0.5, 1.0, 1.0];
         let inertias = [0.10, 0.01, 0.10, 0.10];

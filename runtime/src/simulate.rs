@@ -256,7 +256,7 @@ pub struct SimFailure {
 
 /// Constrained simulation of any [`Dynamics`] (blanket implementation).
 pub trait Simulate: Dynamics {
-    /// Initial assembly (§6) at time `t0` from the model's initial guess: coordinates with
+    /// Initial assembly (docs/method.md §5.9) at time `t0` from the model's initial guess: coordinates with
     /// `hold = true` keep their guess, driven ones take their prescribed value at t0; the
     /// dependent coordinates are chosen among the others by largest |J_i| and solved by
     /// Newton (15), with a backtracking Newton as fallback. Velocities: the free guesses are

@@ -1,4 +1,4 @@
-//! Run time against error for every integrator on the reference models (§6).
+//! Run time against error for every integrator on the reference models (docs/method.md §7).
 
 use super::timing::median_seconds;
 use crate::CliError;

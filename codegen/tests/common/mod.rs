@@ -53,7 +53,7 @@ pub fn concave_profile() -> Scalar {
     )
 }
 
-/// The paper's four-body chain on the concave cam (paper-model.md §5–6).
+/// The paper's four-body chain on the concave cam (docs/method.md §7).
 pub fn paper_concave() -> Model {
     let prismatic = Joint {
         kind: JointKind::Prismatic,
