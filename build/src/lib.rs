@@ -38,6 +38,47 @@
 //! }
 //! ```
 //!
+//! The same steps, run here: a model written to a temporary directory, compiled, and the
+//! generated module read back (a build script leaves out `out_dir`, which defaults to
+//! `$OUT_DIR/camchain`, and keeps the `cargo:rerun-if-changed` lines):
+//!
+//! ```
+//! let dir = std::env::temp_dir().join(format!("camchain-build-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir)?;
+//! let model = dir.join("pendulum.ron");
+//! std::fs::write(
+//!     &model,
+//!     r#"(
+//!         gravity: (0.0, -9.81, 0.0),
+//!         bodies: [(
+//!             name: "rod", parent: "ground", mass: 1.0, com: (0.5, 0.0, 0.0),
+//!             inertia: Izz(0.083),
+//!             joint: (kind: Revolute, axis: (0.0, 0.0, 1.0), anchor: (0.0, 0.0, 0.0),
+//!                     coordinate: "theta"),
+//!         )],
+//!         initial: (q: {"theta": -1.0}),
+//!     )"#,
+//! )?;
+//! let compiled = camchain_build::Config::new()
+//!     .out_dir(dir.join("out"))
+//!     .emit_rerun_if_changed(false)
+//!     .compile_models(&[&model])?;
+//! assert_eq!(compiled[0].module, "pendulum"); // the file stem, as no `name:` is given
+//! let code = std::fs::read_to_string(&compiled[0].output)?;
+//! assert!(code.contains("pub struct Model;"));
+//! assert!(code.contains("impl rt::Dynamics for Model"));
+//! // A bad value stops the build with the file, line, column and field:
+//! std::fs::write(&model, std::fs::read_to_string(&model)?.replace("mass: 1.0", "mass: 0.0"))?;
+//! let error = camchain_build::Config::new()
+//!     .out_dir(dir.join("out"))
+//!     .emit_rerun_if_changed(false)
+//!     .compile_models(&[&model])
+//!     .unwrap_err();
+//! assert!(error.to_string().contains("pendulum.ron:4:50: bodies[0].mass: "), "{error}");
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! What [`compile_models`] does, per model file: reads and validates it (a bad file stops
 //! the build with `file:line:column: field: message`, the path as given, relative to the
 //! crate), derives the dynamics symbolically, checks that the initial state assembles, and
