@@ -5,30 +5,15 @@
 use camchain_models as models;
 use camchain_reference::NumericModel;
 use camchain_runtime::{Dynamics, Sample, SimSettings, Simulate};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::{camchain, scratch};
+use std::path::Path;
 
 const PAPER_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_normal_force,\
                             A_h,energy,dissipated,driven_work";
 const DRIVEN_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_normal_force,\
                              A_h,q1_drive,energy,dissipated,driven_work";
-
-/// A fresh, empty directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("camchain-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Runs the binary in `dir` with `args`.
-fn camchain(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_camchain"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
