@@ -236,7 +236,7 @@ fn render(rows: &[Row], calls: usize, batches: usize) -> String {
          One evaluation on the same states (8 consistent states 0.5 s apart along the model's \
          run), median of {batches} batches of {calls} calls (RK4: {} steps), generated and \
          numeric batches interleaved in one run. Numeric: the nalgebra recursive Newton–Euler \
-         reference of `runtime/src/reference.rs` on the same model file.\n\n\
+         reference of `reference/src/numeric.rs` on the same model file.\n\n\
          | model | evaluation | generated [ns] | numeric [ns] | numeric / generated |\n\
          |---|---|---:|---:|---:|",
         (calls / 10).max(100)
