@@ -200,7 +200,10 @@ fn integrate(
             let run = match restitution {
                 // One-sided contact runs in phases; its progress is not reported.
                 Some(e) => model.simulate_unilateral(state, settings, e),
-                None => model.simulate_observed(state, settings, &mut |s| progress.update(s.t)),
+                None => model.simulate_observed(state, settings, &mut |s| {
+                    progress.update(s.t);
+                    std::ops::ControlFlow::Continue(())
+                }),
             };
             match run {
                 Ok(trajectory) => (trajectory, None),

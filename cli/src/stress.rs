@@ -224,28 +224,12 @@ fn execute(case: &Case) -> CaseResult {
 
 /// The name of an error's variant.
 fn kind(error: &SimError) -> &'static str {
-    match error {
-        SimError::NewtonFailed { .. } => "NewtonFailed",
-        SimError::SingularConstraint { .. } => "SingularConstraint",
-        SimError::NotPositiveDefinite { .. } => "NotPositiveDefinite",
-        SimError::NonFinite { .. } => "NonFinite",
-        SimError::StepSizeTooSmall { .. } => "StepSizeTooSmall",
-        SimError::TooManySteps { .. } => "TooManySteps",
-        SimError::InvalidSettings { .. } => "InvalidSettings",
-    }
+    error.kind()
 }
 
 /// The time an error happened at (NaN for invalid settings).
 fn error_time(error: &SimError) -> f64 {
-    match error {
-        SimError::NewtonFailed { t, .. }
-        | SimError::SingularConstraint { t, .. }
-        | SimError::NotPositiveDefinite { t, .. }
-        | SimError::NonFinite { t, .. }
-        | SimError::StepSizeTooSmall { t, .. }
-        | SimError::TooManySteps { t } => *t,
-        SimError::InvalidSettings { .. } => f64::NAN,
-    }
+    error.time().unwrap_or(f64::NAN)
 }
 
 /// `1.23e-5`, or `0` for an exact zero, `—` when not available.

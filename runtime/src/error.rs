@@ -92,12 +92,50 @@ pub enum SimError {
         t: f64,
     },
 
+    /// The observer of the run asked it to stop (`ControlFlow::Break` from
+    /// `Simulate::simulate_observed`: an interrupt, an output that could not be written).
+    #[error("stopped at t = {t} s at the observer's request")]
+    Interrupted {
+        /// Time of the last sample (s).
+        t: f64,
+    },
+
     /// Settings, initial data or a requested partition are invalid.
     #[error("invalid settings: {message}")]
     InvalidSettings {
         /// What is wrong.
         message: String,
     },
+}
+
+impl SimError {
+    /// The variant's name, e.g. `NewtonFailed` (for tables and logs).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            SimError::NewtonFailed { .. } => "NewtonFailed",
+            SimError::SingularConstraint { .. } => "SingularConstraint",
+            SimError::NotPositiveDefinite { .. } => "NotPositiveDefinite",
+            SimError::NonFinite { .. } => "NonFinite",
+            SimError::StepSizeTooSmall { .. } => "StepSizeTooSmall",
+            SimError::TooManySteps { .. } => "TooManySteps",
+            SimError::Interrupted { .. } => "Interrupted",
+            SimError::InvalidSettings { .. } => "InvalidSettings",
+        }
+    }
+
+    /// The time the failure happened at (`None` for invalid settings).
+    pub fn time(&self) -> Option<f64> {
+        match self {
+            SimError::NewtonFailed { t, .. }
+            | SimError::SingularConstraint { t, .. }
+            | SimError::NotPositiveDefinite { t, .. }
+            | SimError::NonFinite { t, .. }
+            | SimError::StepSizeTooSmall { t, .. }
+            | SimError::TooManySteps { t }
+            | SimError::Interrupted { t } => Some(*t),
+            SimError::InvalidSettings { .. } => None,
+        }
+    }
 }
 
 /// A coordinate or velocity this large (rad, m, rad/s, m/s) in a failed state means that

@@ -10,6 +10,7 @@
 //! - [`partition`]: choice of the dependent coordinates and the reduced dynamics (15–18).
 //! - [`integrators`]: fixed-step RK4, adaptive Dormand–Prince 5(4) and 8(5,3) with dense
 //!   output.
+//! - [`settings`]: the ranges of the settings a run accepts, checked before it starts.
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
 //! - [`unilateral`]: one-sided contact: lift-off, flight, impact with restitution.
 //! - [`events`]: contact events (force sign changes, lift-off, impact) and their location.
@@ -20,9 +21,11 @@ pub mod error;
 pub mod events;
 pub mod integrators;
 pub mod partition;
+pub mod settings;
 pub mod simulate;
 pub mod unilateral;
 
 pub use dynamics::*;
 pub use error::SimError;
+pub use settings::InvalidSetting;
 pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};

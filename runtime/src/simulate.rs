@@ -25,12 +25,7 @@ use crate::partition::{
 /// 1e-6 of itself changes its local error by a relative 5e-6 (RK4), nothing measurable.
 const LANDING_SLACK: f64 = 1e-6;
 
-/// Accepted steps allowed in one call of `step`/`step_with`, or per output interval of
-/// `simulate`, before [`SimError::TooManySteps`].
-pub const MAX_STEPS_PER_CALL: usize = 10_000_000;
-
-/// Most output intervals `simulate` accepts (a guard against a mistyped `dt_out`).
-const MAX_OUTPUT_INTERVALS: f64 = 1e8;
+pub use crate::settings::MAX_STEPS_PER_CALL;
 
 /// Simulation state: time, full coordinates and velocities, and the private machinery
 /// (partition, workspace, integrator buffers) sized for its model.
@@ -333,7 +328,9 @@ pub trait Simulate: Dynamics {
         state: State,
         settings: &SimSettings,
     ) -> Result<Trajectory, Box<SimFailure>> {
-        run(self, state, settings, SampleLevel::Full, &mut |_| {})
+        run(self, state, settings, SampleLevel::Full, &mut |_| {
+            Observed::Continue(())
+        })
     }
 
     /// [`Simulate::simulate`] that computes only t, q, q̇ and the quadratures at the output
@@ -345,7 +342,9 @@ pub trait Simulate: Dynamics {
         state: State,
         settings: &SimSettings,
     ) -> Result<Trajectory, Box<SimFailure>> {
-        run(self, state, settings, SampleLevel::State, &mut |_| {})
+        run(self, state, settings, SampleLevel::State, &mut |_| {
+            Observed::Continue(())
+        })
     }
 
     /// [`Simulate::simulate`] with one-sided contact: the follower lifts off where the
@@ -358,17 +357,33 @@ pub trait Simulate: Dynamics {
         settings: &SimSettings,
         restitution: f64,
     ) -> Result<Trajectory, Box<SimFailure>> {
-        crate::unilateral::simulate_unilateral(self, state, settings, restitution)
+        crate::unilateral::simulate_unilateral(self, state, settings, restitution, &mut |_| {
+            Observed::Continue(())
+        })
+    }
+
+    /// [`Simulate::simulate_unilateral`] with an observer, as in
+    /// [`Simulate::simulate_observed`].
+    fn simulate_unilateral_observed(
+        &self,
+        state: State,
+        settings: &SimSettings,
+        restitution: f64,
+        observe: &mut dyn FnMut(&Sample) -> Observed,
+    ) -> Result<Trajectory, Box<SimFailure>> {
+        crate::unilateral::simulate_unilateral(self, state, settings, restitution, observe)
     }
 
     /// [`Simulate::simulate`] that also hands the sample at every output time to `observe`
     /// as soon as it is computed, in time order (progress reports, streaming output). The
-    /// trajectory, and every number in it, is the same as that of `simulate`.
+    /// trajectory, and every number in it, is the same as that of `simulate`. When `observe`
+    /// returns `ControlFlow::Break(())` (the user interrupted, a streamed file could not be
+    /// written) the run stops there with [`SimError::Interrupted`] and the samples so far.
     fn simulate_observed(
         &self,
         state: State,
         settings: &SimSettings,
-        observe: &mut dyn FnMut(&Sample),
+        observe: &mut dyn FnMut(&Sample) -> Observed,
     ) -> Result<Trajectory, Box<SimFailure>> {
         run(self, state, settings, SampleLevel::Full, observe)
     }
@@ -406,28 +421,15 @@ fn positive(name: &str, value: f64) -> Result<(), SimError> {
 }
 
 fn validate_integration(settings: &SimSettings) -> Result<(), SimError> {
-    positive("dt", settings.dt)?;
-    if settings.integrator.is_adaptive() {
-        positive("rtol", settings.rtol)?;
-        positive("atol", settings.atol)?;
-    }
-    Ok(())
+    settings.validate_integration().map_err(setting_error)
 }
 
 fn validate_output(settings: &SimSettings, t0: f64) -> Result<(), SimError> {
-    positive("dt_out", settings.dt_out)?;
-    let (t_end, dt_out) = (settings.t_end, settings.dt_out);
-    if !(t_end.is_finite() && t_end >= t0) {
-        return Err(invalid(format!(
-            "t_end = {t_end} must be finite and ≥ t = {t0}"
-        )));
-    }
-    if (t_end - t0) / dt_out > MAX_OUTPUT_INTERVALS {
-        return Err(invalid(format!(
-            "dt_out = {dt_out} gives more than 1e8 samples"
-        )));
-    }
-    Ok(())
+    settings.validate_output(t0).map_err(setting_error)
+}
+
+fn setting_error(e: crate::settings::InvalidSetting) -> SimError {
+    invalid(e.to_string())
 }
 
 fn check_belongs<D: Dynamics + ?Sized>(model: &D, state: &State) -> Result<(), SimError> {
@@ -562,6 +564,13 @@ fn assemble_positions<D: Dynamics + ?Sized>(
     Ok(solved)
 }
 
+/// Where a run hands each sample as soon as it is computed; an error (the observer asked to
+/// stop) ends the run with the samples emitted so far.
+pub(crate) type Emit<'e> = dyn FnMut(Sample) -> Result<(), SimError> + 'e;
+
+/// What an observer of [`Simulate::simulate_observed`] tells the run after each sample.
+pub type Observed = std::ops::ControlFlow<()>;
+
 /// What a sample holds beyond t, q, q̇ and the quadratures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SampleLevel {
@@ -580,7 +589,7 @@ fn run<D: Dynamics + ?Sized>(
     mut state: State,
     settings: &SimSettings,
     level: SampleLevel,
-    observe: &mut dyn FnMut(&Sample),
+    observe: &mut dyn FnMut(&Sample) -> Observed,
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
     if settings.dt_out > 0.0 && settings.t_end.is_finite() && state.t.is_finite() {
@@ -593,8 +602,13 @@ fn run<D: Dynamics + ?Sized>(
     let checks = validate_run(model, &state, settings);
     let outcome = checks.map_err(|e| (e, Stats::default())).and_then(|()| {
         let mut emit = |sample: Sample| {
-            observe(&sample);
+            let flow = observe(&sample);
+            let t = sample.t;
             trajectory.samples.push(sample);
+            match flow {
+                Observed::Continue(()) => Ok(()),
+                Observed::Break(()) => Err(SimError::Interrupted { t }),
+            }
         };
         if settings.integrator.is_adaptive() {
             run_dense(model, &mut state, settings, level, &mut emit, &mut events)
@@ -628,7 +642,7 @@ fn run_landing<D: Dynamics + ?Sized>(
     state: &mut State,
     settings: &SimSettings,
     level: SampleLevel,
-    emit: &mut dyn FnMut(Sample),
+    emit: &mut Emit,
 ) -> RunResult {
     let mut stats = Stats::default();
     let t0 = state.t;
@@ -636,10 +650,10 @@ fn run_landing<D: Dynamics + ?Sized>(
     for k in 0..=intervals {
         let target = output_time(t0, k, intervals, settings);
         let outcome = advance(model, state, target, settings, &mut stats)
-            .and_then(|()| sample_in_place(model, state, level));
-        match outcome {
-            Ok(sample) => emit(sample),
-            Err(error) => return Err((error, stats)),
+            .and_then(|()| sample_in_place(model, state, level))
+            .and_then(|sample| emit(sample));
+        if let Err(error) = outcome {
+            return Err((error, stats));
         }
     }
     Ok(stats)
@@ -653,7 +667,7 @@ fn run_dense<D: Dynamics + ?Sized>(
     state: &mut State,
     settings: &SimSettings,
     level: SampleLevel,
-    emit: &mut dyn FnMut(Sample),
+    emit: &mut Emit,
     events: &mut Vec<ContactEvent>,
 ) -> RunResult {
     let before = all_counters(&state.engine);
@@ -675,7 +689,7 @@ fn dense_loop<D: Dynamics + ?Sized>(
     state: &mut State,
     settings: &SimSettings,
     level: SampleLevel,
-    emit: &mut dyn FnMut(Sample),
+    emit: &mut Emit,
     stats: &mut Stats,
     events: &mut Vec<ContactEvent>,
 ) -> Result<(), SimError> {
@@ -762,7 +776,7 @@ pub(crate) struct Phase<'p, 'w> {
     pub(crate) level: SampleLevel,
     pub(crate) watch: &'p Watch<'w>,
     pub(crate) grid: &'p mut Grid,
-    pub(crate) emit: &'p mut dyn FnMut(Sample),
+    pub(crate) emit: &'p mut Emit<'p>,
     pub(crate) stats: &'p mut Stats,
     pub(crate) events: &'p mut Vec<ContactEvent>,
 }
@@ -779,7 +793,7 @@ impl Phase<'_, '_> {
         }
         let settings = self.settings;
         if self.grid.next == 0 {
-            (self.emit)(sample_in_place(model, state, self.level)?);
+            (self.emit)(sample_in_place(model, state, self.level)?)?;
             self.grid.next = 1;
         }
         let mut sample_ws = state.engine.ws.clone();
@@ -831,7 +845,7 @@ impl Phase<'_, '_> {
                 interpolate_last_step(model, state, settings, t_out, &mut y_out)?;
                 let sample =
                     sample_interpolated(model, state, &mut sample_ws, t_out, &y_out, self.level)?;
-                (self.emit)(sample);
+                (self.emit)(sample)?;
                 self.grid.next += 1;
                 steps_since_output = 0;
             }
@@ -846,7 +860,7 @@ impl Phase<'_, '_> {
                 .pending(settings)
                 .is_some_and(|t_out| t_out <= t_new)
             {
-                (self.emit)(sample_in_place(model, state, self.level)?);
+                (self.emit)(sample_in_place(model, state, self.level)?)?;
                 self.grid.next += 1;
                 steps_since_output = 0;
             }
@@ -2293,10 +2307,39 @@ mod tests {
         let mut seen = Vec::new();
         let state = arm.assemble(0.0).unwrap();
         let observed = arm
-            .simulate_observed(state, &settings, &mut |s| seen.push(s.clone()))
+            .simulate_observed(state, &settings, &mut |s| {
+                seen.push(s.clone());
+                Observed::Continue(())
+            })
             .unwrap();
         assert_eq!(seen, observed.samples);
         assert_eq!(observed, run(&arm, &settings));
+    }
+
+    #[test]
+    fn an_observer_that_breaks_stops_the_run_with_the_samples_so_far() {
+        let arm = Arm::new(true, true).with_spring_damper(5.0, 0.3);
+        for integrator in [IntegratorKind::Rk4, IntegratorKind::Dop853] {
+            let settings = settings(integrator, 1.0, 0.1, 1e-3, 1e-9);
+            let state = arm.assemble(0.0).unwrap();
+            let mut count = 0;
+            let failure = arm
+                .simulate_observed(state, &settings, &mut |_| {
+                    count += 1;
+                    if count == 4 {
+                        Observed::Break(())
+                    } else {
+                        Observed::Continue(())
+                    }
+                })
+                .expect_err("stopped");
+            // Samples at t = 0, 0.1, 0.2, 0.3: the fourth asked to stop.
+            assert_eq!(failure.error, SimError::Interrupted { t: 0.30000000000000004 });
+            let times: Vec<f64> = failure.partial.samples.iter().map(|s| s.t).collect();
+            assert_eq!(times[..4], [0.0, 0.1, 0.2, 0.30000000000000004]);
+            let whole = run(&arm, &settings);
+            assert_eq!(failure.partial.samples[..4], whole.samples[..4]);
+        }
     }
 
     #[test]

@@ -26,8 +26,8 @@ use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, Energy, Mode
 use crate::error::SimError;
 use crate::events::{ContactEvent, EventKind};
 use crate::simulate::{
-    Grid, Phase, SampleLevel, SimFailure, Simulate, State, Stats, Stop, Trajectory, Watch,
-    add_phase_counters, phase_counters, validate_run,
+    Emit, Grid, Observed, Phase, SampleLevel, SimFailure, Simulate, State, Stats, Stop, Trajectory,
+    Watch, add_phase_counters, phase_counters, validate_run,
 };
 use crate::{Sample, SimSettings};
 use nalgebra::{DMatrix, DVector};
@@ -237,12 +237,21 @@ pub fn simulate_unilateral<D: Dynamics + ?Sized>(
     state: State,
     settings: &SimSettings,
     restitution: f64,
+    observe: &mut dyn FnMut(&Sample) -> Observed,
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut trajectory = Trajectory::default();
     let mut events = Vec::new();
     let mut stats = Stats::default();
     let outcome = validate_unilateral(model, &state, settings, restitution).and_then(|()| {
-        let mut emit = |sample: Sample| trajectory.samples.push(sample);
+        let mut emit = |sample: Sample| {
+            let flow = observe(&sample);
+            let t = sample.t;
+            trajectory.samples.push(sample);
+            match flow {
+                Observed::Continue(()) => Ok(()),
+                Observed::Break(()) => Err(SimError::Interrupted { t }),
+            }
+        };
         run_phases(
             model,
             state,
@@ -299,7 +308,7 @@ fn run_phases<D: Dynamics + ?Sized>(
     state: State,
     settings: &SimSettings,
     restitution: f64,
-    emit: &mut dyn FnMut(Sample),
+    emit: &mut Emit,
     stats: &mut Stats,
     events: &mut Vec<ContactEvent>,
 ) -> Result<(), SimError> {
@@ -332,7 +341,7 @@ fn run_phases<D: Dynamics + ?Sized>(
                 let watch = Watch::Gap { gap: &gap };
                 let mut flight_emit = |mut sample: Sample| {
                     complete_flight_sample(model, &mut sample);
-                    emit(sample);
+                    emit(sample)
                 };
                 let stop = run_phase(
                     *detached,
@@ -403,7 +412,7 @@ fn run_phase<D: Dynamics + ?Sized>(
     settings: &SimSettings,
     watch: &Watch,
     grid: &mut Grid,
-    emit: &mut dyn FnMut(Sample),
+    emit: &mut Emit,
     stats: &mut Stats,
     events: &mut Vec<ContactEvent>,
 ) -> Result<Option<Stop>, SimError> {
