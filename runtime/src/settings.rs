@@ -184,7 +184,8 @@ mod tests {
     #[test]
     fn each_setting_out_of_range_is_named() {
         let base = settings(IntegratorKind::Dop853);
-        let cases: [(fn(&mut SimSettings), &str); 8] = [
+        type Edit = fn(&mut SimSettings);
+        let cases: [(Edit, &str); 8] = [
             (|s| s.rtol = 1e-20, "rtol"),
             (|s| s.rtol = 5.0, "rtol"),
             (|s| s.atol = 0.0, "atol"),

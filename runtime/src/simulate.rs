@@ -651,7 +651,7 @@ fn run_landing<D: Dynamics + ?Sized>(
         let target = output_time(t0, k, intervals, settings);
         let outcome = advance(model, state, target, settings, &mut stats)
             .and_then(|()| sample_in_place(model, state, level))
-            .and_then(|sample| emit(sample));
+            .and_then(&mut *emit);
         if let Err(error) = outcome {
             return Err((error, stats));
         }
