@@ -449,15 +449,7 @@ fn normalize(path: &Path) -> PathBuf {
 
 /// A module name must be a Rust identifier that is not a keyword.
 fn check_module_name(module: &str, model: &str, shown: &Path) -> Result<(), Problem> {
-    let mut chars = module.chars();
-    let starts_well = chars
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
-    let valid = starts_well
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-        && module != "_"
-        && !KEYWORDS.contains(&module);
-    if valid {
+    if camchain_codegen::schema::is_identifier(module) {
         Ok(())
     } else {
         Err(Problem::Usage(format!(
@@ -468,15 +460,6 @@ fn check_module_name(module: &str, model: &str, shown: &Path) -> Result<(), Prob
         )))
     }
 }
-
-/// Rust's strict and reserved keywords, which cannot name a module.
-const KEYWORDS: &[&str] = &[
-    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
-    "false", "fn", "for", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub",
-    "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
-    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "gen", "macro",
-    "override", "priv", "try", "typeof", "unsized", "virtual", "yield",
-];
 
 /// The index file: one `pub mod` per model, including its file (relative to the index,
 /// which sits beside them), and the table `ALL` of every model by name.

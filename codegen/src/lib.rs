@@ -57,6 +57,25 @@ pub fn read_model_file(path: &Path, display: &Path) -> Result<String, ModelError
     })
 }
 
+/// Everything the build checks of a model file before it generates code: parsing and
+/// validation ([`schema::parse_model`]), the symbolic derivation ([`Derivation`]) and the
+/// assembly check of the initial state ([`assembly::assemble`]), each problem located in the
+/// file (`file:line:column: field: message`). The command line runs it on a model file before
+/// simulating it on the numeric reference, so that both report the same problems.
+pub fn check_source(source: &str, display: &Path) -> Result<Model, ModelError> {
+    let model = schema::parse_model(source, display)?;
+    check_assembly(&model, source, display)?;
+    Ok(model)
+}
+
+/// The initial state of a validated model assembles onto its cams (located at `initial`).
+fn check_assembly(model: &Model, source: &str, display: &Path) -> Result<(), ModelError> {
+    let derivation = Derivation::new(model);
+    assembly::assemble(model, &derivation)
+        .map(|_| ())
+        .map_err(|message| schema::field_error(display, source, "initial", message))
+}
+
 /// Validates and checks the text of a model file and generates its Rust module: parsing and
 /// validation ([`schema::parse_model`]), the symbolic derivation ([`Derivation`]), the
 /// assembly check of the initial state ([`assembly::assemble`]) and the emission
@@ -67,9 +86,20 @@ pub fn generate_source(
     options: &EmitOptions,
 ) -> Result<Generated, ModelError> {
     let model = schema::parse_model(source, display)?;
-    let derivation = Derivation::new(&model);
-    assembly::assemble(&model, &derivation)
-        .map_err(|message| schema::field_error(display, source, "initial", message))?;
+    if !schema::is_identifier(&model.name) {
+        return Err(schema::field_error(
+            display,
+            source,
+            "name",
+            format!(
+                "model name `{}` is not a valid Rust identifier (ASCII letters, digits and `_`, \
+                 not starting with a digit, not a keyword), and the build names the generated \
+                 module after it: give the model a `name:` (the file name is the default)",
+                model.name
+            ),
+        ));
+    }
+    check_assembly(&model, source, display)?;
     let shown = display.to_string_lossy().replace('\\', "/");
     emit::generate_with(&model, &shown, options).map_err(|message| ModelError {
         file: display.to_path_buf(),

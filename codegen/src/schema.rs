@@ -40,6 +40,8 @@ mod raw;
 mod scan;
 mod validate;
 
+pub use validate::ranges;
+
 use crate::error::ModelError;
 use crate::model::Model;
 use ron::extensions::Extensions;
@@ -60,7 +62,11 @@ pub fn load_model(path: &Path) -> Result<Model, ModelError> {
 
 /// Parses and validates model source text; `file` is used in error messages and for the
 /// default model name (the file stem).
+///
+/// A UTF-8 byte-order mark at the start of the text (as some Windows editors write it) is
+/// skipped.
 pub fn parse_model(source: &str, file: &Path) -> Result<Model, ModelError> {
+    let source = without_bom(source);
     let at = Locator::new(file, source);
     let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
     let parsed: raw::Model = options.from_str(source).map_err(|e| at.ron_error(&e))?;
@@ -85,7 +91,19 @@ pub fn field_error(
     field: &str,
     message: impl Into<String>,
 ) -> ModelError {
-    Locator::new(file, source).error(field, message)
+    Locator::new(file, without_bom(source)).error(field, message)
+}
+
+/// The text without a leading UTF-8 byte-order mark.
+fn without_bom(source: &str) -> &str {
+    source.strip_prefix('\u{feff}').unwrap_or(source)
+}
+
+/// True for an ASCII Rust identifier that is not a keyword: what a model's name must be
+/// for the build to generate a module of that name (the numeric reference runs a model of
+/// any name).
+pub fn is_identifier(name: &str) -> bool {
+    validate::is_identifier(name)
 }
 
 /// Builds located errors for one source text.
@@ -348,23 +366,33 @@ mod tests {
             Err(e) => panic!("{e}"),
         };
         assert_eq!(m.name, "some_chain");
-        let e = match parse_model(&source, Path::new("dir/some-chain.ron")) {
-            Ok(_) => panic!("a stem with `-` is not an identifier"),
+        // Any file name runs on the numeric path; the build needs a module name.
+        let display = Path::new("dir/some chain-v2.ron");
+        let m = parse_model(&source, display).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.name, "some chain-v2");
+        let options = crate::EmitOptions::default();
+        let e = match crate::generate_source(&source, display, &options) {
+            Ok(_) => panic!("`some chain-v2` names no module"),
             Err(e) => e,
         };
         assert_eq!((e.field.as_str(), e.line), ("name", 0));
-        assert!(e.message.contains("some-chain"), "{e}");
+        assert!(e.message.contains("some chain-v2"), "{e}");
     }
 
     #[test]
-    fn rejects_a_keyword_as_model_name() {
-        assert_rejected(
-            "\"test_chain\"",
-            "\"fn\"",
-            "name",
-            3,
-            "not a valid Rust identifier",
+    fn the_build_rejects_a_keyword_as_model_name() {
+        let source = edited("\"test_chain\"", "\"fn\"");
+        assert!(
+            parse_model(&source, &file()).is_ok(),
+            "the numeric path runs it"
         );
+        let options = crate::EmitOptions::default();
+        let e = match crate::generate_source(&source, &file(), &options) {
+            Ok(_) => panic!("`fn` names no module"),
+            Err(e) => e,
+        };
+        assert_eq!((e.field.as_str(), e.line), ("name", 3), "{e}");
+        assert!(e.message.contains("not a valid Rust identifier"), "{e}");
     }
 
     #[test]
@@ -653,13 +681,7 @@ mod tests {
 
     #[test]
     fn rejects_non_positive_simulation_settings() {
-        for (field, value) in [
-            ("t_end", "0"),
-            ("dt_out", "-0.1"),
-            ("dt", "0.0"),
-            ("rtol", "-1e-9"),
-            ("atol", "inf"),
-        ] {
+        for (field, value) in [("t_end", "0"), ("dt_out", "-0.1"), ("dt", "0.0")] {
             let e = assert_rejected(
                 "simulation: (t_end: 5, integrator: Rk4)",
                 &format!("simulation: (integrator: Rk4, {field}: {value})"),
@@ -669,6 +691,58 @@ mod tests {
             );
             assert!(e.column > 0, "{e}");
         }
+    }
+
+    #[test]
+    fn rejects_tolerances_and_sample_counts_out_of_the_runtime_s_ranges() {
+        // The same bounds as camchain_runtime::settings (compared in camchain-reference).
+        for (field, value, message) in [
+            ("rtol", "1e-20", "rtol must be in [1e-14, 1e-1], got 1e-20"),
+            ("rtol", "5", "rtol must be in [1e-14, 1e-1], got 5e0"),
+            ("atol", "0", "atol must be in [1e-18, 1e0], got 0e0"),
+            ("atol", "inf", "atol must be in [1e-18, 1e0], got inf"),
+        ] {
+            assert_rejected(
+                "simulation: (t_end: 5, integrator: Rk4)",
+                &format!("simulation: (t_end: 5, integrator: Dop853, {field}: {value})"),
+                &format!("simulation.{field}"),
+                36,
+                message,
+            );
+        }
+        assert_rejected(
+            "simulation: (t_end: 5, integrator: Rk4)",
+            "simulation: (t_end: 1e12, integrator: Rk4)",
+            "simulation.dt_out",
+            36,
+            "gives 1.000e14 samples, more than the 1e6 a run keeps",
+        );
+    }
+
+    #[test]
+    fn integrators_are_named_in_any_letter_case() {
+        for name in ["Dop853", "dop853", "DOP853"] {
+            let source = edited("integrator: Rk4", &format!("integrator: {name}"));
+            let m = parse_model(&source, &file()).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(m.simulation.integrator, IntegratorChoice::Dop853, "{name}");
+        }
+        assert_rejected(
+            "integrator: Rk4",
+            "integrator: Euler",
+            "simulation.integrator",
+            36,
+            "unknown integrator (one of rk4, dopri5, dop853, in any letter case), found `Euler`",
+        );
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let with_bom = format!("\u{feff}{BASE}");
+        let m = parse_model(&with_bom, &file()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.name, "test_chain");
+        // Errors are located as in the same file without the mark.
+        let e = error_of(&format!("\u{feff}{}", edited("mass: 0.5", "mass: -1")));
+        assert_eq!((e.line, e.column), (21, 19), "{e}");
     }
 
     #[test]

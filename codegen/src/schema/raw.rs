@@ -4,7 +4,7 @@
 //! [`super::validate`]. The type names appear in ron's messages ("unexpected field named
 //! `foo` in `Joint`"), so they are named after the file's concepts.
 
-use serde::de::{MapAccess, Visitor};
+use serde::de::{EnumAccess, MapAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::fmt;
 
@@ -140,11 +140,74 @@ pub(super) struct Initial {
     pub hold: Vec<String>,
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
+/// An integrator, named in any letter case (`Dop853`, `dop853`, `DOP853`): the command line
+/// spells it `dop853`, the file traditionally `Dop853`, and both mean the same.
+#[derive(Debug, Clone, Copy)]
 pub(super) enum Integrator {
     Rk4,
     Dopri5,
     Dop853,
+}
+
+/// The integrators' names, as the command line spells them.
+pub(super) const INTEGRATORS: [&str; 3] = ["rk4", "dopri5", "dop853"];
+
+impl<'de> Deserialize<'de> for Integrator {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_enum(
+            "Integrator",
+            &["Rk4", "Dopri5", "Dop853"],
+            IntegratorVisitor,
+        )
+    }
+}
+
+struct IntegratorVisitor;
+
+impl<'de> Visitor<'de> for IntegratorVisitor {
+    type Value = Integrator;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        write!(f, "an integrator: {}", INTEGRATORS.join(", "))
+    }
+
+    fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Integrator, E> {
+        match name.to_ascii_lowercase().as_str() {
+            "rk4" => Ok(Integrator::Rk4),
+            "dopri5" => Ok(Integrator::Dopri5),
+            "dop853" => Ok(Integrator::Dop853),
+            // The located error appends ", found `<name>`".
+            _ => Err(E::custom(format!(
+                "unknown integrator (one of {}, in any letter case)",
+                INTEGRATORS.join(", ")
+            ))),
+        }
+    }
+
+    fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Integrator, A::Error> {
+        let (name, variant): (Identifier, _) = data.variant()?;
+        variant.unit_variant()?;
+        self.visit_str(&name.0)
+    }
+}
+
+/// A bare identifier (an enum variant's name as written).
+struct Identifier(String);
+
+impl<'de> Deserialize<'de> for Identifier {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Name;
+        impl Visitor<'_> for Name {
+            type Value = Identifier;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a name")
+            }
+            fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Identifier, E> {
+                Ok(Identifier(name.to_string()))
+            }
+        }
+        deserializer.deserialize_identifier(Name)
+    }
 }
 
 #[derive(Debug, Deserialize)]

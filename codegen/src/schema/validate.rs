@@ -56,25 +56,21 @@ pub(super) fn validate(file: &raw::Model, stem: &str, at: &Locator) -> Checked<M
     })
 }
 
+/// The model's name: `name:`, or the file stem. Any non-empty text: only the build needs a
+/// Rust identifier (it names the generated module) and checks that itself.
 fn model_name(name: Option<&str>, stem: &str, at: &Locator) -> Checked<String> {
-    match name {
-        Some(name) => {
-            identifier(at, "name", name, "model name")?;
-            Ok(name.to_string())
-        }
-        None if is_identifier(stem) => Ok(stem.to_string()),
-        None => Err(at.error(
+    let name = name.unwrap_or(stem);
+    if name.trim().is_empty() || name.chars().any(char::is_control) {
+        return Err(at.error(
             "name",
-            format!(
-                "the model name defaults to the file stem `{stem}`, which is not a valid Rust \
-                 identifier; add `name: \"...\"`"
-            ),
-        )),
+            format!("the model name {name:?} is empty or has control characters"),
+        ));
     }
+    Ok(name.to_string())
 }
 
 /// True for an ASCII Rust identifier that is not a keyword.
-fn is_identifier(name: &str) -> bool {
+pub(crate) fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
     let starts_well = chars
         .next()
@@ -588,18 +584,69 @@ fn coordinate_values(
     Ok(out)
 }
 
+/// The ranges of the runtime's settings (`camchain_runtime::settings`; a test in
+/// `camchain-reference` checks that both accept and refuse the same values).
+pub mod ranges {
+    /// Relative tolerances of the adaptive integrators.
+    pub const RTOL: (f64, f64) = (1e-14, 0.1);
+    /// Absolute tolerances of the adaptive integrators.
+    pub const ATOL: (f64, f64) = (1e-18, 1.0);
+    /// The most samples of a run, t_end / dt_out.
+    pub const MAX_SAMPLES: f64 = 1e6;
+    /// The most RK4 steps per output interval, dt_out / dt.
+    pub const MAX_RK4_STEPS: f64 = 1e7;
+}
+
 fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulation> {
     let field = |name: &str| format!("simulation.{name}");
+    let integrator = match s.integrator {
+        raw::Integrator::Rk4 => IntegratorChoice::Rk4,
+        raw::Integrator::Dopri5 => IntegratorChoice::Dopri5,
+        raw::Integrator::Dop853 => IntegratorChoice::Dop853,
+    };
+    let t_end = positive(at, &field("t_end"), "t_end", s.t_end)?;
+    let dt_out = positive(at, &field("dt_out"), "dt_out", s.dt_out)?;
+    let dt = positive(at, &field("dt"), "dt", s.dt)?;
+    let samples = t_end / dt_out;
+    if samples > ranges::MAX_SAMPLES {
+        return Err(at.error(
+            &field("dt_out"),
+            format!(
+                "t_end = {t_end} s with dt_out = {dt_out} s gives {samples:.3e} samples, more \
+                 than the {:e} a run keeps: a larger dt_out or a smaller t_end",
+                ranges::MAX_SAMPLES
+            ),
+        ));
+    }
+    let adaptive = !matches!(integrator, IntegratorChoice::Rk4);
+    if !adaptive && dt_out / dt > ranges::MAX_RK4_STEPS {
+        return Err(at.error(
+            &field("dt"),
+            format!(
+                "an rk4 step of {dt:e} s needs {:.1e} steps per output interval (dt_out = \
+                 {dt_out:e} s), more than the {:e} allowed",
+                dt_out / dt,
+                ranges::MAX_RK4_STEPS
+            ),
+        ));
+    }
+    // Checked whatever the file's integrator: they are the defaults of any adaptive run.
+    let in_range = |name: &str, value: f64, (low, high): (f64, f64)| {
+        if value.is_finite() && (low..=high).contains(&value) {
+            Ok(value)
+        } else {
+            Err(at.error(
+                &field(name),
+                format!("{name} must be in [{low:e}, {high:e}], got {value:e}"),
+            ))
+        }
+    };
     Ok(Simulation {
-        t_end: positive(at, &field("t_end"), "t_end", s.t_end)?,
-        dt_out: positive(at, &field("dt_out"), "dt_out", s.dt_out)?,
-        integrator: match s.integrator {
-            raw::Integrator::Rk4 => IntegratorChoice::Rk4,
-            raw::Integrator::Dopri5 => IntegratorChoice::Dopri5,
-            raw::Integrator::Dop853 => IntegratorChoice::Dop853,
-        },
-        dt: positive(at, &field("dt"), "dt", s.dt)?,
-        rtol: positive(at, &field("rtol"), "rtol", s.rtol)?,
-        atol: positive(at, &field("atol"), "atol", s.atol)?,
+        t_end,
+        dt_out,
+        integrator,
+        dt,
+        rtol: in_range("rtol", s.rtol, ranges::RTOL)?,
+        atol: in_range("atol", s.atol, ranges::ATOL)?,
     })
 }
