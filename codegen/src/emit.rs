@@ -367,7 +367,7 @@ fn info_static(model: &Model) -> String {
          coordinates: Vec::from([{coords}]),\n\
          contacts: Vec::from([{contacts}]),\n\
          spatial: {spatial},\n\
-         initial: rt::InitialGuess {{ q: Vec::from({q}), qd: Vec::from({qd}), hold: Vec::from({hold:?}) }},\n\
+         initial: rt::InitialGuess {{ q: Vec::from({q}), qd: Vec::from({qd}), hold: Vec::from({hold:?}), given_q: Vec::from({given_q:?}), given_qd: Vec::from({given_qd:?}) }},\n\
          defaults: rt::SimSettings {{ t_end: {t_end}, dt_out: {dt_out}, integrator: rt::IntegratorKind::{integrator}, dt: {dt}, rtol: {rtol}, atol: {atol} }},\n\
          }});\n",
         name = model.name,
@@ -378,6 +378,8 @@ fn info_static(model: &Model) -> String {
         q = float_list(&model.initial.q),
         qd = float_list(&model.initial.qd),
         hold = model.initial.hold,
+        given_q = model.initial.given_q,
+        given_qd = model.initial.given_qd,
         t_end = lit(s.t_end),
         dt_out = lit(s.dt_out),
         dt = lit(s.dt),

@@ -143,6 +143,10 @@ pub struct Initial {
     pub qd: Vec<f64>,
     /// `hold[i]`: coordinate i keeps its guessed value during assembly.
     pub hold: Vec<bool>,
+    /// `given_q[i]`: the file gives coordinate i's guess (otherwise it is 0).
+    pub given_q: Vec<bool>,
+    /// `given_qd[i]`: the file gives velocity i's guess (otherwise it is 0).
+    pub given_qd: Vec<bool>,
 }
 
 /// A complete, validated model.

@@ -44,6 +44,8 @@ pub fn model_info(model: &Model) -> ModelInfo {
             q: model.initial.q.clone(),
             qd: model.initial.qd.clone(),
             hold: model.initial.hold.clone(),
+            given_q: model.initial.given_q.clone(),
+            given_qd: model.initial.given_qd.clone(),
         },
         defaults: SimSettings {
             t_end: model.simulation.t_end,
@@ -699,6 +701,8 @@ mod tests {
                 q: vec![0.0; n],
                 qd: vec![0.0; n],
                 hold: vec![false; n],
+                given_q: vec![false; n],
+                given_qd: vec![false; n],
             },
             simulation: Simulation {
                 t_end: 1.0,

@@ -72,6 +72,11 @@ pub struct InitialGuess {
     pub qd: Vec<f64>,
     /// `hold[i]`: assembly keeps coordinate i at its guess.
     pub hold: Vec<bool>,
+    /// `given_q[i]`: the model file gives coordinate i's guess (else it defaults to 0);
+    /// assembly warns when it has to move a given value far or a drive overrides it.
+    pub given_q: Vec<bool>,
+    /// `given_qd[i]`: the model file gives velocity i's guess.
+    pub given_qd: Vec<bool>,
 }
 
 /// Static description of a model.

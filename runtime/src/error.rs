@@ -29,9 +29,10 @@ pub enum SimError {
 
     /// The constraint Jacobian J (5b) has no usable column: no set of eligible coordinates
     /// gives an invertible J_v, so the dependent coordinates cannot be chosen or solved.
+    /// With the contact point on the cam this is a dead point: the mechanism locks.
     #[error(
-        "at t = {t} s the constraint Jacobian J (5b) has no usable column for the dependent \
-         coordinates (J_v singular) at q = {}",
+        "at t = {t} s {}; q = {}",
+        SingularCause(*.on_cam, *.residual),
         Compact(.q)
     )]
     SingularConstraint {
@@ -39,6 +40,10 @@ pub enum SimError {
         t: f64,
         /// Coordinates.
         q: Vec<f64>,
+        /// max |h| there (m).
+        residual: f64,
+        /// True when |h| is within Newton's tolerance (the point is on the cam).
+        on_cam: bool,
     },
 
     /// The reduced mass matrix M* of eq. (18) is not positive definite (an invalid model:
@@ -134,6 +139,30 @@ impl SimError {
             | SimError::TooManySteps { t }
             | SimError::Interrupted { t } => Some(*t),
             SimError::InvalidSettings { .. } => None,
+        }
+    }
+}
+
+/// What a singular constraint Jacobian means, on the cam (a dead point) or off it.
+struct SingularCause(bool, f64);
+
+impl fmt::Display for SingularCause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let SingularCause(on_cam, residual) = *self;
+        if on_cam {
+            write!(
+                f,
+                "the mechanism locks at a dead point: the contact point is on the cam (|h| = \
+                 {residual:.1e} m) but no coordinate free to move can move it across the cam (the \
+                 usable columns of the constraint Jacobian J (5b) vanish)"
+            )
+        } else {
+            write!(
+                f,
+                "no coordinate free to move can move the contact point across the cam (J_v \
+                 singular) while it is off the cam (|h| = {residual:.3e} m): no held, driven or \
+                 dependent choice can put it back"
+            )
         }
     }
 }

@@ -6,6 +6,7 @@
 //! thiserror. Most programs reach it through the `camchain` facade as `camchain::runtime`.
 //!
 //! Module map:
+//! - [`assembly`]: a consistent initial state, and the report of what assembly changed.
 //! - [`dynamics`]: the [`Dynamics`] trait every model implements (eqs. 3–8, 13).
 //! - [`partition`]: choice of the dependent coordinates and the reduced dynamics (15–18).
 //! - [`integrators`]: fixed-step RK4, adaptive Dormand–Prince 5(4) and 8(5,3) with dense
@@ -16,6 +17,7 @@
 //! - [`events`]: contact events (force sign changes, lift-off, impact) and their location.
 //! - [`error`]: simulation errors with time and state.
 
+pub mod assembly;
 pub mod dynamics;
 pub mod error;
 pub mod events;

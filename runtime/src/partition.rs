@@ -33,12 +33,19 @@ use std::sync::Arc;
 /// lose accuracy and the step size drop near J_v = 0.
 pub const REPARTITION_RATIO: f64 = 0.2;
 
-/// Newton (15) converges when max_k |h_k| is at most this (m, or rad for angular
-/// constraints): 1e-12 is ~10⁴ times the round-off of h for coordinates of order 1.
+/// Newton (15) converges when max_k |h_k| is at most this times the model's length scale
+/// (m, or rad for angular constraints): 1e-12 is ~10⁴ times the round-off of h for
+/// coordinates of order 1. The length scale ([`Workspace::set_length_scale`]: the largest
+/// contact-point coordinate at assembly, at least 1) keeps the tolerance that far above the
+/// round-off of a model written in millimetres or placed far from the origin.
 pub const NEWTON_RESIDUAL_TOLERANCE: f64 = 1e-12;
 
 /// Newton (15) also requires its last correction to be at most this times (1 + ‖v‖∞).
 pub const NEWTON_STEP_TOLERANCE: f64 = 1e-12;
+
+/// Entries of J below this times the model's length scale are round-off
+/// ([`Workspace::jacobian_floor`]).
+const JACOBIAN_FLOOR: f64 = 1e-12;
 
 /// Newton (15) gives up after this many corrections.
 pub const NEWTON_MAX_ITERATIONS: usize = 25;
@@ -151,7 +158,7 @@ fn dependent_determinant(j: &[f64], nc: usize, n: usize, dependent: &[usize]) ->
         (&mut heap[..], &mut heap_pivots[..])
     };
     gather_columns(j, n, dependent, a);
-    if lu_factor(a, pivots, nc) {
+    if lu_factor(a, pivots, nc, 0.0) {
         lu_determinant(a, pivots, nc)
     } else {
         0.0
@@ -306,6 +313,8 @@ pub struct Workspace {
     udd: Vec<f64>,
     pub(crate) lambda: Vec<f64>,
     pub(crate) drive: Vec<f64>,
+    /// The lengths of the model (≥ 1): scales Newton's residual tolerance.
+    length_scale: f64,
 }
 
 impl Workspace {
@@ -338,7 +347,54 @@ impl Workspace {
             udd: vec![0.0; nu],
             lambda: vec![0.0; nc],
             drive: vec![0.0; n],
+            length_scale: 1.0,
         }
+    }
+
+    /// Sets the model's length scale (the largest contact-point coordinate, in the model's
+    /// length unit), which multiplies [`NEWTON_RESIDUAL_TOLERANCE`]; values below 1 count
+    /// as 1.
+    pub fn set_length_scale(&mut self, scale: f64) {
+        self.length_scale = if scale.is_finite() {
+            scale.max(1.0)
+        } else {
+            1.0
+        };
+    }
+
+    /// The model's length scale (≥ 1).
+    pub fn length_scale(&self) -> f64 {
+        self.length_scale
+    }
+
+    /// Entries of J (and pivots of J_v) at or below this are round-off, not a lever arm:
+    /// J has the units of a length per coordinate unit, so 1e-12 of the model's length
+    /// scale. A J_v this small is a dead point, not an unreachable cam.
+    pub fn jacobian_floor(&self) -> f64 {
+        JACOBIAN_FLOOR * self.length_scale
+    }
+
+    /// [`choose_dependent`] on the J last evaluated, with the entries at or below
+    /// [`Self::jacobian_floor`] counted as zero.
+    pub fn choose_dependent(&self, eligible: &[bool]) -> Option<Vec<usize>> {
+        let floor = self.jacobian_floor();
+        let usable = self.nc == 0
+            || self
+                .jacobian
+                .iter()
+                .enumerate()
+                .any(|(k, x)| eligible[k % self.n] && x.abs() > floor);
+        if usable {
+            choose_dependent(&self.jacobian, self.nc, self.n, eligible)
+        } else {
+            None
+        }
+    }
+
+    /// Newton's residual tolerance for this model: [`NEWTON_RESIDUAL_TOLERANCE`] times the
+    /// length scale.
+    pub fn residual_tolerance(&self) -> f64 {
+        NEWTON_RESIDUAL_TOLERANCE * self.length_scale
     }
 
     /// Coordinates q.
@@ -395,7 +451,7 @@ impl Workspace {
             let residual = self.constraint_residual(model, t)?;
             self.factor_jacobian_for_newton(model, dependent, t, residual, iterations)?;
             let next = self.pending_correction(dependent);
-            if residual <= NEWTON_RESIDUAL_TOLERANCE
+            if residual <= self.residual_tolerance()
                 && next <= NEWTON_STEP_TOLERANCE * (1.0 + self.v_size(dependent))
             {
                 return Ok(iterations);
@@ -455,7 +511,7 @@ impl Workspace {
             }
             model.constraint(&self.q, &mut self.h);
             let trial = euclidean(&self.h);
-            let small = max_abs(&self.h) <= NEWTON_RESIDUAL_TOLERANCE;
+            let small = max_abs(&self.h) <= self.residual_tolerance();
             if trial.is_finite() && (small || trial < (1.0 - 1e-4 * fraction) * norm) {
                 return Ok(fraction * max_abs(&self.scratch));
             }
@@ -481,7 +537,7 @@ impl Workspace {
         iterations: usize,
     ) -> Result<(), SimError> {
         match self.factor_current_jacobian(dependent, t) {
-            Err(SimError::SingularConstraint { .. }) if residual > NEWTON_RESIDUAL_TOLERANCE => {
+            Err(SimError::SingularConstraint { .. }) if residual > self.residual_tolerance() => {
                 Err(self.newton_failure(t, residual, iterations))
             }
             other => other,
@@ -505,7 +561,7 @@ impl Workspace {
     }
 
     fn converged(&self, residual: f64, last_correction: f64, dependent: &[usize]) -> bool {
-        residual <= NEWTON_RESIDUAL_TOLERANCE
+        residual <= self.residual_tolerance()
             && last_correction <= NEWTON_STEP_TOLERANCE * (1.0 + self.v_size(dependent))
     }
 
@@ -597,13 +653,23 @@ impl Workspace {
             return Err(self.non_finite(t, "J"));
         }
         gather_columns(&self.jacobian, self.n, dependent, &mut self.jv_lu);
-        if lu_factor(&mut self.jv_lu, &mut self.pivots, self.nc) {
+        let floor = self.jacobian_floor();
+        if lu_factor(&mut self.jv_lu, &mut self.pivots, self.nc, floor) {
             Ok(())
         } else {
-            Err(SimError::SingularConstraint {
-                t,
-                q: self.q.clone(),
-            })
+            Err(self.singular(t))
+        }
+    }
+
+    /// [`SimError::SingularConstraint`] at the current q, with the residual of the h last
+    /// evaluated.
+    pub(crate) fn singular(&self, t: f64) -> SimError {
+        let residual = max_abs(&self.h);
+        SimError::SingularConstraint {
+            t,
+            q: self.q.clone(),
+            residual,
+            on_cam: residual <= self.residual_tolerance(),
         }
     }
 
@@ -996,11 +1062,11 @@ fn euclidean(x: &[f64]) -> f64 {
 /// In-place LU factorisation with partial pivoting of the n×n row-major `a` (P A = L U, L
 /// unit lower, both stored in `a`; `pivots[k]` is the row swapped with row k at step k).
 /// Returns false when a pivot is zero or not finite.
-fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize) -> bool {
+fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize, floor: f64) -> bool {
     if n == 1 {
         // One contact (the paper's case): J_v is a number.
         pivots[0] = 0;
-        return a[0] != 0.0 && a[0].is_finite();
+        return a[0].abs() > floor && a[0].is_finite();
     }
     for k in 0..n {
         let p = (k..n).fold(k, |best, r| {
@@ -1017,7 +1083,7 @@ fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize) -> bool {
             }
         }
         let pivot = a[k * n + k];
-        if pivot == 0.0 || !pivot.is_finite() {
+        if pivot.abs() <= floor || !pivot.is_finite() {
             return false;
         }
         for r in k + 1..n {
@@ -1336,7 +1402,7 @@ mod tests {
                 .solve(&DVector::from_column_slice(&b))
                 .unwrap();
             let (mut lu, mut pivots) = (a.clone(), vec![0; n]);
-            assert!(lu_factor(&mut lu, &mut pivots, n));
+            assert!(lu_factor(&mut lu, &mut pivots, n, 0.0));
             let (mut x, mut x_t) = (b.clone(), b.clone());
             lu_solve(&lu, &pivots, n, &mut x);
             lu_solve_transposed(&lu, &pivots, n, &mut x_t);
@@ -1376,7 +1442,7 @@ mod tests {
         ws.qdd = numbers.vector(n);
         let dependent = choose_dependent(&ws.jacobian, nc, n, &eligible).unwrap();
         gather_columns(&ws.jacobian, n, &dependent, &mut ws.jv_lu);
-        assert!(lu_factor(&mut ws.jv_lu, &mut ws.pivots, nc));
+        assert!(lu_factor(&mut ws.jv_lu, &mut ws.pivots, nc, 0.0));
         (ws, Partition::new(driven, &dependent).unwrap())
     }
 

@@ -25,6 +25,7 @@ use crate::partition::{
 /// 1e-6 of itself changes its local error by a relative 5e-6 (RK4), nothing measurable.
 const LANDING_SLACK: f64 = 1e-6;
 
+pub use crate::assembly::AssemblyReport;
 pub use crate::settings::MAX_STEPS_PER_CALL;
 
 /// Simulation state: time, full coordinates and velocities, and the private machinery
@@ -65,7 +66,7 @@ struct Engine {
 }
 
 impl State {
-    fn new(t: f64, ws: Workspace, partition: Partition) -> Self {
+    pub(crate) fn new(t: f64, ws: Workspace, partition: Partition) -> Self {
         let nu = partition.independent().len();
         let dim = integrated_len(&partition);
         let engine = Engine {
@@ -258,7 +259,14 @@ pub trait Simulate: Dynamics {
     /// kept, the dependent ones solve J q̇ = 0 (16). Then the integration partition is chosen
     /// among all non-driven coordinates.
     fn assemble(&self, t0: f64) -> Result<State, SimError> {
-        assemble_state(self, t0)
+        crate::assembly::assemble(self, t0).map(|(state, _)| state)
+    }
+
+    /// [`Simulate::assemble`], with a report of what assembly changed in the model's guess
+    /// (solved coordinates, values set by drives, velocities from J q̇ = 0) and how it chose
+    /// among the roots of h = 0 (the one nearest the guess, for one contact).
+    fn assemble_reported(&self, t0: f64) -> Result<(State, AssemblyReport), SimError> {
+        crate::assembly::assemble(self, t0)
     }
 
     /// A state at time `t` from given coordinates and velocities (e.g. to restart from a
@@ -267,7 +275,7 @@ pub trait Simulate: Dynamics {
     /// and their velocities from (16); the others are kept.
     fn state_at(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<State, SimError> {
         let hold = vec![false; self.info().n()];
-        assemble_from(self, t, (q, qd), &hold)
+        crate::assembly::assemble_from(self, t, (q, qd), &hold).map(|(state, _)| state)
     }
 
     /// Advances `state` by `dt` with the model's default settings.
@@ -406,7 +414,7 @@ fn store_dependent(partition: &Partition, y: &mut [f64], q: &[f64], qd: &[f64]) 
     }
 }
 
-fn invalid(message: String) -> SimError {
+pub(crate) fn invalid(message: String) -> SimError {
     SimError::InvalidSettings { message }
 }
 
@@ -461,107 +469,6 @@ fn check_finite_state(state: &State) -> Result<(), SimError> {
         q: state.q.clone(),
         qd: state.qd.clone(),
     })
-}
-
-fn assemble_state<D: Dynamics + ?Sized>(model: &D, t0: f64) -> Result<State, SimError> {
-    let initial = &model.info().initial;
-    assemble_from(model, t0, (&initial.q, &initial.qd), &initial.hold)
-}
-
-/// A consistent state at t0 from (q, q̇): held and driven coordinates keep their values, the
-/// dependent ones are solved by Newton (15) and (16).
-pub(crate) fn assemble_from<D: Dynamics + ?Sized>(
-    model: &D,
-    t0: f64,
-    (q, qd): (&[f64], &[f64]),
-    hold: &[bool],
-) -> Result<State, SimError> {
-    let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
-    let driven: Vec<bool> = info.coordinates.iter().map(|c| c.driven).collect();
-    validate_model(model, &driven, t0)?;
-    if q.len() != n || qd.len() != n || hold.len() != n {
-        return Err(invalid(format!("{} needs {n} coordinates", info.name)));
-    }
-    let nu = n - nc - driven.iter().filter(|d| **d).count();
-    let mut ws = Workspace::new(n, nc, nu);
-    ws.set_state(q, qd);
-    model.prescribed(t0, &mut ws.q, &mut ws.qd, &mut ws.qdd);
-    if ws.q().iter().chain(ws.qd()).any(|x| !x.is_finite()) {
-        return Err(ws.non_finite(t0, "initial guess"));
-    }
-    let solved = assemble_positions(model, &mut ws, &driven, hold, t0)?;
-    ws.factor_jacobian(model, &solved, t0)?;
-    ws.solve_velocities(&solved);
-    let eligible: Vec<bool> = driven.iter().map(|d| !d).collect();
-    let dependent = choose_dependent(&ws.jacobian, nc, n, &eligible).ok_or_else(|| {
-        SimError::SingularConstraint {
-            t: t0,
-            q: ws.q().to_vec(),
-        }
-    })?;
-    let partition = Partition::new(&driven, &dependent)?;
-    Ok(State::new(t0, ws, partition))
-}
-
-fn validate_model<D: Dynamics + ?Sized>(
-    model: &D,
-    driven: &[bool],
-    t0: f64,
-) -> Result<(), SimError> {
-    let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
-    let initial = &info.initial;
-    if !t0.is_finite() {
-        return Err(invalid(format!("t0 = {t0} must be finite")));
-    }
-    if n == 0 {
-        return Err(invalid(format!("{} has no coordinates", info.name)));
-    }
-    if initial.q.len() != n || initial.qd.len() != n || initial.hold.len() != n {
-        return Err(invalid(format!(
-            "the initial guess of {} must have {n} entries",
-            info.name
-        )));
-    }
-    let free = driven.iter().filter(|d| !**d).count();
-    if free < nc {
-        return Err(invalid(format!(
-            "{}: {nc} contacts but only {free} free coordinates",
-            info.name
-        )));
-    }
-    Ok(())
-}
-
-/// Chooses the coordinates to solve among those neither held nor driven (largest |J_i|)
-/// and solves h = 0 for them (plain Newton, then backtracking Newton).
-fn assemble_positions<D: Dynamics + ?Sized>(
-    model: &D,
-    ws: &mut Workspace,
-    driven: &[bool],
-    hold: &[bool],
-    t0: f64,
-) -> Result<Vec<usize>, SimError> {
-    let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
-    let solvable: Vec<bool> = (0..n).map(|i| !driven[i] && !hold[i]).collect();
-    model.constraint_jacobian(&ws.q, &mut ws.jacobian);
-    if ws.jacobian.iter().any(|x| !x.is_finite()) {
-        return Err(ws.non_finite(t0, "J"));
-    }
-    let solved = choose_dependent(&ws.jacobian, nc, n, &solvable).ok_or_else(|| {
-        SimError::SingularConstraint {
-            t: t0,
-            q: ws.q().to_vec(),
-        }
-    })?;
-    let guess = ws.q().to_vec();
-    if ws.solve_positions(model, &solved, t0).is_err() {
-        ws.q.copy_from_slice(&guess);
-        ws.solve_positions_damped(model, &solved, t0)?;
-    }
-    Ok(solved)
 }
 
 /// Where a run hands each sample as soon as it is computed; an error (the observer asked to
@@ -1589,6 +1496,8 @@ mod tests {
                 q: vec![x0, y0 + 0.05],
                 qd: vec![xd0, 0.0],
                 hold: vec![true, false],
+                given_q: vec![true; 2],
+                given_qd: vec![true; 2],
             };
             let coordinates = vec![
                 coordinate("x", CoordinateKind::Prismatic, false),
@@ -1724,6 +1633,8 @@ mod tests {
                 q: vec![0.0, -std::f64::consts::FRAC_PI_2 + 0.3, 0.4],
                 qd: vec![0.3, 0.5, 0.0],
                 hold: vec![true, true, false],
+                given_q: vec![true; 3],
+                given_qd: vec![true; 3],
             };
             let info = model_info("arm", coordinates, usize::from(cam), initial);
             Self {
@@ -2334,7 +2245,12 @@ mod tests {
                 })
                 .expect_err("stopped");
             // Samples at t = 0, 0.1, 0.2, 0.3: the fourth asked to stop.
-            assert_eq!(failure.error, SimError::Interrupted { t: 0.30000000000000004 });
+            assert_eq!(
+                failure.error,
+                SimError::Interrupted {
+                    t: 0.30000000000000004
+                }
+            );
             let times: Vec<f64> = failure.partial.samples.iter().map(|s| s.t).collect();
             assert_eq!(times[..4], [0.0, 0.1, 0.2, 0.30000000000000004]);
             let whole = run(&arm, &settings);

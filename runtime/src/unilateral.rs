@@ -173,7 +173,13 @@ fn impact<D: Dynamics + ?Sized>(
     let normal_velocity: f64 = row.iter().zip(qd).map(|(a, b)| a * b).sum();
     let m_ff = DMatrix::from_fn(free.len(), free.len(), |a, b| m[free[a] * n + free[b]]);
     let j_f = DVector::from_iterator(free.len(), free.iter().map(|&i| row[i]));
-    let singular = || SimError::SingularConstraint { t, q: q.to_vec() };
+    // A landing point is on the cam: a singular M_ff or zero J_f there locks the impact.
+    let singular = || SimError::SingularConstraint {
+        t,
+        q: q.to_vec(),
+        residual: 0.0,
+        on_cam: true,
+    };
     let x = m_ff.cholesky().ok_or_else(singular)?.solve(&j_f);
     let denominator = j_f.dot(&x);
     if !(denominator > 0.0 && denominator.is_finite()) {

@@ -99,6 +99,8 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
         q: Vec::from([-1.6707963267948966, 0.0, 0.0, 0.0]),
         qd: Vec::from([0.0, 0.0, 0.0, 0.0]),
         hold: Vec::from([true, true, false, true]),
+        given_q: Vec::from([true, true, true, true]),
+        given_qd: Vec::from([false, false, false, false]),
     },
     defaults: rt::SimSettings {
         t_end: 10.0,

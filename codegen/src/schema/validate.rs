@@ -535,8 +535,8 @@ fn initial(file: &raw::Initial, bodies: &[Body], at: &Locator) -> Checked<Initia
         .enumerate()
         .map(|(i, b)| (b.joint.coordinate.as_str(), i))
         .collect();
-    let q = coordinate_values(at, "initial.q", &file.q, &by_name)?;
-    let qd = coordinate_values(at, "initial.qd", &file.qd, &by_name)?;
+    let (q, given_q) = coordinate_values(at, "initial.q", &file.q, &by_name)?;
+    let (qd, given_qd) = coordinate_values(at, "initial.qd", &file.qd, &by_name)?;
     let mut hold: Vec<bool> = bodies
         .iter()
         .map(|b| b.joint.prescribed.is_some())
@@ -550,16 +550,23 @@ fn initial(file: &raw::Initial, bodies: &[Body], at: &Locator) -> Checked<Initia
         }
         hold[i] = true;
     }
-    Ok(Initial { q, qd, hold })
+    Ok(Initial {
+        q,
+        qd,
+        hold,
+        given_q,
+        given_qd,
+    })
 }
 
-/// `{"name": value}` → a value per coordinate in body order, 0 where absent.
+/// `{"name": value}` → a value per coordinate in body order, 0 where absent, and which
+/// were given.
 fn coordinate_values(
     at: &Locator,
     path: &str,
     values: &raw::NamedValues,
     index: &HashMap<&str, usize>,
-) -> Checked<Vec<f64>> {
+) -> Checked<(Vec<f64>, Vec<bool>)> {
     let mut out = vec![0.0; index.len()];
     let mut given = vec![false; index.len()];
     for (k, (name, value)) in values.0.iter().enumerate() {
@@ -581,7 +588,7 @@ fn coordinate_values(
             return Err(at.error_located(&field, &entry, message));
         };
     }
-    Ok(out)
+    Ok((out, given))
 }
 
 /// The ranges of the runtime's settings (`camchain_runtime::settings`; a test in

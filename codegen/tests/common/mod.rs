@@ -116,6 +116,8 @@ pub fn paper_concave() -> Model {
             q: vec![-std::f64::consts::FRAC_PI_2 - 0.1, 0.0, 0.0, 0.0],
             qd: vec![0.0; 4],
             hold: vec![true, true, false, true],
+            given_q: vec![true; 4],
+            given_qd: vec![false; 4],
         },
         simulation: Simulation {
             t_end: 10.0,
@@ -236,6 +238,8 @@ pub fn spatial_tree() -> Model {
             q: vec![0.0; 5],
             qd: vec![0.0; 5],
             hold: vec![false; 5],
+            given_q: vec![false; 5],
+            given_qd: vec![false; 5],
         },
         simulation: Simulation {
             t_end: 1.0,

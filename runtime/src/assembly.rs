@@ -1,0 +1,342 @@
+//! Assembly of a consistent initial state (docs/method.md §5.9), and the report of what it
+//! changed.
+//!
+//! Held and driven coordinates keep their values (a drive sets its own); one coordinate per
+//! contact, among the others, is solved from h(q) = 0. With one contact the solved
+//! coordinate moves to the root of h nearest its guess: h is scanned outwards from the
+//! guess in both directions (over ±π for an angle, ± the model's length scale for a
+//! displacement) and the first sign change bracketed and refined, so that the mechanism is
+//! assembled in the configuration the guess describes rather than in whichever branch
+//! Newton happens to converge to. Without a sign change within reach, and for several
+//! contacts, Newton (15) runs from the guess, with a backtracking Newton as fallback. The
+//! velocities of the solved coordinates then follow from J q̇ = 0 (16).
+
+use crate::dynamics::{ContactGeometry, CoordinateKind, Dynamics};
+use crate::error::SimError;
+use crate::partition::{Partition, Workspace};
+use crate::simulate::{State, invalid};
+use std::f64::consts::PI;
+
+/// What assembly did to the model's initial guess.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AssemblyReport {
+    /// Every coordinate or velocity whose value assembly changed beyond round-off, in
+    /// coordinate order (positions first).
+    pub changes: Vec<AssemblyChange>,
+    /// How the solved coordinates were found.
+    pub root: RootChoice,
+}
+
+/// One value assembly changed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AssemblyChange {
+    /// Index of the coordinate.
+    pub coordinate: usize,
+    /// True for its velocity, false for its position.
+    pub velocity: bool,
+    /// The guess (the model file's value, or 0 where it gives none).
+    pub from: f64,
+    /// The assembled value.
+    pub to: f64,
+    /// Why it changed.
+    pub cause: ChangeCause,
+    /// True when the model file gave the guess (rather than its default 0).
+    pub given: bool,
+}
+
+/// Why assembly changed a value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ChangeCause {
+    /// The coordinate is driven: its drive sets position and velocity at t0.
+    Drive,
+    /// Solved from the constraint: the position from h = 0, the velocity from J q̇ = 0.
+    Constraint,
+}
+
+/// How the solved coordinates were found.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum RootChoice {
+    /// No contact: nothing to solve.
+    #[default]
+    NoContact,
+    /// The guess was on the cam already.
+    AtGuess,
+    /// One contact: the root of h nearest the guess, found by scanning up to `reach`
+    /// (rad or m) on both sides of it.
+    Nearest {
+        /// How far from the guess the scan went before it found the root.
+        distance: f64,
+    },
+    /// Newton (15) from the guess: several contacts (the scan is one-dimensional), or no
+    /// sign change of h within reach of the guess (`scanned` says which).
+    Newton {
+        /// True when a scan found no root within reach (one contact).
+        scanned: bool,
+    },
+}
+
+/// Steps of the scan on each side of the guess.
+const SCAN_STEPS: usize = 128;
+
+/// Assembles the model's own initial guess at t0, with the report.
+pub(crate) fn assemble<D: Dynamics + ?Sized>(
+    model: &D,
+    t0: f64,
+) -> Result<(State, AssemblyReport), SimError> {
+    let initial = &model.info().initial;
+    assemble_from(model, t0, (&initial.q, &initial.qd), &initial.hold)
+}
+
+/// A consistent state at t0 from (q, q̇): held and driven coordinates keep their values, one
+/// coordinate per contact is solved from h = 0 (nearest root for one contact) and the
+/// velocities of the solved ones from J q̇ = 0 (16).
+pub(crate) fn assemble_from<D: Dynamics + ?Sized>(
+    model: &D,
+    t0: f64,
+    (q, qd): (&[f64], &[f64]),
+    hold: &[bool],
+) -> Result<(State, AssemblyReport), SimError> {
+    let info = model.info();
+    let (n, nc) = (info.n(), info.n_contacts());
+    let driven: Vec<bool> = info.coordinates.iter().map(|c| c.driven).collect();
+    validate_model(model, &driven, t0)?;
+    if q.len() != n || qd.len() != n || hold.len() != n {
+        return Err(invalid(format!("{} needs {n} coordinates", info.name)));
+    }
+    let nu = n - nc - driven.iter().filter(|d| **d).count();
+    let mut ws = Workspace::new(n, nc, nu);
+    ws.set_state(q, qd);
+    model.prescribed(t0, &mut ws.q, &mut ws.qd, &mut ws.qdd);
+    if ws.q().iter().chain(ws.qd()).any(|x| !x.is_finite()) {
+        return Err(ws.non_finite(t0, "initial guess"));
+    }
+    ws.set_length_scale(length_scale(model, ws.q()));
+    let (solved, root) = assemble_positions(model, &mut ws, &driven, hold, t0)?;
+    ws.factor_jacobian(model, &solved, t0)?;
+    ws.solve_velocities(&solved);
+    let eligible: Vec<bool> = driven.iter().map(|d| !d).collect();
+    let dependent = ws
+        .choose_dependent(&eligible)
+        .ok_or_else(|| ws.singular(t0))?;
+    let partition = Partition::new(&driven, &dependent)?;
+    let report = AssemblyReport {
+        changes: changes(model, (q, qd), (ws.q(), ws.qd()), &driven),
+        root,
+    };
+    Ok((State::new(t0, ws, partition), report))
+}
+
+/// The values that differ between the guess and the assembled state (beyond a relative
+/// 1e-12, round-off of Newton's last step).
+fn changes<D: Dynamics + ?Sized>(
+    model: &D,
+    (q, qd): (&[f64], &[f64]),
+    (q_new, qd_new): (&[f64], &[f64]),
+    driven: &[bool],
+) -> Vec<AssemblyChange> {
+    let initial = &model.info().initial;
+    let given = |flags: &[bool], i: usize| flags.get(i).copied().unwrap_or(false);
+    let mut out = Vec::new();
+    for (velocity, from, to, flags) in [
+        (false, q, q_new, &initial.given_q),
+        (true, qd, qd_new, &initial.given_qd),
+    ] {
+        for i in 0..from.len() {
+            let (a, b) = (from[i], to[i]);
+            if (a - b).abs() <= 1e-12 * (1.0 + a.abs().max(b.abs())) {
+                continue;
+            }
+            out.push(AssemblyChange {
+                coordinate: i,
+                velocity,
+                from: a,
+                to: b,
+                cause: if driven[i] {
+                    ChangeCause::Drive
+                } else {
+                    ChangeCause::Constraint
+                },
+                given: given(flags, i),
+            });
+        }
+    }
+    out
+}
+
+/// The model's length scale for Newton's tolerance: the largest coordinate of a contact
+/// point (ground frame) at q.
+fn length_scale<D: Dynamics + ?Sized>(model: &D, q: &[f64]) -> f64 {
+    let mut contacts = vec![ContactGeometry::default(); model.info().n_contacts()];
+    model.contact_geometry(q, &mut contacts);
+    contacts
+        .iter()
+        .flat_map(|c| c.position)
+        .filter(|x| x.is_finite())
+        .fold(1.0_f64, |m, x| m.max(x.abs()))
+}
+
+fn validate_model<D: Dynamics + ?Sized>(
+    model: &D,
+    driven: &[bool],
+    t0: f64,
+) -> Result<(), SimError> {
+    let info = model.info();
+    let (n, nc) = (info.n(), info.n_contacts());
+    let initial = &info.initial;
+    if !t0.is_finite() {
+        return Err(invalid(format!("t0 = {t0} must be finite")));
+    }
+    if n == 0 {
+        return Err(invalid(format!("{} has no coordinates", info.name)));
+    }
+    if initial.q.len() != n || initial.qd.len() != n || initial.hold.len() != n {
+        return Err(invalid(format!(
+            "the initial guess of {} must have {n} entries",
+            info.name
+        )));
+    }
+    let free = driven.iter().filter(|d| !**d).count();
+    if free < nc {
+        return Err(invalid(format!(
+            "{}: {nc} contacts but only {free} free coordinates",
+            info.name
+        )));
+    }
+    Ok(())
+}
+
+/// Chooses the coordinates to solve among those neither held nor driven (largest |J_i|)
+/// and solves h = 0 for them: for one contact at the root nearest the guess when a scan
+/// finds one, otherwise by Newton, then backtracking Newton.
+fn assemble_positions<D: Dynamics + ?Sized>(
+    model: &D,
+    ws: &mut Workspace,
+    driven: &[bool],
+    hold: &[bool],
+    t0: f64,
+) -> Result<(Vec<usize>, RootChoice), SimError> {
+    let info = model.info();
+    let (n, nc) = (info.n(), info.n_contacts());
+    if nc == 0 {
+        return Ok((Vec::new(), RootChoice::NoContact));
+    }
+    let solvable: Vec<bool> = (0..n).map(|i| !driven[i] && !hold[i]).collect();
+    model.constraint_jacobian(&ws.q, &mut ws.jacobian);
+    if ws.jacobian.iter().any(|x| !x.is_finite()) {
+        return Err(ws.non_finite(t0, "J"));
+    }
+    model.constraint(&ws.q, &mut ws.h);
+    let solved = ws
+        .choose_dependent(&solvable)
+        .ok_or_else(|| ws.singular(t0))?;
+    let guess = ws.q().to_vec();
+    let on_cam = ws.h.iter().all(|h| h.abs() <= ws.residual_tolerance());
+    let root = match solved.as_slice() {
+        _ if on_cam => RootChoice::AtGuess,
+        [v] => match nearest_root(model, ws, *v) {
+            Some((value, distance)) => {
+                ws.q[*v] = value;
+                RootChoice::Nearest { distance }
+            }
+            None => RootChoice::Newton { scanned: true },
+        },
+        _ => RootChoice::Newton { scanned: false },
+    };
+    if ws.solve_positions(model, &solved, t0).is_err() {
+        ws.q.copy_from_slice(&guess);
+        ws.solve_positions_damped(model, &solved, t0)?;
+    }
+    Ok((solved, root))
+}
+
+/// The root of h (one contact) along coordinate `v` nearest its current value, and its
+/// distance from it: h is sampled at [`SCAN_STEPS`] points on each side, out to π for an
+/// angle or to the model's length scale for a displacement; the first bracket (the
+/// nearer one when both sides change sign at the same distance) is refined by
+/// regula falsi. `None` when h changes sign nowhere within reach.
+fn nearest_root<D: Dynamics + ?Sized>(model: &D, ws: &Workspace, v: usize) -> Option<(f64, f64)> {
+    let reach = match model.info().coordinates[v].kind {
+        CoordinateKind::Revolute => PI,
+        CoordinateKind::Prismatic => ws.length_scale(),
+    };
+    let step = reach / SCAN_STEPS as f64;
+    let mut q = ws.q().to_vec();
+    let guess = q[v];
+    let mut h = [0.0];
+    let mut at = |x: f64, q: &mut Vec<f64>| {
+        q[v] = x;
+        model.constraint(q, &mut h);
+        h[0]
+    };
+    let h0 = at(guess, &mut q);
+    if !h0.is_finite() {
+        return None;
+    }
+    let mut last = [(guess, h0), (guess, h0)];
+    for k in 1..=SCAN_STEPS {
+        let mut found: Option<(f64, f64)> = None;
+        for (side, sign) in [1.0, -1.0].into_iter().enumerate() {
+            let x = guess + sign * k as f64 * step;
+            let hx = at(x, &mut q);
+            let (x_prev, h_prev) = last[side];
+            if !hx.is_finite() {
+                continue;
+            }
+            if h_prev.is_finite() && (hx == 0.0 || hx.signum() != h_prev.signum()) {
+                let root = refine(&mut at, &mut q, (x_prev, h_prev), (x, hx));
+                let distance = (root - guess).abs();
+                if found.is_none_or(|(_, d)| distance < d) {
+                    found = Some((root, distance));
+                }
+            }
+            last[side] = (x, hx);
+        }
+        if found.is_some() {
+            return found;
+        }
+    }
+    None
+}
+
+/// A root of h in the bracket [a, b] (h(a), h(b) of opposite signs) by the Illinois
+/// variant of regula falsi, to round-off of x (Newton (15) then polishes it).
+fn refine(
+    h: &mut impl FnMut(f64, &mut Vec<f64>) -> f64,
+    q: &mut Vec<f64>,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+) -> f64 {
+    if fb == 0.0 {
+        return b;
+    }
+    // Which end was kept by the last step: halving its value when it is kept twice in a
+    // row is what keeps regula falsi from converging from one side only.
+    let mut kept = 0;
+    for _ in 0..200 {
+        if (b - a).abs() <= 4.0 * f64::EPSILON * (a.abs().max(b.abs()) + 1.0) {
+            break;
+        }
+        let mut x = (a * fb - b * fa) / (fb - fa);
+        if !(x.is_finite() && x > a.min(b) && x < a.max(b)) {
+            x = 0.5 * (a + b);
+        }
+        let fx = h(x, q);
+        if fx == 0.0 || !fx.is_finite() {
+            return x;
+        }
+        if fx.signum() == fb.signum() {
+            (b, fb) = (x, fx);
+            if kept == -1 {
+                fa *= 0.5;
+            }
+            kept = -1;
+        } else {
+            (a, fa) = (x, fx);
+            if kept == 1 {
+                fb *= 0.5;
+            }
+            kept = 1;
+        }
+    }
+    if fa.abs() < fb.abs() { a } else { b }
+}
