@@ -155,6 +155,9 @@ pub struct CompiledModel {
     pub source: PathBuf,
     /// The generated file.
     pub output: PathBuf,
+    /// Warnings about values that are valid but look mistaken (an angle of 90 rad:
+    /// degrees?), located like errors; printed as `cargo:warning` lines in a build script.
+    pub warnings: Vec<String>,
 }
 
 impl Config {
@@ -247,14 +250,18 @@ impl Config {
         write_dir(&out_dir)?;
         let mut compiled = Vec::new();
         let mut problems = Vec::new();
-        for (module, source, code) in generated {
+        for (module, (name, shown, warnings), code) in generated {
             let output = out_dir.join(format!("{module}.rs"));
+            for warning in &warnings {
+                self.cargo_directive("warning", warning);
+            }
             match write_if_changed(&output, &code) {
                 Ok(()) => compiled.push(CompiledModel {
-                    name: source.0,
+                    name,
                     module,
-                    source: source.1,
+                    source: shown,
                     output,
+                    warnings,
                 }),
                 Err(e) => problems.push(Problem::Io(output, e.to_string())),
             }
@@ -323,23 +330,30 @@ impl Config {
     }
 
     fn rerun_if_changed(&self, path: &Path) {
+        self.cargo_directive("rerun-if-changed", &path.display().to_string());
+    }
+
+    /// Prints `cargo:<key>=<value>` when running as a build script (see
+    /// [`Config::emit_rerun_if_changed`]).
+    fn cargo_directive(&self, key: &str, value: &str) {
         if self.rerun_if_changed {
-            println!("cargo:rerun-if-changed={}", path.display());
+            println!("cargo:{key}={value}");
         }
     }
 
-    /// Generates every model: (module, (model name, shown path), code), in the order given.
+    /// Generates every model: (module, (model name, shown path, warnings), code), in the
+    /// order given.
     #[allow(clippy::type_complexity)]
     fn generate_all(
         &self,
         files: &[(PathBuf, PathBuf)],
-    ) -> Result<Vec<(String, (String, PathBuf), String)>, Error> {
+    ) -> Result<Vec<(String, (String, PathBuf, Vec<String>), String)>, Error> {
         let mut problems = Vec::new();
         let mut generated = Vec::new();
         let mut owners: BTreeMap<String, PathBuf> = BTreeMap::new();
         for (file, shown) in files {
             match self.generate_one(file, shown) {
-                Ok((name, code)) => {
+                Ok((name, code, warnings)) => {
                     let module = self
                         .module_names
                         .get(&name)
@@ -356,14 +370,14 @@ impl Config {
                         )));
                     } else {
                         owners.insert(module.clone(), shown.clone());
-                        generated.push((module, (name, shown.clone()), code));
+                        generated.push((module, (name, shown.clone(), warnings), code));
                     }
                 }
                 Err(e) => problems.push(Problem::Model(e)),
             }
         }
         for model in self.module_names.keys() {
-            if !generated.iter().any(|(_, (name, _), _)| name == model) && problems.is_empty() {
+            if !generated.iter().any(|(_, (name, ..), _)| name == model) && problems.is_empty() {
                 problems.push(Problem::Usage(format!(
                     "Config::module_name names model `{model}`, which none of the files \
                      compiled defines"
@@ -377,15 +391,24 @@ impl Config {
         }
     }
 
-    /// Generates one model file: its model name and module text.
-    fn generate_one(&self, file: &Path, shown: &Path) -> Result<(String, String), ModelError> {
+    /// Generates one model file: its model name, module text and warnings.
+    fn generate_one(
+        &self,
+        file: &Path,
+        shown: &Path,
+    ) -> Result<(String, String, Vec<String>), ModelError> {
         let text = read_model_file(file, shown)?;
         let mut options = self.options.clone();
         if self.embed_source {
             options.embedded_source = Some(text.clone());
         }
         let generated = generate_source(&text, shown, &options)?;
-        Ok((generated.name, generated.code))
+        let model = camchain_codegen::schema::parse_model(&text, shown)?;
+        let warnings = camchain_codegen::located_warnings(&model, &text, shown)
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        Ok((generated.name, generated.code, warnings))
     }
 }
 

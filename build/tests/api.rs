@@ -220,3 +220,42 @@ fn a_missing_file_is_named() {
     assert!(error.to_string().starts_with(&expected), "{error}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_value_that_looks_like_degrees_is_a_located_warning_not_an_error() {
+    let dir = scratch("degrees", &["double_pendulum"]);
+    let path = dir.join("models/double_pendulum.ron");
+    let text = std::fs::read_to_string(&path).expect("copied");
+    let edited = text.replacen("\"q2\": 0.8", "\"q2\": 45.0", 1);
+    assert_ne!(edited, text);
+    std::fs::write(&path, &edited).expect("written");
+    let compiled = config(&dir.join("out"))
+        .compile_models(&[&path])
+        .unwrap_or_else(|e| panic!("a warning does not fail the build: {e}"));
+    let line = edited
+        .lines()
+        .position(|l| l.contains("45.0"))
+        .expect("edited")
+        + 1;
+    // Located at the entry `"q2": 45.0`, as an error in it would be.
+    let column = edited
+        .lines()
+        .nth(line - 1)
+        .and_then(|l| l.find("\"q2\""))
+        .expect("key")
+        + 1;
+    assert_eq!(compiled[0].warnings.len(), 1, "{:?}", compiled[0].warnings);
+    let warning = &compiled[0].warnings[0];
+    assert!(
+        warning.starts_with(&format!(
+            "{}:{line}:{column}: initial.q[\"q2\"]: ",
+            path.display()
+        )),
+        "{warning}"
+    );
+    assert!(
+        warning.contains("45 rad") && warning.contains("degrees?"),
+        "{warning}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -8,6 +8,7 @@
 //! - [`expr`]: the hash-consed symbolic expression DAG: folding, differentiation,
 //!   interpretation and operation counts.
 //! - [`linear`]: the pass that collects nested sums into linear combinations.
+//! - [`lint`]: warnings for valid models that look mistaken (degrees for radians, …).
 //! - [`kinematics`]: forward recursion of rotations, positions, velocities, accelerations (9).
 //! - [`constraint`]: contact point f1, f2, J1, J2, convective terms and h, J, c (1–8).
 //! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (10–13), and energies.
@@ -23,6 +24,7 @@ pub mod error;
 pub mod expr;
 pub mod kinematics;
 pub mod linear;
+pub mod lint;
 pub mod model;
 pub mod profile;
 pub mod schema;
@@ -66,6 +68,15 @@ pub fn check_source(source: &str, display: &Path) -> Result<Model, ModelError> {
     let model = schema::parse_model(source, display)?;
     check_assembly(&model, source, display)?;
     Ok(model)
+}
+
+/// The warnings of [`lint::warnings`] for a validated model, located in its file like errors
+/// (`file:line:column: field: message`).
+pub fn located_warnings(model: &Model, source: &str, display: &Path) -> Vec<ModelError> {
+    lint::warnings(model)
+        .into_iter()
+        .map(|w| schema::field_error(display, source, &w.field, w.message))
+        .collect()
 }
 
 /// The initial state of a validated model assembles onto its cams (located at `initial`).
