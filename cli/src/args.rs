@@ -161,21 +161,24 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub dt_out: Option<f64>,
 
-    /// Integrator: rk4 (fixed step --dt) or dopri5 (adaptive, --rtol/--atol, first step
-    /// --dt) [default: the model's]
-    #[arg(long, value_enum, value_name = "NAME")]
+    /// Integrator, in any letter case as in model files: rk4 (fixed step --dt), dopri5 or
+    /// dop853 (adaptive, --rtol/--atol, first step --dt; dop853 is the fastest at tight
+    /// tolerances) [default: the model's]
+    #[arg(long, value_enum, value_name = "NAME", ignore_case = true)]
     pub integrator: Option<IntegratorArg>,
 
-    /// Step in seconds: fixed step of rk4, first step of dopri5 [default: the model's]
+    /// Step in seconds: fixed step of rk4, first step of dopri5 and dop853 [default: the
+    /// model's]
     #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub dt: Option<f64>,
 
-    /// Relative tolerance of dopri5 [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = positive_number, allow_hyphen_values = true)]
+    /// Relative tolerance of dopri5 and dop853, in [1e-14, 0.1] [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = relative_tolerance, allow_hyphen_values = true)]
     pub rtol: Option<f64>,
 
-    /// Absolute tolerance of dopri5 [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = positive_number, allow_hyphen_values = true)]
+    /// Absolute tolerance of dopri5 and dop853 (rad, m, rad/s, m/s), in [1e-18, 1]
+    /// [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = absolute_tolerance, allow_hyphen_values = true)]
     pub atol: Option<f64>,
 
     /// One-sided contact: the follower lifts off where the normal force reaches zero and
@@ -296,9 +299,27 @@ fn positive(text: &str, what: &str) -> Result<f64, String> {
     }
 }
 
-/// A positive, finite tolerance.
-fn positive_number(text: &str) -> Result<f64, String> {
-    positive(text, "a tolerance")
+/// A tolerance in `range` (the runtime's, `camchain_runtime::settings`).
+fn tolerance(text: &str, (low, high): (f64, f64)) -> Result<f64, String> {
+    let value = positive(text, "a tolerance")?;
+    if (low..=high).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!(
+            "{value:e} is outside [{low:e}, {high:e}]: below, the error estimate is round-off \
+             (the steps shrink until the run fails); above, there is no accuracy left"
+        ))
+    }
+}
+
+/// A relative tolerance in the runtime's range.
+fn relative_tolerance(text: &str) -> Result<f64, String> {
+    tolerance(text, camchain_runtime::settings::RTOL_RANGE)
+}
+
+/// An absolute tolerance in the runtime's range.
+fn absolute_tolerance(text: &str) -> Result<f64, String> {
+    tolerance(text, camchain_runtime::settings::ATOL_RANGE)
 }
 
 /// A positive, finite time in seconds.

@@ -64,19 +64,23 @@ pub fn row(info: &ModelInfo, sample: &Sample) -> Vec<f64> {
 /// Writes the header and every sample.
 pub fn write(out: &mut dyn Write, info: &ModelInfo, samples: &[Sample]) -> io::Result<()> {
     writeln!(out, "{}", header(info).join(","))?;
-    let mut line = String::new();
     for sample in samples {
-        line.clear();
-        for (i, value) in row(info, sample).iter().enumerate() {
-            if i > 0 {
-                line.push(',');
-            }
-            line.push_str(&format!("{value:?}"));
-        }
-        line.push('\n');
-        out.write_all(line.as_bytes())?;
+        write_row(out, info, sample)?;
     }
     out.flush()
+}
+
+/// Writes one sample's row (a line of [`row`]'s values, round-trip formatted).
+pub fn write_row(out: &mut dyn Write, info: &ModelInfo, sample: &Sample) -> io::Result<()> {
+    let mut line = String::new();
+    for (i, value) in row(info, sample).iter().enumerate() {
+        if i > 0 {
+            line.push(',');
+        }
+        line.push_str(&format!("{value:?}"));
+    }
+    line.push('\n');
+    out.write_all(line.as_bytes())
 }
 
 #[cfg(test)]

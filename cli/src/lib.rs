@@ -4,8 +4,10 @@
 //! Modules (private but for [`scenarios`], which the stress tests use):
 //! - `args`: the syntax (clap) and the settings it overrides;
 //! - `source`: which model a MODEL argument names, generated or numeric;
+//! - `plan`: what `simulate` checks before it runs or writes anything;
 //! - `simulate`: the `simulate` command, run by run;
-//! - `progress`, `summary`, `csv`, `output`: what a run shows and writes;
+//! - `progress`, `summary`, `csv`, `output`: what a run shows and writes; `interrupt`:
+//!   Ctrl-C during a run;
 //! - `kinematics`, `figures`, `plots`: the figures after the paper's figures 3–6;
 //! - `list`: the `list` command;
 //! - `ops`: the `ops` command (operation counts of the generated functions);
@@ -14,17 +16,20 @@
 //! - `bench`: the `bench` command (the measurements of `BENCHMARKS.md`).
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
-//! for a usage error (bad option or value, unknown model name) and 1 for anything else (a
-//! model file missing or invalid, a failed run, a file that could not be written).
+//! for a usage error (bad option or value, unknown model name), 130 for a run interrupted
+//! by Ctrl-C and 1 for anything else (a model file missing or invalid, a failed run, a file
+//! that could not be written).
 
 mod args;
 mod bench;
 mod csv;
 mod figures;
+mod interrupt;
 mod kinematics;
 mod list;
 mod ops;
 mod output;
+mod plan;
 mod plots;
 mod progress;
 pub mod scenarios;
@@ -47,6 +52,8 @@ pub enum CliError {
     Failed(String),
     /// Failures already reported as they happened (exit code 1).
     Reported,
+    /// Interrupted by Ctrl-C, already reported (exit code 130).
+    Interrupted,
 }
 
 impl std::fmt::Display for CliError {
@@ -54,6 +61,7 @@ impl std::fmt::Display for CliError {
         match self {
             CliError::Usage(message) | CliError::Failed(message) => f.write_str(message),
             CliError::Reported => f.write_str("failed (reported above)"),
+            CliError::Interrupted => f.write_str("interrupted (reported above)"),
         }
     }
 }
@@ -63,6 +71,7 @@ impl CliError {
         match self {
             CliError::Usage(_) => ExitCode::from(2),
             CliError::Failed(_) | CliError::Reported => ExitCode::from(1),
+            CliError::Interrupted => ExitCode::from(interrupt::EXIT_CODE),
         }
     }
 }
@@ -94,7 +103,7 @@ pub fn main() -> ExitCode {
                 CliError::Usage(message) | CliError::Failed(message) => {
                     eprintln!("error: {message}");
                 }
-                CliError::Reported => {}
+                CliError::Reported | CliError::Interrupted => {}
             }
             error.exit_code()
         }

@@ -6,17 +6,20 @@
 //! beside it and renamed into place once complete; anything else (a FIFO, a character
 //! device such as `/dev/stdout` or a null device, a socket) is written directly and never
 //! replaced, so that its reader gets the data and the node stays what it was. A symbolic
-//! link to a regular file is followed: its target is replaced, the link kept. The CSV of a
-//! run that failed is saved as `<name>.partial.csv` beside a regular destination, and an
-//! older `<name>.csv` from an earlier run is removed so that it cannot pass for this run's;
-//! a special destination gets nothing on failure (it is opened and closed, so that a reader
-//! waiting on a FIFO sees the end of the data instead of blocking).
+//! link to a regular file is followed: its target is replaced, the link kept.
+//!
+//! A run's CSV streams to `<name>.partial.csv` while it runs ([`CsvSink`]) and takes its
+//! final name only when complete: a failed or interrupted run leaves an existing result
+//! untouched and its own rows in the partial file. A special destination gets nothing from
+//! a failed run (it is opened and closed, so that a reader waiting on a FIFO sees the end of
+//! the data instead of blocking).
 
 use super::csv;
 use camchain_runtime::{ModelInfo, Sample};
 use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// Where a run's CSV goes.
 #[derive(Debug, Clone, PartialEq)]
@@ -175,9 +178,137 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_file(path, |out| out.write_all(bytes))
 }
 
-/// Saves the CSV of a run: complete under its name, or partial under
-/// [`partial_path`] when the run failed.
-pub fn save_csv(
+/// Where a run's CSV rows go while it runs.
+///
+/// A regular (or new) destination gets the rows as they are computed, in
+/// `<name>.partial.csv` beside it (flushed at least every second, so a crash keeps what was
+/// computed); the complete file is renamed to the destination when the run ends, so an
+/// existing result is only ever replaced by a complete new one, and a failed or interrupted
+/// run leaves the destination as it was. Standard output and special files (FIFO, device)
+/// get the CSV at the end of a complete run only.
+pub enum CsvSink {
+    /// Rows streamed to `partial`, renamed to `dest` when complete.
+    Stream {
+        /// The final name (a link's target for a symbolic link).
+        dest: PathBuf,
+        /// `<name>.partial.csv` beside it.
+        partial: PathBuf,
+        /// The open partial file.
+        out: BufWriter<fs::File>,
+        /// Rows written.
+        rows: usize,
+        /// When the rows were last flushed to the file.
+        flushed: Instant,
+    },
+    /// Written at the end, from the trajectory.
+    AtEnd(CsvTarget),
+}
+
+/// How often a streamed CSV is flushed to its file.
+const FLUSH_EVERY: Duration = Duration::from_secs(1);
+
+impl CsvSink {
+    /// Opens the sink of `target`; for a regular destination this creates (or truncates a
+    /// stale) `<name>.partial.csv` and writes the header.
+    pub fn open(target: &CsvTarget, info: &ModelInfo) -> Result<Self, String> {
+        let path = match target {
+            CsvTarget::File(path) => path,
+            CsvTarget::Stdout => return Ok(CsvSink::AtEnd(target.clone())),
+        };
+        let dest = match destination(path) {
+            Ok(Destination::Replaceable(real)) => real,
+            Ok(Destination::Special) => return Ok(CsvSink::AtEnd(target.clone())),
+            Err(e) => return Err(format!("cannot write {}: {e}", path.display())),
+        };
+        let partial = partial_path(&dest);
+        let file = fs::File::create(&partial)
+            .map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
+        let mut out = BufWriter::new(file);
+        writeln!(out, "{}", csv::header(info).join(","))
+            .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+        Ok(CsvSink::Stream {
+            dest,
+            partial,
+            out,
+            rows: 0,
+            flushed: Instant::now(),
+        })
+    }
+
+    /// Appends a sample's row (streamed sinks only).
+    pub fn row(&mut self, info: &ModelInfo, sample: &Sample) -> io::Result<()> {
+        if let CsvSink::Stream {
+            out, rows, flushed, ..
+        } = self
+        {
+            csv::write_row(out, info, sample)?;
+            *rows += 1;
+            if flushed.elapsed() >= FLUSH_EVERY {
+                out.flush()?;
+                *flushed = Instant::now();
+            }
+        }
+        Ok(())
+    }
+
+    /// Ends the CSV of a run: a complete one takes its final name (or is written out, for
+    /// standard output and special files); a failed one keeps its rows in the partial file
+    /// (removed when it holds none), and the destination is never touched.
+    pub fn finish(
+        self,
+        info: &ModelInfo,
+        samples: &[Sample],
+        complete: bool,
+    ) -> Result<Saved, String> {
+        match self {
+            CsvSink::Stream {
+                dest,
+                partial,
+                out,
+                rows,
+                ..
+            } => finish_stream(&dest, &partial, out, rows, complete),
+            CsvSink::AtEnd(target) => save_at_end(&target, info, samples, complete),
+        }
+    }
+}
+
+fn finish_stream(
+    dest: &Path,
+    partial: &Path,
+    out: BufWriter<fs::File>,
+    rows: usize,
+    complete: bool,
+) -> Result<Saved, String> {
+    let closed = out
+        .into_inner()
+        .map_err(|e| e.into_error())
+        .and_then(|file| file.sync_all());
+    if let Err(e) = closed {
+        return Err(format!("cannot write {}: {e}", partial.display()));
+    }
+    if complete {
+        fs::rename(partial, dest).map_err(|e| {
+            format!(
+                "cannot rename {} to {}: {e}",
+                partial.display(),
+                dest.display()
+            )
+        })?;
+        Ok(Saved::Complete(Some(dest.to_path_buf())))
+    } else if rows == 0 {
+        // Only the header: the file this run created says nothing; remove it.
+        let _ = fs::remove_file(partial);
+        Ok(Saved::Nothing)
+    } else {
+        Ok(Saved::Partial(partial.to_path_buf()))
+    }
+}
+
+/// The CSV of standard output or a special file, written once the run is complete; after
+/// a failure a special file is opened and closed (its reader sees the end of the data) and
+/// standard output gets nothing.
+fn save_at_end(
     target: &CsvTarget,
     info: &ModelInfo,
     samples: &[Sample],
@@ -198,30 +329,12 @@ pub fn save_csv(
         (CsvTarget::Stdout, false) => Ok(Saved::Nothing),
         (CsvTarget::File(path), true) => {
             write_file(path, write).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-            if !is_special(path) {
-                let _ = fs::remove_file(partial_path(path));
-            }
             Ok(Saved::Complete(Some(path.clone())))
         }
-        (CsvTarget::File(path), false) if is_special(path) => {
-            // Nothing of a failed run goes to a FIFO or device; opening and closing it ends
-            // the data for a reader that waits on it.
+        (CsvTarget::File(path), false) => {
             write_file(path, |_| Ok(()))
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
             Ok(Saved::Nothing)
-        }
-        (CsvTarget::File(path), false) => {
-            if path.is_file() {
-                fs::remove_file(path)
-                    .map_err(|e| format!("cannot remove the older {}: {e}", path.display()))?;
-            }
-            if samples.is_empty() {
-                return Ok(Saved::Nothing);
-            }
-            let partial = partial_path(path);
-            write_file(&partial, write)
-                .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
-            Ok(Saved::Partial(partial))
         }
     }
 }

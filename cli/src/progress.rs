@@ -1,77 +1,144 @@
-//! A progress bar for runs that take more than about a second.
+//! Progress of a run that takes a while.
 //!
-//! The bar (on standard error) stays hidden for the first second of a run, so quick runs
-//! print nothing extra; it is never shown with `--quiet` or when standard output is not a
-//! terminal (output piped or redirected), and it is cleared when the run ends.
+//! On a terminal, a bar (on standard error) that stays hidden for the first second, so quick
+//! runs print nothing extra, and is cleared when the run ends. Without a terminal (output
+//! piped or redirected, a batch job), a short line on standard error every 10 s once the run
+//! has lasted 10 s, so that a log shows that a long run is alive and how far it is. Neither
+//! with `--quiet`.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::time::{Duration, Instant};
 
 /// How long a run goes before its progress bar appears.
 const SHOW_AFTER: Duration = Duration::from_secs(1);
 
+/// Without a terminal: the first progress line, and then one line per this interval.
+const LINE_EVERY: Duration = Duration::from_secs(10);
+
 /// Resolution of the bar (positions per run).
 const STEPS: u64 = 1000;
 
+/// How progress is shown.
+enum Display {
+    /// Nothing (`--quiet`).
+    None,
+    /// A bar on a terminal, drawn once the run has lasted [`SHOW_AFTER`].
+    Bar { bar: ProgressBar, shown: bool },
+    /// A line now and then on standard error; `next` is when the next one is due.
+    Lines { next: Duration },
+}
+
 /// Progress of one run in simulated time.
 pub struct Progress {
-    bar: Option<ProgressBar>,
+    display: Display,
+    label: String,
     start: Instant,
-    shown: bool,
     t0: f64,
     t_end: f64,
 }
 
 impl Progress {
-    /// A bar for a run from `t0` to `t_end`, drawn only if `enabled`, standard output is a
-    /// terminal and the run lasts long enough.
+    /// Progress of a run from `t0` to `t_end`, shown only if `enabled`: as a bar when
+    /// standard output is a terminal, else as occasional lines.
     pub fn new(label: &str, t0: f64, t_end: f64, enabled: bool) -> Self {
-        let bar = (enabled && std::io::stdout().is_terminal()).then(|| {
+        let display = if !enabled {
+            Display::None
+        } else if std::io::stdout().is_terminal() {
             let style = ProgressStyle::with_template(
                 "{prefix} [{bar:40.cyan/blue}] {msg} ({elapsed}, about {eta} left)",
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> ");
-            ProgressBar::with_draw_target(Some(STEPS), ProgressDrawTarget::hidden())
+            let bar = ProgressBar::with_draw_target(Some(STEPS), ProgressDrawTarget::hidden())
                 .with_style(style)
-                .with_prefix(label.to_string())
-        });
+                .with_prefix(label.to_string());
+            Display::Bar { bar, shown: false }
+        } else {
+            Display::Lines { next: LINE_EVERY }
+        };
         Progress {
-            bar,
+            display,
+            label: label.to_string(),
             start: Instant::now(),
-            shown: false,
             t0,
             t_end,
         }
     }
 
-    /// Reports that the simulation has reached time `t`.
-    pub fn update(&mut self, t: f64) {
-        let Some(bar) = &self.bar else {
-            return;
-        };
-        if !self.shown {
-            if self.start.elapsed() < SHOW_AFTER {
-                return;
-            }
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-            self.shown = true;
-        }
+    /// The fraction of the run done at simulated time `t`.
+    fn fraction(&self, t: f64) -> f64 {
         let span = self.t_end - self.t0;
-        let fraction = if span > 0.0 {
+        if span > 0.0 {
             ((t - self.t0) / span).clamp(0.0, 1.0)
         } else {
             1.0
-        };
-        bar.set_position((fraction * STEPS as f64).round() as u64);
-        bar.set_message(format!("t = {t:.3} of {} s", self.t_end));
+        }
+    }
+
+    /// Reports that the simulation has reached time `t`.
+    pub fn update(&mut self, t: f64) {
+        let elapsed = self.start.elapsed();
+        let fraction = self.fraction(t);
+        match &mut self.display {
+            Display::None => {}
+            Display::Bar { bar, shown } => {
+                if !*shown {
+                    if elapsed < SHOW_AFTER {
+                        return;
+                    }
+                    bar.set_draw_target(ProgressDrawTarget::stderr());
+                    *shown = true;
+                }
+                bar.set_position((fraction * STEPS as f64).round() as u64);
+                bar.set_message(format!("t = {t:.3} of {} s", self.t_end));
+            }
+            Display::Lines { next } => {
+                if elapsed < *next {
+                    return;
+                }
+                *next = elapsed + LINE_EVERY;
+                let line = progress_line(&self.label, t, self.t_end, fraction, elapsed);
+                // A closed standard error is no reason to stop a run.
+                let _ = writeln!(std::io::stderr(), "{line}");
+            }
+        }
     }
 
     /// Removes the bar from the terminal.
     pub fn finish(&self) {
-        if let Some(bar) = &self.bar {
+        if let Display::Bar { bar, .. } = &self.display {
             bar.finish_and_clear();
         }
+    }
+}
+
+/// `paper_concave: t = 523.4 of 1000 s (52 %), 12 s so far, about 11 s left`.
+fn progress_line(label: &str, t: f64, t_end: f64, fraction: f64, elapsed: Duration) -> String {
+    let spent = elapsed.as_secs_f64();
+    let left = if fraction > 0.0 {
+        format!(", about {:.0} s left", spent * (1.0 - fraction) / fraction)
+    } else {
+        String::new()
+    };
+    format!(
+        "{label}: t = {t:.4} of {t_end} s ({:.0} %), {spent:.0} s so far{left}",
+        100.0 * fraction
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_progress_line_says_where_the_run_is_and_how_long_it_has_left() {
+        let line = progress_line("m", 250.0, 1000.0, 0.25, Duration::from_secs(10));
+        assert_eq!(
+            line,
+            "m: t = 250.0000 of 1000 s (25 %), 10 s so far, about 30 s left"
+        );
+        let start = progress_line("m", 0.0, 10.0, 0.0, Duration::from_secs(10));
+        assert_eq!(start, "m: t = 0.0000 of 10 s (0 %), 10 s so far");
     }
 }

@@ -1,28 +1,31 @@
 //! `camchain simulate`: runs each model, then writes its CSV and figures and prints its
 //! summary; finally draws the concave and convex runs of a pair side by side.
 //!
-//! Everything that can be checked before simulating is checked first (model names and
-//! files, `--coords`, `--csv` with one model, output directories), so that a usage error
-//! or an unwritable destination costs no simulation. A run that fails does not stop the
+//! Everything that can be checked before simulating is checked first ([`super::plan`]), so
+//! that a usage error or an unwritable destination costs no simulation and touches no file.
+//! A run streams its CSV rows to `<name>.partial.csv` and renames it when complete; a run
+//! that fails keeps what it computed there and changes nothing else (an earlier result at
+//! the destination stays as it was); Ctrl-C stops the running simulation at its next
+//! sample, keeps the partial CSV and exits with 130. A run that fails does not stop the
 //! others; the command then exits with code 1.
 
 use super::CliError;
-use super::args::{DEFAULT_MODELS, SimulateArgs};
+use super::args::SimulateArgs;
 use super::figures::{self, RunView};
-use super::output::{self, CsvTarget, Saved};
+use super::interrupt::Interrupt;
+use super::output::{CsvSink, Saved};
+use super::plan::{Job, plan};
 use super::plots::Figure;
 use super::progress::Progress;
-use super::source::{self, LoadedModel};
 use super::summary::{self, RunReport};
-use camchain_runtime::simulate::MAX_STEPS_PER_CALL;
-use camchain_runtime::{Dynamics, IntegratorKind, SimSettings, Simulate, Trajectory};
-use std::collections::HashSet;
+use camchain_runtime::simulate::Observed;
+use camchain_runtime::{Sample, SimError, Simulate, Trajectory};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Prints summaries and notes: on standard output, or on standard error when the CSV goes
-/// to standard output; nothing with `--quiet`.
+/// to standard output; nothing with `--quiet`. Warnings go to standard error.
 struct Console {
     quiet: bool,
     to_stderr: bool,
@@ -40,22 +43,28 @@ impl Console {
             std::io::stdout().write_all(text.as_bytes())
         };
     }
-}
 
-/// One model to run and where its results go.
-struct Job {
-    model: LoadedModel,
-    /// Coordinates of the time-history figure (indices).
-    coords: Vec<usize>,
-    csv: CsvTarget,
-    /// Directory of its figures, if figures are written.
-    figures: Option<PathBuf>,
+    fn warn(&self, label: &str, warning: &str) {
+        if !self.quiet {
+            eprintln!("warning: {label}: {warning}");
+        }
+    }
 }
 
 /// A completed run, kept for the side-by-side figures.
 struct Done {
     job: usize,
     trajectory: Trajectory,
+}
+
+/// How one run ended.
+enum Outcome {
+    /// Complete, with its trajectory.
+    Done(Trajectory),
+    /// Failed (reported).
+    Failed,
+    /// Stopped by Ctrl-C (reported).
+    Interrupted,
 }
 
 /// Runs the `simulate` command.
@@ -65,15 +74,17 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         quiet: args.quiet,
         to_stderr: args.csv_to_stdout(),
     };
+    let interrupt = Interrupt::install();
     let mut failed = false;
     let mut done = Vec::new();
     for (index, job) in jobs.iter().enumerate() {
-        match run_job(job, args, &console) {
-            Ok(trajectory) => done.push(Done {
+        match run_job(job, args, &console, &interrupt) {
+            Outcome::Done(trajectory) => done.push(Done {
                 job: index,
                 trajectory,
             }),
-            Err(()) => failed = true,
+            Outcome::Failed => failed = true,
+            Outcome::Interrupted => return Err(CliError::Interrupted),
         }
     }
     if let (Some(dir), false) = (args.out_dir(), args.no_plots) {
@@ -86,193 +97,164 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
 }
 
-/// Resolves the models and checks the options and destinations.
-fn plan(args: &SimulateArgs) -> Result<Vec<Job>, CliError> {
-    let names: Vec<String> = if args.models.is_empty() {
-        DEFAULT_MODELS.iter().map(|s| s.to_string()).collect()
-    } else {
-        args.models.clone()
-    };
-    if args.csv.is_some() && names.len() != 1 {
-        return Err(CliError::Usage(format!(
-            "--csv writes the CSV of one model, but {} are to run (give one MODEL, or use \
-             --out DIR for several)",
-            names.len()
-        )));
-    }
-    let mut labels = HashSet::new();
-    let mut jobs = Vec::new();
-    for name in &names {
-        let model = source::load(name, args.numeric)?;
-        if !labels.insert(model.label.clone()) {
-            return Err(CliError::Usage(format!("{} is given twice", model.label)));
-        }
-        check_step_budget(&model, args)?;
-        let coords = coordinates(&model, &args.coords)?;
-        jobs.push(Job {
-            coords,
-            csv: CsvTarget::Stdout,
-            figures: None,
-            model,
-        });
-    }
-    for job in &mut jobs {
-        let label = &job.model.label;
-        let dir = args.out_dir().map(|d| d.join(label));
-        if let Some(dir) = &dir {
-            output::create_dir(dir).map_err(CliError::Failed)?;
-        }
-        job.csv = match (&args.csv, &dir) {
-            (Some(_), _) if args.csv_to_stdout() => CsvTarget::Stdout,
-            (Some(path), _) => {
-                output::check_csv_destination(path).map_err(CliError::Failed)?;
-                CsvTarget::File(path.clone())
-            }
-            (None, Some(dir)) => CsvTarget::File(dir.join(format!("{label}.csv"))),
-            (None, None) => CsvTarget::Stdout,
-        };
-        job.figures = dir.filter(|_| !args.no_plots);
-    }
-    Ok(jobs)
-}
-
-/// Refuses, before running, an rk4 step so small that the runtime would give up only after
-/// [`MAX_STEPS_PER_CALL`] steps in the first output interval (a minute or more of work).
-fn check_step_budget(model: &LoadedModel, args: &SimulateArgs) -> Result<(), CliError> {
-    let settings = args.settings(&model.engine.dynamics().info().defaults);
-    let steps = settings.dt_out / settings.dt;
-    if settings.integrator == IntegratorKind::Rk4 && steps > MAX_STEPS_PER_CALL as f64 {
-        return Err(CliError::Usage(format!(
-            "--dt: {}: an rk4 step of {:e} s needs {steps:.1e} steps per output interval \
-             (--dt-out {:e} s), more than the {MAX_STEPS_PER_CALL} allowed",
-            model.label, settings.dt, settings.dt_out
-        )));
-    }
-    Ok(())
-}
-
-/// The coordinates of the time-history figure: those named by `--coords`, or all from
-/// the tip to the base.
-fn coordinates(model: &LoadedModel, names: &[String]) -> Result<Vec<usize>, CliError> {
-    let info = model.engine.dynamics().info();
-    if names.is_empty() {
-        return Ok((0..info.n()).rev().collect());
-    }
-    names
-        .iter()
-        .map(|name| {
-            if name.trim().is_empty() {
-                return Err(CliError::Usage(
-                    "--coords: empty coordinate name; give names separated by commas, e.g. \
-                     --coords q4,q3"
-                        .to_string(),
-                ));
-            }
-            info.coordinate_index(name.trim()).ok_or_else(|| {
-                let known: Vec<&str> = info.coordinates.iter().map(|c| c.name.as_str()).collect();
-                CliError::Usage(format!(
-                    "--coords: {} has no coordinate `{name}` (its coordinates: {})",
-                    model.name,
-                    known.join(", ")
-                ))
-            })
-        })
-        .collect()
-}
-
-/// Assembles and simulates, with a progress bar; returns the trajectory (partial on
-/// failure), the failure, if any, and the wall time.
-fn integrate(
-    model: &dyn Dynamics,
-    label: &str,
-    settings: &SimSettings,
-    restitution: Option<f64>,
-    quiet: bool,
-) -> (Trajectory, Option<String>, Duration) {
-    let start = Instant::now();
-    let mut progress = Progress::new(label, 0.0, settings.t_end, !quiet);
-    let outcome = match model.assemble(0.0) {
-        Err(e) => (
-            Trajectory::default(),
-            Some(format!("assembly onto the cam failed: {e}")),
-        ),
-        Ok(state) => {
-            let run = match restitution {
-                // One-sided contact runs in phases; its progress is not reported.
-                Some(e) => model.simulate_unilateral(state, settings, e),
-                None => model.simulate_observed(state, settings, &mut |s| {
-                    progress.update(s.t);
-                    std::ops::ControlFlow::Continue(())
-                }),
-            };
-            match run {
-                Ok(trajectory) => (trajectory, None),
-                Err(failure) => {
-                    let message = failure.to_string();
-                    (failure.partial, Some(message))
-                }
-            }
-        }
-    };
-    progress.finish();
-    (outcome.0, outcome.1, start.elapsed())
-}
-
-/// Runs one job: simulation, CSV, figures, summary. Problems are reported here.
-fn run_job(job: &Job, args: &SimulateArgs, console: &Console) -> Result<Trajectory, ()> {
+/// Runs one job: assembly, simulation with the CSV streamed, then (complete runs) the
+/// figures and the summary. Problems are reported here.
+fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interrupt) -> Outcome {
     let model = &job.model;
+    let label = &model.label;
+    for warning in &model.warnings {
+        console.warn(label, warning);
+    }
     let dynamics = model.engine.dynamics();
     let info = dynamics.info();
-    let settings = args.settings(&info.defaults);
-    let (trajectory, failure, wall) = integrate(
-        dynamics,
-        &model.label,
-        &settings,
-        args.restitution,
-        args.quiet,
-    );
-    let mut ok = failure.is_none();
-    if let Some(message) = &failure {
-        eprintln!("error: {}: {message}", model.label);
+    let settings = &job.settings;
+    let mut sink = match CsvSink::open(&job.csv, info) {
+        Ok(sink) => sink,
+        Err(message) => {
+            eprintln!("error: {label}: {message}");
+            return Outcome::Failed;
+        }
+    };
+    let start = Instant::now();
+    let assembled = dynamics.assemble_reported(0.0);
+    let (state, report) = match assembled {
+        Ok(assembled) => assembled,
+        Err(e) => {
+            eprintln!("error: {label}: assembly onto the cam failed: {e}");
+            let _ = sink.finish(info, &[], false);
+            return Outcome::Failed;
+        }
+    };
+    console.say(&summary::assembly(info, &report));
+    for warning in summary::assembly_warnings(info, &report, state.length_scale()) {
+        console.warn(label, &warning);
+    }
+    let mut progress = Progress::new(label, 0.0, settings.t_end, !args.quiet);
+    let mut write_error = None;
+    let mut observe = |sample: &Sample| {
+        progress.update(sample.t);
+        if let Err(e) = sink.row(info, sample) {
+            write_error = Some(e);
+            return Observed::Break(());
+        }
+        if interrupt.requested() {
+            Observed::Break(())
+        } else {
+            Observed::Continue(())
+        }
+    };
+    let run = match args.restitution {
+        Some(e) => dynamics.simulate_unilateral_observed(state, settings, e, &mut observe),
+        None => dynamics.simulate_observed(state, settings, &mut observe),
+    };
+    progress.finish();
+    let wall = start.elapsed();
+    let (trajectory, failure) = match run {
+        Ok(trajectory) => (trajectory, None),
+        Err(failure) => (failure.partial, Some(failure.error)),
+    };
+    let saved = sink.finish(info, &trajectory.samples, failure.is_none());
+    if let Some(error) = failure {
+        return report_failure(label, &error, write_error, &trajectory, saved);
     }
     let mut written = Vec::new();
-    match output::save_csv(&job.csv, info, &trajectory.samples, ok) {
+    let mut ok = true;
+    match saved {
         Ok(Saved::Complete(Some(path))) => written.push(path),
-        Ok(Saved::Complete(None) | Saved::Nothing) => {}
-        Ok(Saved::Partial(path)) => eprintln!(
-            "{}: the {} samples computed before the failure are in {}",
-            model.label,
-            trajectory.samples.len(),
-            path.display()
-        ),
+        Ok(_) => {}
         Err(message) => {
-            eprintln!("error: {}: {message}", model.label);
+            eprintln!("error: {label}: {message}");
             ok = false;
         }
     }
-    if let (Some(dir), true) = (&job.figures, failure.is_none()) {
+    if let Some(dir) = &job.figures {
         match draw_run(job, &trajectory, dir, console) {
-            Ok(paths) => written.extend(paths),
+            Ok(paths) => {
+                remove_stale_outputs(dir, label, &paths);
+                written.extend(paths);
+            }
             Err(message) => {
-                eprintln!("error: {}: {message}", model.label);
+                eprintln!("error: {label}: {message}");
                 ok = false;
             }
         }
     }
     console.say(&summary::render(&RunReport {
-        label: &model.label,
+        label,
         engine: model.engine.describe(),
         info,
-        settings: &settings,
+        settings,
         samples: &trajectory.samples,
         events: &trajectory.events,
         stats: trajectory.stats,
         wall,
     }));
+    for warning in summary::result_warnings(info, &trajectory.samples) {
+        console.warn(label, &warning);
+    }
     if !written.is_empty() {
         console.say(&format!("  wrote {}\n", list_files(&written)));
     }
-    if ok { Ok(trajectory) } else { Err(()) }
+    if ok {
+        Outcome::Done(trajectory)
+    } else {
+        Outcome::Failed
+    }
+}
+
+/// One `error:` line for a failed run (or one line for an interrupted one), and where its
+/// partial CSV is; no summary.
+fn report_failure(
+    label: &str,
+    error: &SimError,
+    write_error: Option<std::io::Error>,
+    trajectory: &Trajectory,
+    saved: Result<Saved, String>,
+) -> Outcome {
+    let interrupted = matches!(error, SimError::Interrupted { .. }) && write_error.is_none();
+    match (&write_error, interrupted) {
+        (Some(e), _) => eprintln!("error: {label}: the CSV could not be written: {e}"),
+        (None, true) => eprintln!(
+            "{label}: interrupted at t = {} s",
+            error.time().unwrap_or(f64::NAN)
+        ),
+        (None, false) => eprintln!("error: {label}: {error}"),
+    }
+    let samples = trajectory.samples.len();
+    match saved {
+        Ok(Saved::Partial(path)) => eprintln!(
+            "{label}: the {samples} samples computed until then are in {}",
+            path.display()
+        ),
+        Ok(_) => {}
+        Err(message) => eprintln!("error: {label}: {message}"),
+    }
+    if interrupted {
+        Outcome::Interrupted
+    } else {
+        Outcome::Failed
+    }
+}
+
+/// The figures a run writes in its directory, besides its CSV.
+const FIGURE_STEMS: [&str; 3] = ["histories", "snapshots", "contact"];
+
+/// Removes, after a complete run, the outputs of an earlier run of the same name that this
+/// one did not write again (a figure it could not draw this time, a partial CSV of a run
+/// that failed), so that a run directory never mixes two runs. Only those known names are
+/// touched, and only regular files.
+fn remove_stale_outputs(dir: &Path, label: &str, written: &[PathBuf]) {
+    let mut known: Vec<PathBuf> = FIGURE_STEMS
+        .iter()
+        .flat_map(|stem| ["png", "svg"].map(|ext| dir.join(format!("{stem}.{ext}"))))
+        .collect();
+    known.push(dir.join(format!("{label}.partial.csv")));
+    for path in known {
+        let regular = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_file());
+        if regular && !written.contains(&path) {
+            let _ = std::fs::remove_file(&path);
+        }
+    }
 }
 
 /// "out/paper_concave/: paper_concave.csv, histories.png, …".

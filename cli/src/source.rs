@@ -49,13 +49,18 @@ impl Engine {
 pub struct LoadedModel {
     /// The model's name (from the file, or the built-in name).
     pub name: String,
-    /// The run's name in file names and the summary: the model's name, with `_numeric`
-    /// appended on the numeric path.
+    /// The run's name in file names and the summary: a built-in model's name (with
+    /// `_numeric` appended on the numeric path), or a model file's name without `.ron`.
     pub label: String,
+    /// Where the model comes from, as messages name it: the file as given, or the name of
+    /// a built-in model.
+    pub origin: String,
     /// The dynamics to integrate.
     pub engine: Engine,
     /// The geometry for drawing snapshots, or why it is not available.
     pub geometry: Result<Geometry, String>,
+    /// Warnings about values that look mistaken, located in the model file.
+    pub warnings: Vec<String>,
 }
 
 /// How messages name a built-in model's file (`models/<name>.ron` of the repository; its
@@ -91,7 +96,10 @@ pub fn load(arg: &str, numeric: bool) -> Result<LoadedModel, CliError> {
             )));
         };
         return if numeric {
-            Ok(numeric_model(builtin_description(arg)?))
+            let mut loaded = numeric_model(builtin_description(arg)?, Vec::new());
+            loaded.label = format!("{arg}_numeric");
+            loaded.origin = arg.to_string();
+            Ok(loaded)
         } else {
             Ok(generated(arg, model))
         };
@@ -111,30 +119,46 @@ fn generated(name: &str, model: &'static (dyn Dynamics + Sync)) -> LoadedModel {
     LoadedModel {
         name: name.to_string(),
         label: name.to_string(),
+        origin: name.to_string(),
         engine: Engine::Generated(model),
         geometry,
+        warnings: Vec::new(),
     }
 }
 
+/// A model file on the numeric path, checked as the build checks it (located errors,
+/// assembly of the initial state included), and named after the file.
 fn from_file(file: &Path) -> Result<LoadedModel, CliError> {
-    Ok(numeric_model(read_model(file)?))
+    let (model, warnings) = read_model(file)?;
+    let mut loaded = numeric_model(model, warnings);
+    loaded.label = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| loaded.name.clone());
+    loaded.origin = file.display().to_string();
+    Ok(loaded)
 }
 
-/// A validated model on the numeric path.
-fn numeric_model(model: Model) -> LoadedModel {
+/// A validated model on the numeric path (label and origin set by the caller).
+fn numeric_model(model: Model, warnings: Vec<String>) -> LoadedModel {
     let geometry = Geometry::new(&model);
     let name = model.name.clone();
     LoadedModel {
-        label: format!("{name}_numeric"),
+        label: name.clone(),
+        origin: String::new(),
         name,
         engine: Engine::Numeric(Box::new(NumericModel::new(model))),
         geometry,
+        warnings,
     }
 }
 
-/// Reads and validates a model file; errors are one line, located in the file when the
-/// problem is in its content.
-fn read_model(file: &Path) -> Result<Model, CliError> {
+/// Reads a model file and checks it as the build does (`camchain_codegen::check_source`:
+/// the format, every value, the expressions and the assembly of the initial state);
+/// returns it with its warnings. Errors are one line, located in the file when the problem
+/// is in its content.
+fn read_model(file: &Path) -> Result<(Model, Vec<String>), CliError> {
     if file.is_dir() {
         return Err(CliError::Failed(format!(
             "cannot read model file {}: it is a directory, not a .ron file",
@@ -143,10 +167,15 @@ fn read_model(file: &Path) -> Result<Model, CliError> {
     }
     let source = std::fs::read_to_string(file)
         .map_err(|e| CliError::Failed(format!("cannot read model file {}: {e}", file.display())))?;
-    parse_model(&source, file).map_err(|e| {
+    let model = camchain_codegen::check_source(&source, file).map_err(|e| {
         let text = e.to_string().replace('\n', " ");
         CliError::Failed(format!("invalid model file: {text}"))
-    })
+    })?;
+    let warnings = camchain_codegen::located_warnings(&model, &source, file)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    Ok((model, warnings))
 }
 
 #[cfg(test)]
@@ -166,7 +195,7 @@ mod tests {
         assert!(!generated.engine.is_numeric());
         assert_eq!(generated.label, "paper_concave");
         assert!(generated.geometry.is_ok());
-        let numeric = load("paper_concave", true).unwrap_or_else(|_| panic!("file"));
+        let numeric = load("paper_concave", true).unwrap_or_else(|_| panic!("built in"));
         assert!(numeric.engine.is_numeric());
         assert_eq!(numeric.label, "paper_concave_numeric");
         assert_eq!(

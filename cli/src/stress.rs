@@ -797,12 +797,14 @@ fn unreachable(_ctx: &Context) -> Result<Section, CliError> {
     say("unreachable cam\n");
     let mut text = String::from(
         "`cli/scenarios/unreachable.ron`: a two-link arm whose first joint is driven, \
-         q1 = −π/2 + t, lifting the elbow; from t = π/3 s (1.0472 s) the tip cannot reach the \
-         flat cam any more. Every integrator stops with `NewtonFailed` (\"the contact point \
-         cannot reach the cam\") at that time, with the state; the samples up to it are kept. \
-         Dormand–Prince approaches the limit with ever shorter steps (the velocity needed to \
-         stay on the cam grows without bound as the arm straightens) and reports the Newton \
-         failure that stopped it.\n\n",
+         q1 = −π/2 + t, lifting the elbow; at t = π/3 s (1.0472 s) the arm is stretched (a \
+         dead point: the tip is on the cam but no joint can move it across the cam) and beyond \
+         it the tip cannot reach the flat cam. Every integrator stops there, with the state, \
+         and the samples up to it are kept: where Dormand–Prince approaches the limit with \
+         ever shorter steps (the velocity needed to stay on the cam grows without bound as the \
+         arm straightens) it stops at the dead point (`SingularConstraint`, \"the mechanism \
+         locks at a dead point\"); where a step lands beyond it, as RK4's do, Newton cannot \
+         bring |h| down (`NewtonFailed`, \"the contact point cannot reach the cam\").\n\n",
     );
     let model = stress::scenario(stress::UNREACHABLE, "unreachable.ron").map_err(failed)?;
     let sweep = stress::sweep(2.0, 0.01, &[1e-2, 1e-3], &[1e-6, 1e-8, 1e-10]);

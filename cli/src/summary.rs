@@ -7,6 +7,7 @@
 //! real, one-sided follower would lift off the cam there.
 
 use super::args::integrator_name;
+use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::{CoordinateKind, IntegratorKind, ModelInfo, Sample, SimSettings, Stats};
 use std::fmt::Write;
@@ -102,7 +103,16 @@ fn range(samples: &[Sample], value: impl Fn(&Sample) -> f64) -> (f64, f64) {
 fn settings_text(settings: &SimSettings) -> String {
     let name = integrator_name(settings.integrator);
     match settings.integrator {
-        IntegratorKind::Rk4 => format!("{name} (dt {} s)", settings.dt),
+        IntegratorKind::Rk4 => match settings.rk4_landing_step() {
+            None => format!("{name} (dt {} s)", settings.dt),
+            Some((steps, last)) => format!(
+                "{name} (dt {} s; each {} s output interval takes {steps} steps, the last \
+                 shortened to {} s)",
+                settings.dt,
+                settings.dt_out,
+                number(last)
+            ),
+        },
         IntegratorKind::Dopri5 | IntegratorKind::Dop853 => format!(
             "{name} (rtol {:e}, atol {:e})",
             settings.rtol, settings.atol
@@ -137,6 +147,16 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
         }
     }
     rows
+}
+
+/// The scale the energy drift is measured against: the largest kinetic energy plus the
+/// range of the potential energy over the run (the energy that moves around; the total
+/// itself has an arbitrary zero).
+pub fn energy_scale(samples: &[Sample]) -> f64 {
+    let kinetic = samples.iter().map(|s| s.energy.kinetic).fold(0.0, f64::max);
+    let potential = |s: &Sample| s.energy.gravity + s.energy.spring;
+    let (lo, hi) = range(samples, potential);
+    kinetic + (hi - lo).max(0.0)
 }
 
 /// max over the samples of |(E + D − W)(t) − (E + D − W)(0)|.
@@ -199,9 +219,18 @@ pub fn render(report: &RunReport) -> String {
                 .fold(0.0, f64::max);
             checks.push(format!("max |{name}_h| {max_h:.2e} m"));
         }
+        let (drift, scale) = (energy_drift(samples), energy_scale(samples));
+        let relative = if scale > 0.0 {
+            format!(
+                " ({:.1e} of the energy scale {} J)",
+                drift / scale,
+                number(scale)
+            )
+        } else {
+            String::new()
+        };
         checks.push(format!(
-            "energy + dissipated − driven_work constant to {:.2e} J",
-            energy_drift(samples)
+            "energy + dissipated − driven_work constant to {drift:.2e} J{relative}"
         ));
         let _ = writeln!(text, "  {}", checks.join("; "));
     }
@@ -294,6 +323,124 @@ fn wall_time(wall: Duration) -> String {
     } else {
         format!("{seconds:.2} s")
     }
+}
+
+/// The line saying what assembly changed in the model's initial guess, e.g.
+/// `assembled: q3 0 → −0.07747 (the root of h nearest the guess); q1_dot …` (empty when it
+/// changed nothing).
+pub fn assembly(info: &ModelInfo, report: &AssemblyReport) -> String {
+    if report.changes.is_empty() {
+        return String::new();
+    }
+    let parts: Vec<String> = report
+        .changes
+        .iter()
+        .map(|c| {
+            let coordinate = &info.coordinates[c.coordinate].name;
+            let name = if c.velocity {
+                format!("{coordinate}_dot")
+            } else {
+                coordinate.clone()
+            };
+            let how = match (c.cause, c.velocity) {
+                (ChangeCause::Drive, _) => " set by its drive",
+                (ChangeCause::Constraint, true) => " from J q̇ = 0",
+                (ChangeCause::Constraint, false) => match report.root {
+                    RootChoice::Nearest { .. } => " (the root nearest the guess)",
+                    RootChoice::Newton { scanned: true } => {
+                        " (Newton: no root found by a scan around the guess)"
+                    }
+                    RootChoice::Newton { scanned: false } => " (Newton from the guess)",
+                    RootChoice::AtGuess | RootChoice::NoContact => "",
+                },
+            };
+            format!("{name}{how} {} → {}", number(c.from), number(c.to))
+        })
+        .collect();
+    format!("assembled: {}\n", parts.join("; "))
+}
+
+/// A solved angle that moved this far from a value the model file gave (rad) is reported.
+const MOVED_ANGLE: f64 = 0.5;
+
+/// A solved displacement that moved this fraction of the model's length scale (its largest
+/// contact-point coordinate) from a value the file gave is reported.
+const MOVED_LENGTH: f64 = 0.5;
+
+/// Warnings about values the model file gave that assembly had to override or move far.
+pub fn assembly_warnings(
+    info: &ModelInfo,
+    report: &AssemblyReport,
+    length_scale: f64,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for c in report.changes.iter().filter(|c| c.given) {
+        let coordinate = &info.coordinates[c.coordinate];
+        let field = if c.velocity {
+            format!("initial.qd[{:?}]", coordinate.name)
+        } else {
+            format!("initial.q[{:?}]", coordinate.name)
+        };
+        let (from, to) = (number(c.from), number(c.to));
+        let warning = match c.cause {
+            ChangeCause::Drive => Some(format!(
+                "{field} = {from} is overridden by the drive of {}: {to} at t = 0",
+                coordinate.name
+            )),
+            ChangeCause::Constraint if c.velocity => Some(format!(
+                "{field} = {from} is replaced by {to}: the velocity of a solved coordinate \
+                 follows from the others (J q̇ = 0)"
+            )),
+            ChangeCause::Constraint => {
+                let limit = match coordinate.kind {
+                    CoordinateKind::Revolute => MOVED_ANGLE,
+                    CoordinateKind::Prismatic => MOVED_LENGTH * length_scale,
+                };
+                ((c.to - c.from).abs() > limit).then(|| {
+                    format!(
+                        "{field} = {from} had to move to {to} {} (by {}) to put the contact \
+                         point on its cam: check the guess and initial.hold",
+                        unit(coordinate.kind),
+                        number(c.to - c.from)
+                    )
+                })
+            }
+        };
+        out.extend(warning);
+    }
+    out
+}
+
+/// Warnings about results that are almost surely a modelling mistake: a normal force
+/// negative at the start or for most of the run (the cam pulls the follower).
+pub fn result_warnings(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
+    let mut out = Vec::new();
+    let Some(first) = samples.first() else {
+        return out;
+    };
+    for (k, name) in info.contacts.iter().enumerate() {
+        let in_contact: Vec<&Sample> = samples.iter().filter(|s| !s.dependent.is_empty()).collect();
+        let negative = in_contact
+            .iter()
+            .filter(|s| s.normal_force[k] < 0.0)
+            .count();
+        let share = negative as f64 / in_contact.len().max(1) as f64;
+        let at_start = first.normal_force.get(k).is_some_and(|f| *f < 0.0);
+        if at_start || share > 0.5 {
+            out.push(format!(
+                "the normal force on {name} is negative {} ({:.0} % of the samples): the cam \
+                 pulls the follower. Check which side of the profile the material is on: the \
+                 cam lies on the side y < f(x) of its frame and pushes towards +y",
+                if at_start {
+                    "from the start"
+                } else {
+                    "for most of the run"
+                },
+                100.0 * share
+            ));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -348,7 +348,7 @@ fn bad_input_gets_one_line_and_an_exit_code() {
 }
 
 #[test]
-fn a_failed_run_leaves_only_a_partial_csv() {
+fn a_failed_run_keeps_the_older_result_and_its_own_rows_beside_it() {
     let dir = scratch("failed-run");
     let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/unreachable.ron");
     let csv = dir.join("result.csv");
@@ -359,12 +359,20 @@ fn a_failed_run_leaves_only_a_partial_csv() {
     );
     let stderr = text(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
+    // The run is named after its file; one error line, one line saying where the rows are.
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 2, "{stderr}");
     assert!(
-        stderr.contains("error: unreachable_numeric: simulation stopped"),
+        lines[0].starts_with("error: unreachable: at t = 1.04"),
         "{stderr}"
     );
+    assert!(lines[1].ends_with("are in result.partial.csv"), "{stderr}");
     assert!(!stderr.contains("panicked"));
-    assert!(!csv.exists(), "no CSV under the final name");
+    assert_eq!(
+        std::fs::read_to_string(&csv).unwrap(),
+        "an older, complete result\n",
+        "the older result survives byte for byte"
+    );
     let partial = std::fs::read_to_string(dir.join("result.partial.csv")).unwrap();
     let (header, rows) = parse_csv(&partial);
     assert_eq!(header.last().map(String::as_str), Some("driven_work"));
@@ -421,8 +429,8 @@ fn bad_options_and_files_name_the_flag_and_the_problem() {
                 "runs",
                 "-q",
             ],
-            1,
-            vec!["exactly one cam contact"],
+            2,
+            vec!["--restitution", "exactly one cam contact"],
         ),
         (
             vec!["bench", "evaluations", "--report", "/nonexistent/dir/B.md"],
@@ -445,7 +453,7 @@ fn bad_options_and_files_name_the_flag_and_the_problem() {
             vec!["'--dt <SECONDS>'", "`abc` is not a number"],
         ),
         (
-            vec!["simulate", "--integrator", "RK4"],
+            vec!["simulate", "--integrator", "Euler"],
             2,
             vec!["'--integrator <NAME>'", "possible values: rk4, dopri5"],
         ),

@@ -603,7 +603,18 @@ impl Workspace {
         }
     }
 
+    /// Why Newton stopped without converging: the contact point cannot reach the cam (h
+    /// has not converged), or — h at its tolerance but the corrections h / J_v still large,
+    /// J_v vanishing — the mechanism locks at a dead point.
     fn newton_failure(&self, t: f64, residual: f64, iterations: usize) -> SimError {
+        if residual <= self.residual_tolerance() {
+            return SimError::SingularConstraint {
+                t,
+                q: self.q.clone(),
+                residual,
+                on_cam: true,
+            };
+        }
         SimError::NewtonFailed {
             t,
             q: self.q.clone(),

@@ -108,6 +108,12 @@ impl State {
         self.partition.independent()
     }
 
+    /// The model's length scale found at assembly (the largest contact-point coordinate,
+    /// at least 1), which scales Newton's tolerance.
+    pub fn length_scale(&self) -> f64 {
+        self.engine.ws.length_scale()
+    }
+
     /// Energy dissipated by the joint dampers since assembly, ∫ Σ c q̇² dt (J).
     pub fn dissipated(&self) -> f64 {
         self.dissipated
