@@ -22,6 +22,8 @@ pub struct Job {
     pub coords: Vec<usize>,
     /// Where its CSV goes.
     pub csv: CsvTarget,
+    /// Its directory (`--out DIR/<run>`), if it has one.
+    pub dir: Option<PathBuf>,
     /// Directory of its figures, if figures are written.
     pub figures: Option<PathBuf>,
 }
@@ -54,6 +56,7 @@ pub fn plan(args: &SimulateArgs) -> Result<Vec<Job>, CliError> {
             settings,
             coords,
             csv: CsvTarget::Stdout,
+            dir: None,
             figures: None,
         });
     }
@@ -133,7 +136,7 @@ fn setting_error(e: &InvalidSetting, args: &SimulateArgs, model: &LoadedModel) -
             model.origin
         ))
     } else {
-        CliError::Usage(format!("{}: {e}", named.join(" with ")))
+        CliError::Usage(format!("{}: {}", named.join(" with "), e.message))
     }
 }
 
@@ -184,7 +187,8 @@ fn destinations(jobs: &mut [Job], args: &SimulateArgs) -> Result<(), CliError> {
             (None, Some(dir)) => CsvTarget::File(dir.join(format!("{label}.csv"))),
             (None, None) => CsvTarget::Stdout,
         };
-        job.figures = dir.filter(|_| !args.no_plots);
+        job.figures = dir.clone().filter(|_| !args.no_plots);
+        job.dir = dir;
     }
     Ok(())
 }

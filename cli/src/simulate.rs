@@ -169,15 +169,15 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     }
     if let Some(dir) = &job.figures {
         match draw_run(job, &trajectory, dir, console) {
-            Ok(paths) => {
-                remove_stale_outputs(dir, label, &paths);
-                written.extend(paths);
-            }
+            Ok(paths) => written.extend(paths),
             Err(message) => {
                 eprintln!("error: {label}: {message}");
                 ok = false;
             }
         }
+    }
+    if let (Some(dir), true) = (&job.dir, ok) {
+        remove_stale_outputs(dir, label, &written);
     }
     console.say(&summary::render(&RunReport {
         label,

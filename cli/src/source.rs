@@ -167,10 +167,9 @@ fn read_model(file: &Path) -> Result<(Model, Vec<String>), CliError> {
     }
     let source = std::fs::read_to_string(file)
         .map_err(|e| CliError::Failed(format!("cannot read model file {}: {e}", file.display())))?;
-    let model = camchain_codegen::check_source(&source, file).map_err(|e| {
-        let text = e.to_string().replace('\n', " ");
-        CliError::Failed(format!("invalid model file: {text}"))
-    })?;
+    // The same `file:line:column: field: message` as the build and `camchain ops`.
+    let model = camchain_codegen::check_source(&source, file)
+        .map_err(|e| CliError::Failed(e.to_string().replace('\n', " ")))?;
     let warnings = camchain_codegen::located_warnings(&model, &source, file)
         .iter()
         .map(ToString::to_string)

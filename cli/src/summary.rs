@@ -110,7 +110,8 @@ fn settings_text(settings: &SimSettings) -> String {
                  shortened to {} s)",
                 settings.dt,
                 settings.dt_out,
-                number(last)
+                // 12 significant digits: 0.001, not 0.0009999999999999992.
+                format!("{:.12e}", last).parse::<f64>().unwrap_or(last)
             ),
         },
         IntegratorKind::Dopri5 | IntegratorKind::Dop853 => format!(
@@ -343,10 +344,10 @@ pub fn assembly(info: &ModelInfo, report: &AssemblyReport) -> String {
                 coordinate.clone()
             };
             let how = match (c.cause, c.velocity) {
-                (ChangeCause::Drive, _) => " set by its drive",
-                (ChangeCause::Constraint, true) => " from J q̇ = 0",
+                (ChangeCause::Drive, _) => " (set by its drive)",
+                (ChangeCause::Constraint, true) => " (from J q̇ = 0)",
                 (ChangeCause::Constraint, false) => match report.root {
-                    RootChoice::Nearest { .. } => " (the root nearest the guess)",
+                    RootChoice::Nearest { .. } => " (the root of h nearest the guess)",
                     RootChoice::Newton { scanned: true } => {
                         " (Newton: no root found by a scan around the guess)"
                     }
@@ -354,7 +355,7 @@ pub fn assembly(info: &ModelInfo, report: &AssemblyReport) -> String {
                     RootChoice::AtGuess | RootChoice::NoContact => "",
                 },
             };
-            format!("{name}{how} {} → {}", number(c.from), number(c.to))
+            format!("{name} {} → {}{how}", number(c.from), number(c.to))
         })
         .collect();
     format!("assembled: {}\n", parts.join("; "))

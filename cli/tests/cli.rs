@@ -480,7 +480,7 @@ fn bad_options_and_files_name_the_flag_and_the_problem() {
         (
             vec!["simulate", "empty.ron"],
             1,
-            vec!["invalid model file: empty.ron:1:1: <top level>"],
+            vec!["error: empty.ron:1:1: <top level>: "],
         ),
         (
             vec!["simulate", exit_call],

@@ -36,16 +36,33 @@ pub fn assemble(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
     let free: Vec<bool> = (0..n)
         .map(|i| !model.initial.hold[i] && model.bodies[i].joint.prescribed.is_none())
         .collect();
+    let free_count = free.iter().filter(|f| **f).count();
+    if free_count < nc {
+        return Err(format!(
+            "initial state cannot be assembled onto the cams: {nc} contacts need one \
+             coordinate each that is neither held nor driven, and {free_count} {} free: leave \
+             more out of initial.hold",
+            if free_count == 1 { "is" } else { "are" }
+        ));
+    }
     let mut residual = f64::INFINITY;
     for _ in 0..MAX_ITERATIONS {
         let h = d.eval(&h_ids, 0.0, &q, &qd);
         residual = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if residual <= TOLERANCE {
-            return Ok(q);
-        }
         let j = d.eval(&j_ids, 0.0, &q, &qd);
-        let step = newton_step(&j, &h, n, nc, &free)
-            .ok_or_else(|| no_free_column(model, &free, residual, &q))?;
+        if residual <= TOLERANCE {
+            // On the cams; the run must also be able to choose one dependent coordinate
+            // per contact there (the runtime's partition needs an invertible J_v).
+            return match newton_step(&j, &h, n, nc, &free) {
+                Some(_) => Ok(q),
+                None => Err(dependent_contacts(model, &j, &free, residual, &q)
+                    .unwrap_or_else(|| no_free_column(model, &free, residual, &q))),
+            };
+        }
+        let step = newton_step(&j, &h, n, nc, &free).ok_or_else(|| {
+            dependent_contacts(model, &j, &free, residual, &q)
+                .unwrap_or_else(|| no_free_column(model, &free, residual, &q))
+        })?;
         for (i, dq) in step {
             q[i] -= dq;
         }
@@ -88,8 +105,48 @@ fn no_free_column(model: &Model, free: &[bool], residual: f64, q: &[f64]) -> Str
     )
 }
 
-/// One Newton step on the free columns with the largest pivots; returns (index, Δq) pairs
-/// with q ← q − Δq.
+/// Two contacts whose constraint rows, restricted to the free coordinates, are parallel
+/// (they ask for the same motion: two contacts at one point, or on one cam through the same
+/// mechanism), which no choice of coordinates can solve; `None` when there are no such two.
+fn dependent_contacts(
+    model: &Model,
+    j: &[f64],
+    free: &[bool],
+    residual: f64,
+    q: &[f64],
+) -> Option<String> {
+    let n = model.n();
+    let nc = model.contacts.len();
+    let row =
+        |k: usize| -> Vec<f64> { (0..n).filter(|&i| free[i]).map(|i| j[k * n + i]).collect() };
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for a in 0..nc {
+        for b in a + 1..nc {
+            let (ra, rb) = (row(a), row(b));
+            let (na, nb) = (norm(&ra), norm(&rb));
+            if na == 0.0 || nb == 0.0 {
+                continue;
+            }
+            let cosine = ra.iter().zip(&rb).map(|(x, y)| x * y).sum::<f64>() / (na * nb);
+            if cosine.abs() > 1.0 - 1e-9 {
+                let (first, second) = (&model.contacts[a].name, &model.contacts[b].name);
+                return Some(format!(
+                    "initial state cannot be assembled onto the cams: |h| = {residual:.3e} m at \
+                     q = {q:?}, and contacts {first} and {second} constrain the same motion \
+                     (their constraint rows are parallel: two contacts at one point?), so no \
+                     choice of coordinates can satisfy both: remove one, or move its marker"
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// One Newton step on the free coordinates: the least-norm Δq with J_free Δq = h (through
+/// the singular value decomposition of J restricted to the free columns); returns
+/// (index, Δq) pairs with q ← q − Δq. `None` when J_free does not have full row rank (a
+/// singular value below 1e-12 of the largest, or of 1 m when all are smaller): no choice of one free
+/// coordinate per contact can be solved there.
 fn newton_step(
     j: &[f64],
     h: &[f64],
@@ -97,27 +154,24 @@ fn newton_step(
     nc: usize,
     free: &[bool],
 ) -> Option<Vec<(usize, f64)>> {
-    let cols = pick_columns(j, n, nc, free)?;
-    let a = DMatrix::from_fn(nc, nc, |r, c| j[r * n + cols[c]]);
+    let cols: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+    if cols.len() < nc {
+        return None;
+    }
+    let a = DMatrix::from_fn(nc, cols.len(), |r, c| j[r * n + cols[c]]);
+    if !a.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let svd = a.svd(true, true);
+    let largest = svd.singular_values.max();
+    let smallest = svd.singular_values.min();
+    if smallest <= 1e-12 * largest.max(1.0) {
+        return None;
+    }
     let b = DVector::from_column_slice(h);
-    let x = a.lu().solve(&b)?;
+    let x = svd.solve(&b, 0.0).ok()?;
     if !x.iter().all(|v| v.is_finite()) {
         return None;
     }
     Some(cols.into_iter().zip(x.iter().copied()).collect())
-}
-
-/// Greedy choice of one free column per constraint row, largest |J| first.
-fn pick_columns(j: &[f64], n: usize, nc: usize, free: &[bool]) -> Option<Vec<usize>> {
-    let mut chosen = Vec::with_capacity(nc);
-    for r in 0..nc {
-        let best = (0..n)
-            .filter(|&i| free[i] && !chosen.contains(&i))
-            .max_by(|&a, &b| j[r * n + a].abs().total_cmp(&j[r * n + b].abs()))?;
-        if j[r * n + best] == 0.0 {
-            return None;
-        }
-        chosen.push(best);
-    }
-    Some(chosen)
 }

@@ -139,9 +139,18 @@ fn check_model(spec: &ModelSpec, ron: &str, states: &[StateSpec]) -> Result<(), 
         numeric.constraint(&q0, &mut hn);
         check.group("h at q0", &[h, hn[k]], &[0.0, 0.0], g.y.abs());
     }
-    // So the build-time assembly check (what `build.rs` runs) accepts the model as it is.
-    if let Err(e) = camchain_codegen::assembly::assemble(&model, &d) {
-        check.errors.push(format!("build-time assembly: {e}"));
+    // The build-time assembly check (what the build runs) and the runtime's assembly agree:
+    // both accept the model as drawn (its guess is on every cam), or — a draw at a dead
+    // point, where no free coordinate can move a contact point across its cam, or with
+    // fewer free coordinates than contacts — both refuse.
+    let build = camchain_codegen::assembly::assemble(&model, &d);
+    let runtime = numeric.assemble(0.0);
+    match (&build, &runtime) {
+        (Ok(_), Ok(_)) | (Err(_), Err(_)) => {}
+        (Ok(_), Err(e)) => check
+            .errors
+            .push(format!("the build accepts, the runtime: {e}")),
+        (Err(e), _) => check.errors.push(format!("build-time assembly: {e}")),
     }
 
     for (qs, qds, t) in states {
