@@ -16,5 +16,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .include_file("random_models.rs")
             .compile_models(&["tests/random_models"])?;
     }
+    // Set by cargo when the `parameter-modes` feature is on (this package's own tests): the
+    // built-in models again with every parameter folded and with every parameter read at
+    // run time (compared by tests/parameters.rs), and the test models of parameter checks.
+    if std::env::var_os("CARGO_FEATURE_PARAMETER_MODES").is_some() {
+        let out = std::path::PathBuf::from(std::env::var("OUT_DIR")?);
+        for (dir, mode) in [
+            ("folded", camchain_build::ParameterMode::FoldAll),
+            (
+                "all_at_run_time",
+                camchain_build::ParameterMode::AllAtRunTime,
+            ),
+        ] {
+            camchain_build::Config::new()
+                .out_dir(out.join(dir))
+                .parameters(mode)
+                .include_file("models.rs")
+                .compile_models(&["."])?;
+        }
+        camchain_build::Config::new()
+            .out_dir(out.join("parameter_models"))
+            .include_file("models.rs")
+            .compile_models(&["tests/parameter_models"])?;
+    }
     Ok(())
 }

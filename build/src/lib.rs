@@ -30,7 +30,7 @@
 //! }
 //!
 //! fn main() -> Result<(), Box<dyn std::error::Error>> {
-//!     let model = follower::Model;
+//!     let model = follower::Model::default();
 //!     let mut state = model.assemble()?; // puts every contact point on its cam
 //!     model.step(&mut state, 1.0)?; // advances 1 s with the model's integrator
 //!     println!("q = {:?}", state.q);
@@ -95,6 +95,7 @@
 //! for a crate that depends on the `camchain` facade; a crate that depends on
 //! `camchain-runtime` directly sets [`Config::runtime_path`] to `::camchain_runtime`.
 
+pub use camchain_codegen::ParameterMode;
 use camchain_codegen::{EmitOptions, ModelError, generate_source, read_model_file};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -198,6 +199,16 @@ impl Config {
     /// [`EntryPoints::Auto`]: their own expressions unless the model is large.
     pub fn entry_points(&mut self, entry_points: EntryPoints) -> &mut Self {
         self.options.entry_points = entry_points;
+        self
+    }
+
+    /// Which parameters the generated code reads at run time: as each file declares
+    /// ([`ParameterMode::AsDeclared`], the default: `constant: true` ones folded, the others
+    /// in the generated `Parameters`), all folded ([`ParameterMode::FoldAll`]: the code is
+    /// what it would be with the numbers written in place), or all at run time
+    /// ([`ParameterMode::AllAtRunTime`], for comparisons).
+    pub fn parameters(&mut self, mode: ParameterMode) -> &mut Self {
+        self.options.parameters = mode;
         self
     }
 
@@ -501,12 +512,28 @@ fn index_file(compiled: &[CompiledModel], runtime_path: &str, sources: bool) -> 
         ));
     }
     text.push_str(&format!(
-        "/// Every model of this build by name, in the order compiled.\n\
-         pub static ALL: &[(&str, &(dyn {runtime_path}::Dynamics + Sync))] = &[\n"
+        "/// Every model of this build by name, in the order compiled, with the file's \
+         parameter values.\n\
+         pub static ALL: ::std::sync::LazyLock<Vec<(&str, &(dyn {runtime_path}::Dynamics + Sync))>> =\n\
+         ::std::sync::LazyLock::new(|| {{\n    Vec::from([\n"
     ));
     for model in compiled {
         text.push_str(&format!(
-            "    ({:?}, &{}::Model),\n",
+            "        ({:?}, &*{}::DEFAULT as &(dyn {runtime_path}::Dynamics + Sync)),\n",
+            model.name, model.module
+        ));
+    }
+    text.push_str("    ])\n});\n\n");
+    text.push_str(&format!(
+        "/// A model built with other parameter values: `(name, value)` pairs over the file's \
+         values, checked as the build checks the file.\n\
+         pub type Constructor = fn(&[(&str, f64)]) -> Result<Box<dyn {runtime_path}::Dynamics + Send + Sync>, {runtime_path}::ParameterError>;\n\n\
+         /// Every model of this build by name, with its [`Constructor`].\n\
+         pub static WITH_PARAMETERS: &[(&str, Constructor)] = &[\n"
+    ));
+    for model in compiled {
+        text.push_str(&format!(
+            "    ({:?}, {}::boxed),\n",
             model.name, model.module
         ));
     }

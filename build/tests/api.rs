@@ -39,7 +39,7 @@ fn a_directory_compiles_every_model_in_name_order() {
     );
     for model in &compiled {
         let code = std::fs::read_to_string(&model.output).expect("written");
-        assert!(code.contains("pub struct Model;"), "{}", model.module);
+        assert!(code.contains("pub struct Model"), "{}", model.module);
         assert!(
             code.contains("use ::camchain::runtime as rt;"),
             "the facade's runtime"
@@ -56,7 +56,7 @@ fn a_directory_compiles_every_model_in_name_order() {
 fn a_bad_model_stops_the_build_with_located_lines_and_writes_nothing() {
     let dir = scratch("bad", &["paper_concave", "double_pendulum"]);
     let text = std::fs::read_to_string(dir.join("models/paper_concave.ron")).expect("copied");
-    let broken = text.replacen("mass: 0.5,", "mass: -0.5,", 1);
+    let broken = text.replacen("mass: \"m2\",", "mass: -0.5,", 1);
     assert_ne!(broken, text, "the edit applies");
     std::fs::write(dir.join("models/paper_concave.ron"), &broken).expect("written");
     // A second problem in another file: both are reported, not only the first.
@@ -141,7 +141,8 @@ fn config_sets_runtime_path_module_names_index_and_embedded_source() {
     assert!(code.contains(&format!("pub const MODEL_SOURCE: &str = r#\"{source}\"#;")));
     let index = std::fs::read_to_string(out.join("all.rs")).expect("the index");
     assert!(index.contains("pub mod concave {\n    include!(\"concave.rs\");\n}"));
-    assert!(index.contains("(\"paper_concave\", &concave::Model)"));
+    assert!(index.contains("(\"paper_concave\", &*concave::DEFAULT as"));
+    assert!(index.contains("(\"paper_concave\", concave::boxed)"));
     assert!(index.contains("dyn ::camchain_runtime::Dynamics + Sync"));
     assert!(index.contains("(\"double_pendulum\", double_pendulum::MODEL_SOURCE)"));
     let _ = std::fs::remove_dir_all(&dir);
@@ -226,7 +227,7 @@ fn a_value_that_looks_like_degrees_is_a_located_warning_not_an_error() {
     let dir = scratch("degrees", &["double_pendulum"]);
     let path = dir.join("models/double_pendulum.ron");
     let text = std::fs::read_to_string(&path).expect("copied");
-    let edited = text.replacen("\"q2\": 0.8", "\"q2\": 45.0", 1);
+    let edited = text.replacen("\"q2\": \"q2_start\"", "\"q2\": 45.0", 1);
     assert_ne!(edited, text);
     std::fs::write(&path, &edited).expect("written");
     let compiled = config(&dir.join("out"))

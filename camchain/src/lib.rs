@@ -37,7 +37,7 @@
 //! }
 //!
 //! fn main() -> Result<(), Box<dyn std::error::Error>> {
-//!     let model = follower::Model;
+//!     let model = follower::Model::default();
 //!     let mut state = model.assemble()?; // every contact point on its cam
 //!     model.step(&mut state, 1.0)?; // 1 s with the model's default integrator
 //!     println!("q = {:?}", state.q);
@@ -53,7 +53,7 @@
 //! use camchain::runtime::{Dynamics, Simulate};
 //! use camchain_models::paper_concave::Model;
 //!
-//! let model = Model;
+//! let model = Model::default();
 //! let mut state = model.assemble()?;
 //! model.step(&mut state, 0.5)?;
 //! let run = model.simulate(state, &model.default_settings())?;
@@ -89,7 +89,7 @@ pub use camchain_reference as reference;
 /// mod follower {
 ///     camchain::include_model!("follower");
 /// }
-/// let model = follower::Model;
+/// let model = follower::Model::default();
 /// ```
 ///
 /// It reads `$OUT_DIR/camchain/<name>.rs`, where `compile_models` writes by default; with

@@ -206,7 +206,7 @@ mod tests {
     fn markers_are_where_the_generated_code_puts_the_contacts() {
         // Both compute the same chain of rotations and translations in a different order;
         // round-off of a few ulps of lengths ~1 m: 1e-12 m.
-        for (name, model) in models::ALL {
+        for (name, model) in models::ALL.iter() {
             let geometry = Geometry::new(&builtin_description(name).unwrap()).unwrap();
             let info = model.info();
             let q: Vec<f64> = (0..info.n()).map(|i| 0.3 - 0.17 * i as f64).collect();

@@ -12,7 +12,7 @@ pub fn render() -> String {
     let mut text = String::from(
         "Built-in models (run one with `camchain simulate NAME`, or a .ron file by its path):\n",
     );
-    for (name, model) in models::ALL {
+    for (name, model) in models::ALL.iter() {
         text.push('\n');
         text.push_str(&describe(name, model.info()));
     }
@@ -69,7 +69,7 @@ mod tests {
     #[test]
     fn every_model_is_listed_with_its_coordinates() {
         let text = render();
-        for (name, model) in models::ALL {
+        for (name, model) in models::ALL.iter() {
             assert!(text.contains(&format!("\n{name}\n")), "{name}");
             for c in &model.info().coordinates {
                 assert!(text.contains(&c.name));

@@ -8,8 +8,8 @@
 //! ([`NumericModel`]), so no rebuild is needed. The unmodified built-in models run their
 //! generated code ([`camchain_models::by_name`]).
 
+use camchain_codegen::model::Field;
 use camchain_codegen::model::{Model, Prescribed};
-use camchain_codegen::profile::parse_expression;
 use camchain_codegen::schema::parse_model;
 use camchain_reference::NumericModel;
 use camchain_runtime::{
@@ -175,7 +175,10 @@ pub fn scaled(model: Model, factor: f64) -> Model {
 
 /// Replaces the profile of contact `k`; the error is the parser's message.
 pub fn with_profile(mut model: Model, k: usize, source: &str) -> Result<Model, String> {
-    let profile = parse_expression(source, "x").map_err(|e| e.to_string())?;
+    let profile = model
+        .parse_expression(source, "x")
+        .map_err(|e| e.to_string())?;
+    model.symbolic.remove(&Field::Profile(k));
     let contact = model
         .contacts
         .get_mut(k)
@@ -199,12 +202,16 @@ pub fn with_velocity(mut model: Model, name: &str, value: f64) -> Result<Model, 
 /// Replaces the prescribed motion of coordinate `name` (an expression in `t`); the error
 /// is the parser's message.
 pub fn with_drive(mut model: Model, name: &str, source: &str) -> Result<Model, String> {
-    let expr = parse_expression(source, "t").map_err(|e| e.to_string())?;
-    let body = model
-        .bodies
-        .iter_mut()
-        .find(|b| b.joint.coordinate == name)
+    let expr = model
+        .parse_expression(source, "t")
+        .map_err(|e| e.to_string())?;
+    let i = model
+        .coordinate_names()
+        .iter()
+        .position(|c| *c == name)
         .ok_or_else(|| format!("the model has no coordinate {name}"))?;
+    model.symbolic.remove(&Field::Drive(i));
+    let body = &mut model.bodies[i];
     body.joint.prescribed = Some(Prescribed {
         source: source.to_string(),
         expr,

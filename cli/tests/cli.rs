@@ -273,7 +273,7 @@ fn list_names_every_model_with_its_coordinates_and_defaults() {
     let out = camchain(&std::env::temp_dir(), &["list"]);
     assert!(out.status.success());
     let listing = text(&out.stdout);
-    for (name, model) in models::ALL {
+    for (name, model) in models::ALL.iter() {
         assert!(listing.contains(name));
         for c in &model.info().coordinates {
             assert!(listing.contains(&c.name));
@@ -303,7 +303,7 @@ fn bad_input_gets_one_line_and_an_exit_code() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/paper_concave.ron"),
     )
     .unwrap()
-    .replace("mass: 0.5,", "mass: -0.5,");
+    .replace("mass: \"m2\",", "mass: -0.5,");
     std::fs::write(&malformed, source).unwrap();
     std::fs::write(dir.join("a_file"), "not a directory").unwrap();
     let cases: [(&[&str], i32, &str); 9] = [

@@ -82,7 +82,7 @@ fn out_of_reach() -> String {
         "hold: [\"q1\", \"q2\", \"q4\"]",
         "hold: [\"q1\", \"q2\", \"q3\"]",
     );
-    edit(&held, "profile: \"-0.595*x", "profile: \"-10.0 - 0.595*x")
+    edit(&held, "profile: \"a1*x", "profile: \"-10.0 + a1*x")
 }
 
 #[test]
@@ -374,11 +374,11 @@ fn a_model_file_gets_the_same_located_diagnoses_as_the_build() {
                         "hold: [\"q1\", \"q2\", \"q4\"]",
                         "hold: [\"q1\", \"q2\"]",
                     ),
-                    "(name: \"A\", body: \"body4\", position: (0.3, 0.0, 0.0)),",
-                    "(name: \"A\", body: \"body4\", position: (0.3, 0.0, 0.0)),\n        (name: \"B\", body: \"body4\", position: (0.3, 0.0, 0.0)),",
+                    "(name: \"A\", body: \"body4\", position: (\"l4\", 0.0, 0.0)),",
+                    "(name: \"A\", body: \"body4\", position: (\"l4\", 0.0, 0.0)),\n        (name: \"B\", body: \"body4\", position: (0.3, 0.0, 0.0)),",
                 ),
-                "(marker: \"A\", profile: \"-0.595*x + 0.5*x*x + 0.5*x.powi(3)\"),",
-                "(marker: \"A\", profile: \"-0.595*x + 0.5*x*x + 0.5*x.powi(3)\"),\n        (marker: \"B\", profile: \"-0.595*x + 0.5*x*x + 0.5*x.powi(3)\"),",
+                "(marker: \"A\", profile: \"a1*x + a2*x*x + a3*x.powi(3)\"),",
+                "(marker: \"A\", profile: \"a1*x + a2*x*x + a3*x.powi(3)\"),\n        (marker: \"B\", profile: \"-0.595*x + 0.5*x*x + 0.5*x.powi(3)\"),",
             ),
             "contacts A and B constrain the same motion",
         ),
@@ -457,7 +457,7 @@ fn a_byte_order_mark_at_the_start_of_a_model_file_is_accepted() {
     );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     // An error in such a file is located as in the same file without the mark.
-    let bad = edit(&model_text("paper_concave"), "mass: 0.5,", "mass: -0.5,");
+    let bad = edit(&model_text("paper_concave"), "mass: \"m2\",", "mass: -0.5,");
     let with = write(&dir, "with.ron", &format!("\u{feff}{bad}"));
     let without = write(&dir, "without.ron", &bad);
     let located = |file: &Path| {
@@ -595,8 +595,8 @@ fn results_that_are_almost_surely_a_modelling_mistake_are_warned_about() {
         "upside.ron",
         &edit(
             &paper,
-            "gravity: (0.0, -9.81, 0.0)",
-            "gravity: (0.0, 9.81, 0.0)",
+            "gravity: (0.0, \"-g\", 0.0)",
+            "gravity: (0.0, \"g\", 0.0)",
         ),
     );
     let out = camchain(

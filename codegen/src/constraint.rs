@@ -11,8 +11,8 @@
 //! are projected on the cam axes; f3' and f3'' are derived symbolically from the profile.
 
 use crate::expr::{Graph, Id};
-use crate::kinematics::{BodyKinematics, V3, vec3};
-use crate::model::{Contact, JointKind, Model};
+use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
+use crate::model::{Contact, Field, JointKind, Model};
 use crate::profile::Scalar;
 
 /// Symbolic terms of one contact.
@@ -44,41 +44,47 @@ pub struct ContactTerms {
     pub bias: Id,
 }
 
-/// Converts a one-variable [`Scalar`] to the DAG, the variable standing for `var`.
-pub fn scalar_to_expr(g: &mut Graph, s: &Scalar, var: Id) -> Id {
+/// Converts a one-variable [`Scalar`] to the DAG, the variable standing for `var` and
+/// parameter i for `params[i]` (its graph variable, or its value when it is folded).
+pub fn scalar_to_expr(g: &mut Graph, s: &Scalar, var: Id, params: &[Id]) -> Id {
+    let mut to = |e: &Scalar| scalar_to_expr(g, e, var, params);
     match s {
         Scalar::Const(c) => g.constant(*c),
         Scalar::Var => var,
+        Scalar::Param(i) => params
+            .get(*i)
+            .copied()
+            .unwrap_or_else(|| g.constant(f64::NAN)),
         Scalar::Neg(a) => {
-            let a = scalar_to_expr(g, a, var);
+            let a = to(a);
             g.neg(a)
         }
         Scalar::Add(a, b) => {
-            let (a, b) = (scalar_to_expr(g, a, var), scalar_to_expr(g, b, var));
+            let (a, b) = (to(a), to(b));
             g.add(a, b)
         }
         Scalar::Sub(a, b) => {
-            let (a, b) = (scalar_to_expr(g, a, var), scalar_to_expr(g, b, var));
+            let (a, b) = (to(a), to(b));
             g.sub(a, b)
         }
         Scalar::Mul(a, b) => {
-            let (a, b) = (scalar_to_expr(g, a, var), scalar_to_expr(g, b, var));
+            let (a, b) = (to(a), to(b));
             g.mul(a, b)
         }
         Scalar::Div(a, b) => {
-            let (a, b) = (scalar_to_expr(g, a, var), scalar_to_expr(g, b, var));
+            let (a, b) = (to(a), to(b));
             g.div(a, b)
         }
         Scalar::Powi(a, n) => {
-            let a = scalar_to_expr(g, a, var);
+            let a = to(a);
             g.powi(a, *n)
         }
         Scalar::Powf(a, b) => {
-            let (a, b) = (scalar_to_expr(g, a, var), scalar_to_expr(g, b, var));
+            let (a, b) = (to(a), to(b));
             g.powf(a, b)
         }
         Scalar::Call(f, a) => {
-            let a = scalar_to_expr(g, a, var);
+            let a = to(a);
             g.call(*f, a)
         }
     }
@@ -90,14 +96,23 @@ pub fn scalar_to_expr(g: &mut Graph, s: &Scalar, var: Id) -> Id {
 /// A polynomial (a cam profile such as −0.595x + 0.5x² + 0.5x³) is written by Horner's
 /// rule instead, value and both derivatives: n multiplications and at most n additions for
 /// degree n, where the expression as written would raise powers separately.
-pub fn value_and_derivatives(g: &mut Graph, s: &Scalar, placeholder: &str, at: Id) -> [Id; 3] {
+///
+/// `params` maps the expression's parameters to the graph (see [`scalar_to_expr`]); the
+/// derivatives are taken with respect to the variable only.
+pub fn value_and_derivatives(
+    g: &mut Graph,
+    s: &Scalar,
+    placeholder: &str,
+    at: Id,
+    params: &[Id],
+) -> [Id; 3] {
     if let Some(c) = polynomial(s) {
         let d1: Vec<f64> = (1..c.len()).map(|k| k as f64 * c[k]).collect();
         let d2: Vec<f64> = (1..d1.len()).map(|k| k as f64 * d1[k]).collect();
         return [&c[..], &d1[..], &d2[..]].map(|c| horner(g, c, at));
     }
     let x = g.var(placeholder);
-    let f = scalar_to_expr(g, s, x);
+    let f = scalar_to_expr(g, s, x, params);
     let d1 = g.diff(f, x);
     let d2 = g.diff(d1, x);
     [f, d1, d2].map(|e| g.substitute(e, x, at))
@@ -170,12 +185,10 @@ pub fn contact_terms(
     g: &mut Graph,
     model: &Model,
     kin: &[BodyKinematics],
-    qd: &[Id],
+    s: &Symbols,
 ) -> Vec<ContactTerms> {
-    model
-        .contacts
-        .iter()
-        .map(|c| one_contact(g, model, kin, qd, c))
+    (0..model.contacts.len())
+        .map(|c| one_contact(g, model, kin, s, c))
         .collect()
 }
 
@@ -183,9 +196,11 @@ fn one_contact(
     g: &mut Graph,
     model: &Model,
     kin: &[BodyKinematics],
-    qd: &[Id],
-    contact: &Contact,
+    s: &Symbols,
+    index: usize,
 ) -> ContactTerms {
+    let contact: &Contact = &model.contacts[index];
+    let qd = &s.qd;
     g.set_section(format!(
         "contact {}: position on the cam, J1, J2, convective terms, h, J, c",
         contact.name
@@ -234,7 +249,12 @@ fn one_contact(
     // α × s + ω × (ω × s) of each segment s. Across a prismatic joint the two bodies turn
     // together, so their segments are summed in the common frame before being rotated
     // (`pending`, in the frame of `body`): (l2 + q3 + l3) once instead of two segments.
-    let mut pending = vec3::constant(g, marker.position);
+    let mut pending = s.field3(
+        g,
+        model,
+        |k| Field::Marker(contact.marker, k),
+        marker.position,
+    );
     let mut done = zero3;
     let mut accel = coriolis;
     let (mut j1, mut j2) = (vec![g.zero(); n], vec![g.zero(); n]);
@@ -276,14 +296,15 @@ fn one_contact(
     }
     // The root's segment is fixed in the ground.
     let position = vec3::add(g, pending, done);
-    let origin = vec3::constant(g, contact.origin);
+    let origin = s.field3(g, model, |k| Field::Origin(index, k), contact.origin);
     let rel = vec3::sub(g, position, origin);
     let f1 = vec3::dot(g, x_axis, rel);
     let f2 = vec3::dot(g, y_axis, rel);
     let conv1 = vec3::dot(g, x_axis, accel);
     let conv2 = vec3::dot(g, y_axis, accel);
-    let [f3, slope, curvature] =
-        value_and_derivatives(g, &contact.profile, &format!("__cam_{}", contact.name), f1);
+    let profile = s.expression(model, Field::Profile(index), &contact.profile);
+    let placeholder = format!("__cam_{}", contact.name);
+    let [f3, slope, curvature] = value_and_derivatives(g, profile, &placeholder, f1, &s.params);
     let h = g.sub(f2, f3);
     let jacobian: Vec<Id> = j1
         .iter()
@@ -369,7 +390,7 @@ mod tests {
         let s = parse_expression("0.3 - 0.595*x + 0.5*x*x + 0.5*x.powi(3)", "x").expect("parses");
         let mut g = Graph::new();
         let x = g.var("x");
-        let [f, d1, d2] = value_and_derivatives(&mut g, &s, "__p", x);
+        let [f, d1, d2] = value_and_derivatives(&mut g, &s, "__p", x, &[]);
         // Fewer operations than the power-by-power form: 3 multiplications and 3 additions
         // for the value.
         assert_eq!(g.op_count(&[f]).total(), 6);

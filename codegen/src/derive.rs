@@ -1,12 +1,12 @@
 //! The whole symbolic derivation of a model: kinematics, cam constraints, dynamics, energy
 //! and prescribed motions, all in one expression graph.
 
-use crate::constraint::{ContactTerms, contact_terms, value_and_derivatives};
+use crate::constraint::{ContactTerms, contact_terms, scalar_to_expr, value_and_derivatives};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{Symbols, forward};
 use crate::linear;
-use crate::model::Model;
+use crate::model::{Field, Model};
 
 /// q(t), q̇(t), q̈(t) of a driven coordinate.
 #[derive(Debug, Clone, Copy)]
@@ -32,6 +32,12 @@ pub struct Derivation {
     pub energy: EnergyTerms,
     /// Prescribed motions of driven joints.
     pub drives: Vec<DriveTerms>,
+    /// The value of every model parameter (what the interpreter gives the run-time ones).
+    pub parameter_values: Vec<f64>,
+    /// Every numeric field that depends on run-time parameters, as an expression of them
+    /// (profiles and drives, which are functions of x and t, are not in it): what the
+    /// generated code checks and the initial guess it computes.
+    pub fields: std::collections::BTreeMap<Field, Id>,
 }
 
 impl Derivation {
@@ -48,7 +54,7 @@ impl Derivation {
         let mut g = Graph::new();
         let symbols = Symbols::new(&mut g, model);
         let kin = forward(&mut g, model, &symbols);
-        let contacts = contact_terms(&mut g, model, &kin, &symbols.qd);
+        let contacts = contact_terms(&mut g, model, &kin, &symbols);
         let dynamics = backward(&mut g, model, &symbols, &kin);
         let energy = energy(&mut g, model, &symbols, &kin);
         let drives = model
@@ -58,12 +64,22 @@ impl Derivation {
             .filter_map(|(i, b)| {
                 let p = b.joint.prescribed.as_ref()?;
                 g.set_section(format!("prescribed motion of {}", b.joint.coordinate));
-                let motion = value_and_derivatives(&mut g, &p.expr, "__drive_t", symbols.t);
+                let expr = symbols.expression(model, Field::Drive(i), &p.expr);
+                let motion =
+                    value_and_derivatives(&mut g, expr, "__drive_t", symbols.t, &symbols.params);
                 Some(DriveTerms {
                     coordinate: i,
                     motion,
                 })
             })
+            .collect();
+        g.set_section("parameters: fields read at run time");
+        let zero = g.zero();
+        let fields = model
+            .symbolic
+            .iter()
+            .filter(|(f, _)| !matches!(f, Field::Profile(_) | Field::Drive(_)))
+            .map(|(&f, expr)| (f, scalar_to_expr(&mut g, expr, zero, &symbols.params)))
             .collect();
         Derivation {
             graph: g,
@@ -72,6 +88,8 @@ impl Derivation {
             contacts,
             energy,
             drives,
+            parameter_values: model.parameters.iter().map(|p| p.value).collect(),
+            fields,
         }
     }
 
@@ -169,6 +187,9 @@ impl Derivation {
             set(id, qd[i]);
         }
         set(self.symbols.t, t);
+        for (&id, value) in self.symbols.params.iter().zip(&self.parameter_values) {
+            set(id, *value);
+        }
         vars
     }
 

@@ -21,7 +21,7 @@
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3};
 use crate::kinematics::{point_position, point_velocity, vec3};
-use crate::model::{Body, JointKind, Model};
+use crate::model::{Body, Field, JointKind, Model};
 
 /// M, F and Q of eq. (13) as expressions.
 #[derive(Debug, Clone)]
@@ -41,9 +41,9 @@ pub fn backward(
     s: &Symbols,
     kin: &[BodyKinematics],
 ) -> DynamicsTerms {
-    let mass = mass_matrix(g, model, kin);
-    let inertial = inertial_forces(g, model, kin);
-    let gravity = gravity_forces(g, model, kin);
+    let mass = mass_matrix(g, model, s, kin);
+    let inertial = inertial_forces(g, model, s, kin);
+    let gravity = gravity_forces(g, model, s, kin);
     let applied = gravity
         .iter()
         .enumerate()
@@ -84,7 +84,21 @@ fn body_constants(body: &Body) -> (f64, [f64; 3], [[f64; 3]; 3]) {
     (m, c.map(|x| m * x), tensor)
 }
 
-fn body_inertia(g: &mut Graph, body: &Body) -> Inertia {
+/// The fields of body i's mass, centre of mass and inertia tensor.
+fn inertia_fields(i: usize) -> impl Iterator<Item = Field> {
+    let com = (0..3).map(move |k| Field::Com(i, k));
+    let tensor = (0..9).map(move |e| Field::Inertia(i, e / 3, e % 3));
+    std::iter::once(Field::Mass(i)).chain(com).chain(tensor)
+}
+
+/// Body i's mass, first moment and inertia about its joint point: constants computed here
+/// when none of its fields is read at run time, otherwise expressions of the parameters
+/// (the same formulas in the graph).
+fn body_inertia(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Inertia {
+    let body = &model.bodies[i];
+    if Symbols::any_runtime(model, inertia_fields(i)) {
+        return body_inertia_symbolic(g, model, s, i);
+    }
     let (m, h, tensor) = body_constants(body);
     Inertia {
         mass: g.constant(m),
@@ -94,6 +108,29 @@ fn body_inertia(g: &mut Graph, body: &Body) -> Inertia {
             vec3::constant(g, tensor[1]),
             vec3::constant(g, tensor[2]),
         ],
+    }
+}
+
+/// [`body_inertia`] with parameters: m, h = m c, I_O = I_G + m (|c|² δ − c cᵀ).
+fn body_inertia_symbolic(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Inertia {
+    let body = &model.bodies[i];
+    let mass = s.field(g, model, Field::Mass(i), body.mass);
+    let c = s.field3(g, model, |k| Field::Com(i, k), body.com);
+    let cc = vec3::dot(g, c, c);
+    let mut tensor = [[g.zero(); 3]; 3];
+    for (a, row) in tensor.iter_mut().enumerate() {
+        for (b, cell) in row.iter_mut().enumerate() {
+            let own = s.field(g, model, Field::Inertia(i, a, b), body.inertia[a][b]);
+            let cacb = g.mul(c[a], c[b]);
+            let shift = if a == b { g.sub(cc, cacb) } else { g.neg(cacb) };
+            let m_shift = g.mul(mass, shift);
+            *cell = g.add(own, m_shift);
+        }
+    }
+    Inertia {
+        mass,
+        first: vec3::scale(g, mass, c),
+        tensor,
     }
 }
 
@@ -218,7 +255,7 @@ fn project(g: &mut Graph, model: &Model, kin: &[BodyKinematics], i: usize, n: V3
 }
 
 /// M by composite inertias.
-fn mass_matrix(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Vec<Id>> {
+fn mass_matrix(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics]) -> Vec<Vec<Id>> {
     let n = model.n();
     let kids = children(model);
     let mut composite: Vec<Option<Inertia>> = vec![None; n];
@@ -228,7 +265,7 @@ fn mass_matrix(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Vec<
             "{}: composite inertia and column {} of M",
             model.bodies[i].name, model.bodies[i].joint.coordinate
         ));
-        let mut c = body_inertia(g, &model.bodies[i]);
+        let mut c = body_inertia(g, model, s, i);
         for &k in &kids[i] {
             if let Some(child) = composite[k] {
                 let moved = to_parent(g, &kin[k], &child);
@@ -281,7 +318,7 @@ struct Loads {
 }
 
 /// F: inertial loads at q̈ = 0, summed from the tip.
-fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Id> {
+fn inertial_forces(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics]) -> Vec<Id> {
     let n = model.n();
     let kids = children(model);
     let mut loads: Vec<Option<Loads>> = (0..n).map(|_| None).collect();
@@ -292,7 +329,7 @@ fn inertial_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<
             model.bodies[i].name, model.bodies[i].joint.coordinate
         ));
         let k = &kin[i];
-        let b = body_inertia(g, &model.bodies[i]);
+        let b = body_inertia(g, model, s, i);
         // Own loads about the joint point (no centre-of-mass acceleration needed).
         let name = &model.bodies[i].name;
         let a_h = vec3::cross(g, k.alpha, b.first);
@@ -354,20 +391,13 @@ fn child_loads_to_parent(g: &mut Graph, child: &BodyKinematics, l: &Loads) -> (V
 }
 
 /// The gravity part of Q: moments of the subtrees' weights about the joints.
-fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<Id> {
+fn gravity_forces(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics]) -> Vec<Id> {
     let n = model.n();
     let kids = children(model);
-    if model.gravity == [0.0; 3] {
+    if model.gravity == [0.0; 3] && !Symbols::any_runtime(model, (0..3).map(Field::Gravity)) {
         return vec![g.zero(); n];
     }
-    // Subtree masses are constants.
-    let mut subtree = vec![0.0; n];
-    for i in (0..n).rev() {
-        subtree[i] += model.bodies[i].mass;
-        if let Some(p) = model.bodies[i].parent {
-            subtree[p] += subtree[i];
-        }
-    }
+    let subtree = subtree_masses(g, model, s);
     let mut moments: Vec<Option<V3>> = vec![None; n];
     let mut out = vec![g.zero(); n];
     for i in (0..n).rev() {
@@ -376,13 +406,13 @@ fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<I
             model.bodies[i].name, model.bodies[i].joint.coordinate
         ));
         let k = &kin[i];
-        let (_, h, _) = body_constants(&model.bodies[i]);
+        let h = body_inertia(g, model, s, i).first;
         // First moment of the subtree's weights about the joint point, children at their
         // joint points: h_i + Σ_c M_c r_c.
-        let mut arm = vec3::constant(g, h);
+        let mut arm = h;
         let mut moment = vec3::zero(g);
         for &c in &kids[i] {
-            let mc = g.constant(subtree[c]);
+            let mc = subtree[c];
             let mr = vec3::scale(g, mc, kin[c].offset);
             arm = vec3::add(g, arm, mr);
             if let Some(nc) = moments[c].take() {
@@ -398,7 +428,7 @@ fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<I
         out[i] = match model.bodies[i].joint.kind {
             JointKind::Revolute => vec3::dot(g, k.axis, moment),
             JointKind::Prismatic => {
-                let m = g.constant(subtree[i]);
+                let m = subtree[i];
                 let ug = vec3::dot(g, k.axis, k.gravity);
                 g.mul(m, ug)
             }
@@ -412,15 +442,40 @@ fn gravity_forces(g: &mut Graph, model: &Model, kin: &[BodyKinematics]) -> Vec<I
     out
 }
 
+/// The mass of every body's subtree: constants summed here when no mass is read at run
+/// time, otherwise sums in the graph.
+fn subtree_masses(g: &mut Graph, model: &Model, s: &Symbols) -> Vec<Id> {
+    let n = model.n();
+    if !Symbols::any_runtime(model, (0..n).map(Field::Mass)) {
+        let mut subtree = vec![0.0; n];
+        for i in (0..n).rev() {
+            subtree[i] += model.bodies[i].mass;
+            if let Some(p) = model.bodies[i].parent {
+                subtree[p] += subtree[i];
+            }
+        }
+        return subtree.into_iter().map(|m| g.constant(m)).collect();
+    }
+    let mut subtree: Vec<Id> = (0..n)
+        .map(|i| s.field(g, model, Field::Mass(i), model.bodies[i].mass))
+        .collect();
+    for i in (0..n).rev() {
+        if let Some(p) = model.bodies[i].parent {
+            subtree[p] = g.add(subtree[p], subtree[i]);
+        }
+    }
+    subtree
+}
+
 /// k (q − rest) + c q̇ of joint i (the sign of Q in M q̈ + F + Q = 0).
 fn spring_damper_load(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Id {
     let Some(sd) = model.bodies[i].joint.spring else {
         return g.zero();
     };
-    let rest = g.constant(sd.rest);
+    let rest = s.field(g, model, Field::Rest(i), sd.rest);
     let stretch = g.sub(s.q[i], rest);
-    let k = g.constant(sd.stiffness);
-    let c = g.constant(sd.damping);
+    let k = s.field(g, model, Field::Stiffness(i), sd.stiffness);
+    let c = s.field(g, model, Field::Damping(i), sd.damping);
     let ks = g.mul(k, stretch);
     let cv = g.mul(c, s.qd[i]);
     g.add(ks, cv)
@@ -447,31 +502,39 @@ pub fn energy(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics])
     let mut gravity = Vec::new();
     let mut spring = Vec::new();
     let mut damper = Vec::new();
-    let gvec = vec3::constant(g, model.gravity);
+    let gvec = s.field3(g, model, Field::Gravity, model.gravity);
     for (i, body) in model.bodies.iter().enumerate() {
-        let m = g.constant(body.mass);
-        let v = point_velocity(g, &kin[i], body.com);
+        let m = s.field(g, model, Field::Mass(i), body.mass);
+        let com = s.field3(g, model, |k| Field::Com(i, k), body.com);
+        let v = point_velocity(g, &kin[i], com);
         vec3::label(g, v, &format!("vel_com_{}", body.name));
         let vv = vec3::dot(g, v, v);
-        let i_w = vec3::mat_mul(g, &body.inertia, kin[i].omega);
+        let i_w = if Symbols::any_runtime(model, (0..9).map(|e| Field::Inertia(i, e / 3, e % 3))) {
+            let rows =
+                [0, 1, 2].map(|r| s.field3(g, model, |c| Field::Inertia(i, r, c), body.inertia[r]));
+            [0, 1, 2].map(|r| vec3::dot(g, rows[r], kin[i].omega))
+        } else {
+            vec3::mat_mul(g, &body.inertia, kin[i].omega)
+        };
         let w_i_w = vec3::dot(g, kin[i].omega, i_w);
         let m_vv = g.mul(m, vv);
         let both = g.add(m_vv, w_i_w);
         let own = g.mul(half, both);
         g.label(own, format!("kinetic_{}", body.name));
         kinetic.push(own);
-        let p = point_position(g, &kin[i], body.com);
+        let p = point_position(g, &kin[i], com);
         vec3::label(g, p, &format!("pos_com_{}", body.name));
         let gp = vec3::dot(g, gvec, p);
         let mgp = g.mul(m, gp);
         gravity.push(g.neg(mgp));
         if let Some(sd) = body.joint.spring {
-            let rest = g.constant(sd.rest);
+            let rest = s.field(g, model, Field::Rest(i), sd.rest);
             let stretch = g.sub(s.q[i], rest);
             let sq = g.powi(stretch, 2);
-            let k = g.constant(0.5 * sd.stiffness);
+            let k = s.field_scaled(g, model, Field::Stiffness(i), sd.stiffness, 0.5);
+            g.label(k, format!("half_stiffness_{}", body.joint.coordinate));
             spring.push(g.mul(k, sq));
-            let c = g.constant(sd.damping);
+            let c = s.field(g, model, Field::Damping(i), sd.damping);
             let v2 = g.powi(s.qd[i], 2);
             damper.push(g.mul(c, v2));
         }

@@ -14,6 +14,9 @@ use crate::profile::Func;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
+mod parameters;
+use parameters::RuntimeParameters;
+
 /// One parameter of a generated function.
 struct Param {
     name: &'static str,
@@ -86,6 +89,9 @@ pub struct EmitOptions {
     /// programs that also want the model description at run time, e.g. to draw it or to run
     /// the numeric reference on it).
     pub embedded_source: Option<String>,
+    /// Which parameters the generated code reads at run time (the file's `constant:` flags
+    /// by default).
+    pub parameters: crate::model::ParameterMode,
 }
 
 impl Default for EmitOptions {
@@ -94,6 +100,7 @@ impl Default for EmitOptions {
             runtime_path: DEFAULT_RUNTIME_PATH.to_string(),
             entry_points: EntryPoints::Auto,
             embedded_source: None,
+            parameters: crate::model::ParameterMode::AsDeclared,
         }
     }
 }
@@ -122,11 +129,22 @@ pub fn generate_with(
 ) -> Result<Generated, String> {
     let mut d = Derivation::new(model);
     let specs = function_specs(model, &d);
-    let fused = FusedTerms::new(&mut d);
+    let mut fused = FusedTerms::new(&mut d);
+    let runtime = RuntimeParameters::new(model, &d, &all_roots(&d, &specs, &fused));
+    if let Some(rp) = &runtime {
+        // A value of the parameters alone is computed once per parameter set, not cached.
+        fused.cached.retain(|&id| !rp.is_param_only(id));
+    }
+    let derived = |receiver: &str| -> Vec<(Id, String)> {
+        runtime
+            .as_ref()
+            .map(|rp| rp.given(receiver))
+            .unwrap_or_default()
+    };
     let fused_specs = fused.specs(&d);
     let fused_ops: usize = fused_specs
         .iter()
-        .map(|(spec, given)| fused_count(&d, spec, given))
+        .map(|(spec, given)| fused_count(&d, spec, &[given.clone(), derived("self.")].concat()))
         .sum();
     let wrap = match options.entry_points {
         EntryPoints::Auto => fused_ops > LARGE_MODEL_OPS,
@@ -137,14 +155,15 @@ pub fn generate_with(
     let mut op_counts = Vec::new();
     for spec in &specs {
         let (text, count) = match wrapper(model, &fused, &spec.name).filter(|_| wrap) {
-            Some(text) => (text, function_count(&d, spec)),
-            None => emit_function(&d, spec),
+            Some(text) => (text, function_count(&d, spec, &derived("self."))),
+            None => emit_function_given(&d, spec, "", true, &derived("self.")),
         };
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
     for (spec, given) in &fused_specs {
-        let (text, count) = emit_function_given(&d, spec, "", true, given);
+        let given = [given.clone(), derived("self.")].concat();
+        let (text, count) = emit_function_given(&d, spec, "", true, &given);
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
@@ -154,7 +173,11 @@ pub fn generate_with(
          fn cache_len(&self) -> usize {{ {} }}",
         fused.cached.len()
     );
-    let helpers = contact_kinematics_helpers(model, &d, &mut op_counts);
+    let helpers =
+        contact_kinematics_helpers(model, &d, &mut op_counts, runtime.is_some(), &derived(""));
+    if let Some(rp) = &runtime {
+        op_counts.push(("derive".to_string(), rp.derive_count(&d)));
+    }
     let mut file = String::new();
     let _ = writeln!(
         file,
@@ -162,7 +185,10 @@ pub fn generate_with(
          use {} as rt;",
         options.runtime_path
     );
-    file.push_str(&model_type(model, source));
+    file.push_str(&model_type(model, source, runtime.is_some()));
+    if let Some(rp) = &runtime {
+        file.push_str(&rp.items(model, &d, source));
+    }
     if let Some(text) = &options.embedded_source {
         let _ = writeln!(
             file,
@@ -173,12 +199,21 @@ pub fn generate_with(
         );
     }
     file.push_str(&info_static(model));
+    let (info, values) = if runtime.is_some() {
+        (
+            "&self.info",
+            "/// The run-time parameters' values.\n\
+             fn parameter_values(&self) -> &[f64] { &self.values }\n",
+        )
+    } else {
+        ("&INFO", "")
+    };
     let _ = write!(
         file,
         "{ALLOW_LITERALS}\nimpl rt::Dynamics for Model {{\n\
-         fn info(&self) -> &rt::ModelInfo {{ &INFO }}\n\
-         {functions}\n{}\n}}\n",
-        contact_kinematics_dispatch(model)
+         fn info(&self) -> &rt::ModelInfo {{ {info} }}\n\
+         {values}{functions}\n{}\n}}\n",
+        contact_kinematics_dispatch(model, runtime.is_some())
     );
     file.push_str(&helpers);
     file.push_str(&op_count_table(&op_counts));
@@ -190,7 +225,7 @@ pub fn generate_with(
         source: source.to_string(),
         code: format!(
             "{}\n{}",
-            header(model, source, &op_counts, wrap),
+            header(model, source, &op_counts, wrap, runtime.is_some()),
             restore_comments(&formatted)
         ),
         op_counts,
@@ -224,7 +259,13 @@ impl Generated {
 
 /// The module's header: `//` comments (a file meant for `include!` cannot start with inner
 /// `//!` doc comments), written above the formatted code.
-fn header(model: &Model, source: &str, counts: &[(String, OpCount)], wrapped: bool) -> String {
+fn header(
+    model: &Model,
+    source: &str,
+    counts: &[(String, OpCount)],
+    wrapped: bool,
+    parametric: bool,
+) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -257,6 +298,18 @@ fn header(model: &Model, source: &str, counts: &[(String, OpCount)], wrapped: bo
             c.sqrt,
             c.other,
             c.total()
+        );
+    }
+    if parametric {
+        let names: Vec<String> = model
+            .runtime_parameters()
+            .map(|(_, p)| format!("`{}`", p.name))
+            .collect();
+        let _ = writeln!(
+            out,
+            "//\n// Read at run time: {} (see `Parameters`); `derive` computes what depends on them\n\
+             // alone once per parameter set, and the counts above do not include it.",
+            names.join(", ")
         );
     }
     if wrapped {
@@ -292,7 +345,7 @@ fn op_count_table(counts: &[(String, OpCount)]) -> String {
     )
 }
 
-fn model_type(model: &Model, source: &str) -> String {
+fn model_type(model: &Model, source: &str, parametric: bool) -> String {
     let mut doc = format!(
         "/// The model `{}`, generated from `{source}`: implements [`rt::Dynamics`]; simulate it \
          with\n/// [`Model::assemble`], [`Model::step`] and [`Model::simulate`].\n",
@@ -304,12 +357,22 @@ fn model_type(model: &Model, source: &str) -> String {
             let _ = writeln!(doc, "/// {}", line.trim_end());
         }
     }
+    let (definition, constructors) = if parametric {
+        (parametric_struct(model, &doc), parametric_constructors())
+    } else {
+        (
+            format!(
+                "{doc}#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]\n\
+                 {ALLOW_UNUSED}\n\
+                 pub struct Model;\n"
+            ),
+            plain_constructors(model, source),
+        )
+    };
     format!(
-        "{doc}#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]\n\
-         {ALLOW_UNUSED}\n\
-         pub struct Model;\n\
-         {ALLOW_UNUSED}\n\
+        "{definition}{ALLOW_UNUSED}\n\
          impl Model {{\n\
+         {constructors}\
          /// Assembles the initial state from the model file's guess: held coordinates keep\n\
          /// their values, the dependent ones are solved so that every contact point is on its cam.\n\
          pub fn assemble(&self) -> Result<rt::State, rt::SimError> {{\n\
@@ -326,8 +389,87 @@ fn model_type(model: &Model, source: &str) -> String {
          rt::Simulate::simulate(self, state, settings)\n}}\n\
          /// The default settings from the model file.\n\
          pub fn default_settings(&self) -> rt::SimSettings {{\n\
-         INFO.defaults.clone()\n}}\n\
-         }}\n"
+         rt::Dynamics::info(self).defaults.clone()\n}}\n\
+         }}\n\
+         /// The model with the file's values, shared (what `ALL` of a build's index lists).\n\
+         {ALLOW_UNUSED}\n\
+         pub static DEFAULT: ::std::sync::LazyLock<Model> = ::std::sync::LazyLock::new(Model::default);\n\
+         /// [`Model::with`], boxed for programs that choose models at run time (sweeps).\n\
+         {ALLOW_UNUSED}\n\
+         pub fn boxed(values: &[(&str, f64)]) -> Result<Box<dyn rt::Dynamics + Send + Sync>, rt::ParameterError> {{\n\
+         Ok(Box::new(Model::with(values)?))\n}}\n"
+    )
+}
+
+/// The `Model` of a model with run-time parameters: the values, what derives from them, and
+/// the description (whose initial guess may depend on them).
+fn parametric_struct(model: &Model, doc: &str) -> String {
+    let n = model.runtime_parameters().count();
+    format!(
+        "{doc}///\n/// Its run-time parameters are in [`Parameters`]: [`Model::default`] has the file's \
+         values, [`Model::new`] and [`Model::with`] others (checked as the build checks the \
+         file).\n\
+         #[derive(Debug, Clone, PartialEq)]\n\
+         pub struct Model {{\n\
+         parameters: Parameters,\n\
+         values: [f64; {n}],\n\
+         derived: Derived,\n\
+         info: rt::ModelInfo,\n\
+         }}\n\
+         impl Default for Model {{\n\
+         /// The model with the file's values (checked when it was built).\n\
+         fn default() -> Self {{ Model::build(Parameters::default()) }}\n}}\n"
+    )
+}
+
+/// Constructors of a model with run-time parameters.
+fn parametric_constructors() -> String {
+    "/// The model with these parameter values, checked as the build checks the model file \
+     (declared bounds first, then every field they change: a negative mass gets the error \
+     the file would get).\n\
+     pub fn new(parameters: Parameters) -> Result<Self, rt::ParameterError> {\n\
+     check(&parameters)?;\n\
+     Ok(Model::build(parameters))\n}\n\
+     /// The file's values with the named ones changed (`Model::with(&[(\"k\", 40.0)])`).\n\
+     pub fn with(values: &[(&str, f64)]) -> Result<Self, rt::ParameterError> {\n\
+     let mut parameters = Parameters::default();\n\
+     for &(name, value) in values {\n\
+     parameters.set(name, value)?;\n}\n\
+     Model::new(parameters)\n}\n\
+     /// The parameter values of this model.\n\
+     pub fn parameters(&self) -> &Parameters {\n\
+     &self.parameters\n}\n\
+     fn build(parameters: Parameters) -> Self {\n\
+     let mut info = INFO.clone();\n\
+     initial_guess(&parameters, &mut info.initial.q, &mut info.initial.qd);\n\
+     Model { values: parameters.values(), derived: derive(&parameters), parameters, info }\n}\n"
+        .to_string()
+}
+
+/// `Model::with` of a model without run-time parameters: only the empty list is accepted.
+fn plain_constructors(model: &Model, source: &str) -> String {
+    let names: Vec<String> = model
+        .parameters
+        .iter()
+        .map(|p| format!("{:?}", p.name))
+        .collect();
+    let at = &model.parameters_at;
+    format!(
+        "/// The model with the file's values: it has no run-time parameter, so any name given \
+         is an error (a declared parameter is folded into this code: constant).\n\
+         pub fn with(values: &[(&str, f64)]) -> Result<Self, rt::ParameterError> {{\n\
+         match values.first() {{\n\
+         None => Ok(Model),\n\
+         Some(&(name, _)) => {{\n\
+         let known: &[&str] = &[{names}];\n\
+         let message = if known.contains(&name) {{ rt::parameters::checks::constant_parameter(name) }} \
+         else {{ rt::parameters::checks::unknown_parameter(name, known) }};\n\
+         Err(rt::ParameterError {{ file: {source:?}.to_string(), line: {}, column: {}, field: {:?}.to_string(), message }})\n\
+         }}\n}}\n}}\n",
+        at.line,
+        at.column,
+        at.field,
+        names = names.join(", "),
     )
 }
 
@@ -369,6 +511,7 @@ fn info_static(model: &Model) -> String {
          spatial: {spatial},\n\
          initial: rt::InitialGuess {{ q: Vec::from({q}), qd: Vec::from({qd}), hold: Vec::from({hold:?}), given_q: Vec::from({given_q:?}), given_qd: Vec::from({given_qd:?}) }},\n\
          defaults: rt::SimSettings {{ t_end: {t_end}, dt_out: {dt_out}, integrator: rt::IntegratorKind::{integrator}, dt: {dt}, rtol: {rtol}, atol: {atol} }},\n\
+         parameters: Vec::from([{parameters}]),\n\
          }});\n",
         name = model.name,
         desc = model.description,
@@ -385,7 +528,28 @@ fn info_static(model: &Model) -> String {
         dt = lit(s.dt),
         rtol = lit(s.rtol),
         atol = lit(s.atol),
+        parameters = parameter_infos(model),
     )
+}
+
+/// The run-time parameters as `rt::ParameterInfo` values.
+fn parameter_infos(model: &Model) -> String {
+    let option = |v: Option<f64>| v.map_or("None".to_string(), |v| format!("Some({})", lit(v)));
+    let items: Vec<String> = model
+        .runtime_parameters()
+        .map(|(_, p)| {
+            format!(
+                "rt::ParameterInfo {{ name: {:?}.to_string(), unit: {:?}.to_string(), default: {}, min: {}, max: {}, description: {:?}.to_string() }}",
+                p.name,
+                p.unit,
+                lit(p.default),
+                option(p.min),
+                option(p.max),
+                p.description
+            )
+        })
+        .collect();
+    items.join(", ")
 }
 
 fn float_list(v: &[f64]) -> String {
@@ -845,10 +1009,29 @@ impl FusedTerms {
 /// 8000, is above and checks the calls against the numeric recursion.)
 pub const LARGE_MODEL_OPS: usize = 4000;
 
-/// Operation count of a function's outputs (what it computes when emitted on its own).
-fn function_count(d: &Derivation, spec: &FunctionSpec) -> OpCount {
+/// Operation count of a function's outputs (what it computes when emitted on its own), the
+/// nodes of `given` read rather than computed.
+fn function_count(d: &Derivation, spec: &FunctionSpec, given: &[(Id, String)]) -> OpCount {
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
-    d.graph.op_count(&roots)
+    let given: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
+    d.graph.op_count_until(&roots, &given)
+}
+
+/// The outputs of every generated function (the standalone entry points, the fused pair and
+/// the contact kinematics).
+fn all_roots(d: &Derivation, specs: &[FunctionSpec], fused: &FusedTerms) -> Vec<Id> {
+    let mut roots: Vec<Id> = specs
+        .iter()
+        .flat_map(|s| s.outputs.iter().map(|(_, id)| *id))
+        .chain(fused.position.iter().map(|(_, id)| *id))
+        .chain(fused.velocity.iter().map(|(_, id)| *id))
+        .collect();
+    for c in &d.contacts {
+        roots.extend(c.position);
+        roots.extend([c.f1, c.f2, c.slope, c.curvature, c.conv1, c.conv2]);
+        roots.extend(c.j1.iter().chain(&c.j2));
+    }
+    roots
 }
 
 /// Operation count of a fused function, the cached nodes read rather than computed.
@@ -1037,17 +1220,18 @@ fn energy_spec(d: &Derivation) -> FunctionSpec {
     }
 }
 
-fn contact_kinematics_dispatch(model: &Model) -> String {
+fn contact_kinematics_dispatch(model: &Model, parametric: bool) -> String {
+    let derived = if parametric { "&self.derived, " } else { "" };
     if model.contacts.is_empty() {
         return "/// No contact: nothing to write.\n\
                 fn contact_kinematics_into(&self, _q: &[f64], _qd: &[f64], _k: usize, _out: &mut rt::ContactKinematics) {}\n"
             .to_string();
     }
     let body = if model.contacts.len() == 1 {
-        "if k == 0 { contact_kinematics_0(q, qd, out); }".to_string()
+        format!("if k == 0 {{ contact_kinematics_0({derived}q, qd, out); }}")
     } else {
         let arms: String = (0..model.contacts.len())
-            .map(|k| format!("{k} => contact_kinematics_{k}(q, qd, out),\n"))
+            .map(|k| format!("{k} => contact_kinematics_{k}({derived}q, qd, out),\n"))
             .collect();
         format!("match k {{\n{arms}_ => {{}}\n}}")
     };
@@ -1063,6 +1247,8 @@ fn contact_kinematics_helpers(
     model: &Model,
     d: &Derivation,
     counts: &mut Vec<(String, OpCount)>,
+    parametric: bool,
+    derived: &[(Id, String)],
 ) -> String {
     let n = model.n();
     let mut out = String::new();
@@ -1091,20 +1277,28 @@ fn contact_kinematics_helpers(
                 c_name(model, k)
             ),
             name: format!("contact_kinematics_{k}"),
-            params: vec![
-                param("q", "&[f64]"),
-                param("qd", "&[f64]"),
-                Param {
+            params: [
+                parametric.then_some(Param {
+                    name: "derived",
+                    ty: "&Derived",
+                    always_used: false,
+                }),
+                Some(param("q", "&[f64]")),
+                Some(param("qd", "&[f64]")),
+                Some(Param {
                     name: "out",
                     ty: "&mut rt::ContactKinematics",
                     always_used: true,
-                },
-            ],
+                }),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
             ret: None,
             outputs,
             tail: String::new(),
         };
-        let (text, count) = emit_function_with_prelude(d, &spec, "", false);
+        let (text, count) = emit_function_given(d, &spec, "", false, derived);
         out.push_str(ALLOW_LITERALS);
         out.push('\n');
         out.push_str(&text);
@@ -1115,19 +1309,6 @@ fn contact_kinematics_helpers(
 
 fn c_name(model: &Model, k: usize) -> &str {
     &model.contacts[k].name
-}
-
-fn emit_function(d: &Derivation, spec: &FunctionSpec) -> (String, OpCount) {
-    emit_function_with_prelude(d, spec, "", true)
-}
-
-fn emit_function_with_prelude(
-    d: &Derivation,
-    spec: &FunctionSpec,
-    prelude: &str,
-    method: bool,
-) -> (String, OpCount) {
-    emit_function_given(d, spec, prelude, method, &[])
 }
 
 /// Emits `spec`; the nodes of `given` are read from the expressions paired with them (e.g.
@@ -1143,10 +1324,21 @@ fn emit_function_given(
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
     let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
     let count = g.op_count_until(&roots, &given_set);
-    let mut body = Emitter::new(g, &spec.outputs, given);
+    let mut body = Emitter::new(g, &spec.outputs, given, &d.symbols.params);
     let (bindings, used_vars) = body.bindings();
     let inputs = input_bindings(d, &used_vars);
-    let used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
+    let mut used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
+    // A parameter that a bound given expression reads (`derived.k1`, `cache[3]`).
+    for p in &spec.params {
+        let reads = |(id, source): &(Id, String)| {
+            body.names.contains_key(id)
+                && (source.starts_with(&format!("{}.", p.name))
+                    || source.starts_with(&format!("{}[", p.name)))
+        };
+        if given.iter().any(reads) {
+            used_params.insert(p.name);
+        }
+    }
     let params: Vec<String> = spec
         .params
         .iter()
@@ -1208,6 +1400,18 @@ fn input_bindings(d: &Derivation, used: &HashSet<Id>) -> Vec<(&'static str, Stri
     }
     if used.contains(&d.symbols.t) {
         lines.push(("t", String::new()));
+    }
+    for &id in &d.symbols.params {
+        if used.contains(&id) {
+            let Node::Var(k) = d.graph.node(id) else {
+                continue;
+            };
+            let field = &d.graph.var_names()[k as usize];
+            lines.push((
+                "p",
+                format!("let {} = p.{field};\n", names.var(&d.graph, id)),
+            ));
+        }
     }
     lines
 }
@@ -1379,10 +1583,12 @@ struct Emitter<'g> {
     outputs: HashMap<Id, String>,
     names: HashMap<Id, String>,
     vars: Names,
+    /// The variables of the run-time parameters.
+    parameters: HashSet<Id>,
 }
 
 impl<'g> Emitter<'g> {
-    fn new(g: &'g Graph, outputs: &[(String, Id)], given: &[(Id, String)]) -> Self {
+    fn new(g: &'g Graph, outputs: &[(String, Id)], given: &[(Id, String)], params: &[Id]) -> Self {
         let roots: Vec<Id> = outputs.iter().map(|(_, id)| *id).collect();
         let given: HashMap<Id, String> = given.iter().cloned().collect();
         let stop: HashSet<Id> = given.keys().copied().collect();
@@ -1419,6 +1625,7 @@ impl<'g> Emitter<'g> {
             outputs: output_names,
             names: HashMap::new(),
             vars: Names::of_vars(g),
+            parameters: params.iter().copied().collect(),
         }
     }
 
@@ -1437,7 +1644,19 @@ impl<'g> Emitter<'g> {
     fn bindings(&mut self) -> (String, HashSet<Id>) {
         let mut text = String::new();
         let mut used_vars = HashSet::new();
-        let mut taken: HashSet<String> = self.vars.by_var.values().cloned().collect();
+        // Every input's name is taken, but that of a parameter this function reads only
+        // through stored values (`let k2 = self.derived.k2;` may then be called `k2`).
+        let mut taken: HashSet<String> = self
+            .vars
+            .by_var
+            .iter()
+            .filter(|&(&k, _)| {
+                let id = self.g.var_id(k);
+                !self.parameters.contains(&id)
+                    || (self.reachable[id.index()] && !self.given.contains_key(&id))
+            })
+            .map(|(_, name)| name.clone())
+            .collect();
         for word in [
             "q", "qd", "qdd", "t", "m", "f", "j", "c", "h", "out", "applied", "power", "cache",
         ] {
@@ -1478,7 +1697,10 @@ impl<'g> Emitter<'g> {
                 Some(source) => source.clone(),
                 None => self.render(id).0,
             };
-            let name = self.fresh_name(id, &mut taken);
+            let name = match self.given_field(id) {
+                Some(field) => fresh(&field, &mut taken),
+                None => self.fresh_name(id, &mut taken),
+            };
             let _ = writeln!(text, "let {name} = {expr};");
             self.names.insert(id, name);
         }
@@ -1535,13 +1757,7 @@ impl<'g> Emitter<'g> {
     /// named expression that uses it.
     fn fresh_name(&self, id: Id, taken: &mut HashSet<String>) -> String {
         if let Some(base) = self.structural_name(id) {
-            let mut name = base.clone();
-            let mut k = 1;
-            while !taken.insert(name.clone()) {
-                k += 1;
-                name = format!("{base}_{k}");
-            }
-            return name;
+            return fresh(&base, taken);
         }
         let prefix = self.term_name(id);
         let mut k = 1;
@@ -1552,6 +1768,16 @@ impl<'g> Emitter<'g> {
             }
             k += 1;
         }
+    }
+
+    /// The field a given node is read from (`k2` for `self.derived.k2`), as its name.
+    fn given_field(&self, id: Id) -> Option<String> {
+        let source = self.given.get(&id)?;
+        let (_, field) = source.rsplit_once('.')?;
+        field
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_')
+            .then(|| field.to_string())
     }
 
     fn structural_name(&self, id: Id) -> Option<String> {
@@ -1661,6 +1887,17 @@ impl<'g> Emitter<'g> {
             text
         }
     }
+}
+
+/// `base`, or `base_2`, `base_3`, … when taken; marks the name taken.
+fn fresh(base: &str, taken: &mut HashSet<String>) -> String {
+    let mut name = base.to_string();
+    let mut k = 1;
+    while !taken.insert(name.clone()) {
+        k += 1;
+        name = format!("{base}_{k}");
+    }
+    name
 }
 
 /// `m_3` for the target `m[3]`, `mass_3` for `out.mass[3]`, `kinetic` for `let kinetic`.

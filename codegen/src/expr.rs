@@ -195,6 +195,14 @@ impl Graph {
         &self.vars
     }
 
+    /// The node of variable `k` (an index into [`Graph::var_names`]).
+    pub fn var_id(&self, k: u32) -> Id {
+        self.var_ids
+            .get(&self.vars[k as usize])
+            .copied()
+            .unwrap_or(Id(u32::MAX))
+    }
+
     /// Index of a variable in [`Graph::var_names`], if it exists.
     pub fn var_index(&self, name: &str) -> Option<usize> {
         self.vars.iter().position(|v| v == name)

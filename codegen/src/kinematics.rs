@@ -10,8 +10,10 @@
 //! carried separately, seen in each body's frame, so that F and the gravity part of Q are
 //! separate recursions and each only costs O(n).
 
+use crate::constraint::scalar_to_expr;
 use crate::expr::{Graph, Id};
-use crate::model::{JointKind, Model};
+use crate::model::{Field, JointKind, Model};
+use crate::profile::Scalar;
 
 /// A 3-vector of expressions.
 pub type V3 = [Id; 3];
@@ -25,16 +27,93 @@ pub struct Symbols {
     pub qd: Vec<Id>,
     /// Time t.
     pub t: Id,
+    /// One entry per model parameter: the variable of a run-time parameter, or the value of
+    /// a constant one (which the validated expressions never mention).
+    pub params: Vec<Id>,
 }
 
 impl Symbols {
-    /// Creates the variables of `model` in `g`.
+    /// Creates the variables of `model` in `g`: coordinates, velocities, time, and the
+    /// run-time parameters (after them, so that a model without any gets the same graph).
     pub fn new(g: &mut Graph, model: &Model) -> Self {
         let names = model.coordinate_names();
         let q = names.iter().map(|n| g.var(n)).collect();
         let qd = names.iter().map(|n| g.var(&format!("{n}_dot"))).collect();
         let t = g.var("t");
-        Symbols { q, qd, t }
+        if model.runtime_parameters().next().is_some() {
+            g.set_section("run-time parameters (values stored when they are set)");
+        }
+        let params = model
+            .parameters
+            .iter()
+            .map(|p| {
+                if p.constant {
+                    g.constant(p.value)
+                } else {
+                    g.var(&p.name)
+                }
+            })
+            .collect();
+        Symbols { q, qd, t, params }
+    }
+
+    /// True when `id` is the variable of a run-time parameter.
+    pub fn is_parameter(&self, g: &Graph, id: Id) -> bool {
+        matches!(g.node(id), crate::expr::Node::Var(_)) && self.params.contains(&id)
+    }
+
+    /// A numeric field: its expression of run-time parameters if the model has one,
+    /// otherwise the constant `value` (exactly as before parameters existed).
+    pub fn field(&self, g: &mut Graph, model: &Model, field: Field, value: f64) -> Id {
+        self.field_scaled(g, model, field, value, 1.0)
+    }
+
+    /// `factor` times a numeric field (`0.5 k` of a spring's energy): folded into one
+    /// constant when the field is constant.
+    pub fn field_scaled(
+        &self,
+        g: &mut Graph,
+        model: &Model,
+        field: Field,
+        value: f64,
+        factor: f64,
+    ) -> Id {
+        match model.symbolic.get(&field) {
+            Some(expr) => {
+                let zero = g.zero();
+                let e = scalar_to_expr(g, expr, zero, &self.params);
+                let k = g.constant(factor);
+                g.mul(k, e)
+            }
+            None => g.constant(factor * value),
+        }
+    }
+
+    /// Three numeric fields (a point, a vector) keyed by component.
+    pub fn field3(
+        &self,
+        g: &mut Graph,
+        model: &Model,
+        key: impl Fn(usize) -> Field,
+        value: [f64; 3],
+    ) -> V3 {
+        [0, 1, 2].map(|k| self.field(g, model, key(k), value[k]))
+    }
+
+    /// An expression field (a profile, a drive): the one with run-time parameters if the
+    /// model has it, otherwise `resolved`.
+    pub fn expression<'m>(
+        &self,
+        model: &'m Model,
+        field: Field,
+        resolved: &'m Scalar,
+    ) -> &'m Scalar {
+        model.symbolic.get(&field).unwrap_or(resolved)
+    }
+
+    /// True when any of the fields is read at run time.
+    pub fn any_runtime(model: &Model, fields: impl IntoIterator<Item = Field>) -> bool {
+        fields.into_iter().any(|f| model.symbolic.contains_key(&f))
     }
 }
 
@@ -272,10 +351,16 @@ pub struct BodyKinematics {
     pub gravity: V3,
 }
 
+/// −g in ground coordinates (gravity enters as an acceleration of the ground).
+pub fn minus_gravity(g: &mut Graph, model: &Model, s: &Symbols) -> V3 {
+    let gravity = s.field3(g, model, Field::Gravity, model.gravity);
+    [0, 1, 2].map(|k| g.neg(gravity[k]))
+}
+
 /// Forward recursion over all bodies (parents first), eq. (9).
 pub fn forward(g: &mut Graph, model: &Model, s: &Symbols) -> Vec<BodyKinematics> {
     let mut out: Vec<BodyKinematics> = Vec::with_capacity(model.n());
-    let ground = ground_kinematics(g, model);
+    let ground = ground_kinematics(g, model, s);
     for (i, body) in model.bodies.iter().enumerate() {
         let parent = match body.parent {
             Some(p) => &out[p],
@@ -293,8 +378,9 @@ pub fn forward(g: &mut Graph, model: &Model, s: &Symbols) -> Vec<BodyKinematics>
 }
 
 /// The ground as a "body" at rest.
-fn ground_kinematics(g: &mut Graph, model: &Model) -> BodyKinematics {
+fn ground_kinematics(g: &mut Graph, model: &Model, s: &Symbols) -> BodyKinematics {
     let zero = vec3::zero(g);
+    let gravity = minus_gravity(g, model, s);
     BodyKinematics {
         relative: Rotation::Identity,
         offset: zero,
@@ -308,7 +394,7 @@ fn ground_kinematics(g: &mut Graph, model: &Model) -> BodyKinematics {
         alpha: zero,
         accel: zero,
         accel_in_parent: zero,
-        gravity: vec3::constant(g, model.gravity.map(|x| -x)),
+        gravity,
     }
 }
 
@@ -321,7 +407,7 @@ fn child_kinematics(
 ) -> BodyKinematics {
     let joint = &model.bodies[i].joint;
     let axis = vec3::constant(g, joint.axis);
-    let anchor = vec3::constant(g, joint.anchor);
+    let anchor = s.field3(g, model, |k| Field::Anchor(i, k), joint.anchor);
     let (q, qd) = (s.q[i], s.qd[i]);
     let (relative, offset) = match joint.kind {
         JointKind::Revolute => (
@@ -385,7 +471,7 @@ fn child_kinematics(
         }
     };
     let rotation = p.rotation.compose(g, &relative);
-    let gravity = gravity_in_body(g, model, &rotation, &relative, p);
+    let gravity = gravity_in_body(g, model, s, &rotation, &relative, p);
     let step = p.rotation.apply(g, offset);
     let origin = vec3::add(g, p.origin, step);
     let axis_ground = p.rotation.apply(g, axis);
@@ -415,13 +501,14 @@ fn child_kinematics(
 fn gravity_in_body(
     g: &mut Graph,
     model: &Model,
+    s: &Symbols,
     rotation: &Rotation,
     relative: &Rotation,
     p: &BodyKinematics,
 ) -> V3 {
     match rotation {
         Rotation::Axis { .. } => {
-            let ground = vec3::constant(g, model.gravity.map(|x| -x));
+            let ground = minus_gravity(g, model, s);
             rotation.apply_transpose(g, ground)
         }
         _ => relative.apply_transpose(g, p.gravity),
@@ -457,16 +544,16 @@ fn label_matrix(g: &mut Graph, rows: &[V3; 3], name: &str) {
     }
 }
 
-/// A point fixed on a body: its position in ground coordinates.
-pub fn point_position(g: &mut Graph, k: &BodyKinematics, local: [f64; 3]) -> V3 {
-    let m = vec3::constant(g, local);
+/// A point fixed on a body (`local`, body frame): its position in ground coordinates.
+pub fn point_position(g: &mut Graph, k: &BodyKinematics, local: V3) -> V3 {
+    let m = local;
     let moved = k.rotation.apply(g, m);
     vec3::add(g, k.origin, moved)
 }
 
 /// Velocity of a body-fixed point, body frame: v_O + ω × m.
-pub fn point_velocity(g: &mut Graph, k: &BodyKinematics, local: [f64; 3]) -> V3 {
-    let m = vec3::constant(g, local);
+pub fn point_velocity(g: &mut Graph, k: &BodyKinematics, local: V3) -> V3 {
+    let m = local;
     let w_m = vec3::cross(g, k.omega, m);
     vec3::add(g, k.velocity, w_m)
 }

@@ -31,7 +31,7 @@ pub mod schema;
 
 pub use derive::Derivation;
 pub use error::ModelError;
-pub use model::Model;
+pub use model::{Model, ParameterMode};
 
 pub use emit::{EmitOptions, EntryPoints, Generated};
 
@@ -96,7 +96,7 @@ pub fn generate_source(
     display: &Path,
     options: &EmitOptions,
 ) -> Result<Generated, ModelError> {
-    let model = schema::parse_model(source, display)?;
+    let model = schema::parse_model_with(source, display, &[], options.parameters)?;
     if !schema::is_identifier(&model.name) {
         return Err(schema::field_error(
             display,

@@ -149,6 +149,127 @@ pub struct Initial {
     pub given_qd: Vec<bool>,
 }
 
+/// A named number of the model file that fields and expressions use (`parameters:`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    /// Unique name (a Rust identifier).
+    pub name: String,
+    /// The value this model was built with: the file's default, or the value a run gave.
+    pub value: f64,
+    /// The file's value.
+    pub default: f64,
+    /// The unit, as free text (`"N/m"`), for documentation and output headers.
+    pub unit: String,
+    /// Smallest value accepted (inclusive), if declared.
+    pub min: Option<f64>,
+    /// Largest value accepted (inclusive), if declared.
+    pub max: Option<f64>,
+    /// Folded into the generated code at build time (`constant: true`) instead of being
+    /// read at run time.
+    pub constant: bool,
+    /// Free text from the file.
+    pub description: String,
+    /// Where its `constant` field is (or would be) written: errors about giving a constant
+    /// parameter a value point there.
+    pub constant_at: FieldLocation,
+}
+
+/// Which parameters the generated code reads at run time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ParameterMode {
+    /// As the file declares: `constant: true` ones are folded, the others read at run time.
+    #[default]
+    AsDeclared,
+    /// Every parameter folded: the generated code is what it would be with the numbers
+    /// written in place (no `Parameters`, nothing read at run time).
+    FoldAll,
+    /// Every parameter read at run time, except those a field that must be constant uses
+    /// (a joint axis, a cam plane's axes): for tests that compare it with [`FoldAll`].
+    ///
+    /// [`FoldAll`]: ParameterMode::FoldAll
+    AllAtRunTime,
+}
+
+/// Where a field is written in the model file (1-based; 0 when it cannot be located).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct FieldLocation {
+    /// Dotted path of the field (`bodies[0].mass`).
+    pub field: String,
+    /// Line.
+    pub line: usize,
+    /// Column.
+    pub column: usize,
+}
+
+/// A check the generated code makes when it is given parameter values, in the order the
+/// build's validator makes it, so that a bad value gets the error the file would get.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RuntimeCheck {
+    /// A run-time parameter within its declared range (finite; `min`, `max`).
+    Bounds {
+        /// Index into [`Model::parameters`].
+        parameter: usize,
+        /// `parameters[i].value`, `.min` and `.max`.
+        at: [FieldLocation; 3],
+    },
+    /// The value of a field is finite.
+    Finite(Field, FieldLocation),
+    /// The value of a field is positive (`what` names it in the message).
+    Positive(Field, &'static str, FieldLocation),
+    /// The value of a field is non-negative.
+    NonNegative(Field, &'static str, FieldLocation),
+    /// The inertia tensor of a body (sorted index) is physical.
+    Inertia(usize, FieldLocation),
+}
+
+/// A numeric field of the model, by position (body and coordinate indices are the sorted,
+/// parents-first ones): the key of [`Model::symbolic`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Field {
+    /// Component k of gravity.
+    Gravity(usize),
+    /// Mass of body i.
+    Mass(usize),
+    /// Component k of body i's centre of mass.
+    Com(usize, usize),
+    /// Entry (r, c) of body i's inertia tensor.
+    Inertia(usize, usize, usize),
+    /// Component k of joint i's anchor.
+    Anchor(usize, usize),
+    /// Spring stiffness of joint i.
+    Stiffness(usize),
+    /// Damping of joint i.
+    Damping(usize),
+    /// Spring rest value of joint i.
+    Rest(usize),
+    /// The prescribed motion of joint i (an expression of t).
+    Drive(usize),
+    /// Component k of marker m's position.
+    Marker(usize, usize),
+    /// Component k of contact c's cam-frame origin.
+    Origin(usize, usize),
+    /// The profile of contact c (an expression of x).
+    Profile(usize),
+    /// The initial guess of coordinate i.
+    InitialQ(usize),
+    /// The initial guess of velocity i.
+    InitialQd(usize),
+}
+
+impl Field {
+    /// True for the third (z) component of a point or of gravity.
+    pub fn is_z(self) -> bool {
+        matches!(
+            self,
+            Field::Gravity(2)
+                | Field::Com(_, 2)
+                | Field::Anchor(_, 2)
+                | Field::Marker(_, 2)
+                | Field::Origin(_, 2)
+        )
+    }
+}
+
 /// A complete, validated model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -156,6 +277,18 @@ pub struct Model {
     pub name: String,
     /// Free text from the file.
     pub description: String,
+    /// The parameters, in file order; every numeric field below holds its value for
+    /// these parameters' values.
+    pub parameters: Vec<Parameter>,
+    /// The fields that depend on a run-time (not `constant`) parameter, as expressions
+    /// whose [`Scalar::Param`] leaves are those parameters
+    /// (constant ones are already folded in): what the generated code computes at run time.
+    /// Empty when the model has no run-time parameters.
+    pub symbolic: std::collections::BTreeMap<Field, crate::profile::Scalar>,
+    /// The checks of the values that depend on run-time parameters, in validation order.
+    pub runtime_checks: Vec<RuntimeCheck>,
+    /// Where the `parameters` list is written (for errors about unknown names).
+    pub parameters_at: FieldLocation,
     /// Gravity vector in ground coordinates (m/s²).
     pub gravity: [f64; 3],
     /// Bodies, parents before children.
@@ -199,5 +332,27 @@ impl Model {
                 .iter()
                 .all(|c| in_plane(&c.origin) && in_plane(&c.x_axis) && in_plane(&c.y_axis))
             && self.gravity[2] == 0.0
+            && !self.symbolic.keys().any(|f| f.is_z())
+    }
+
+    /// Parses an expression of `variable` that may use the model's parameters, each
+    /// replaced by its value (for a variant of the model built in memory).
+    pub fn parse_expression(
+        &self,
+        source: &str,
+        variable: &str,
+    ) -> Result<crate::profile::Scalar, crate::profile::ExprError> {
+        let names: Vec<&str> = self.parameters.iter().map(|p| p.name.as_str()).collect();
+        let values: Vec<f64> = self.parameters.iter().map(|p| p.value).collect();
+        crate::profile::parse_expression_with(source, Some(variable), &names)
+            .map(|e| e.resolve_all(&values))
+    }
+
+    /// The parameters read at run time (not `constant`), with their indices.
+    pub fn runtime_parameters(&self) -> impl Iterator<Item = (usize, &Parameter)> {
+        self.parameters
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| !p.constant)
     }
 }

@@ -53,6 +53,9 @@ pub enum Scalar {
     Const(f64),
     /// The variable (`x` for a profile, `t` for a drive).
     Var,
+    /// A parameter of the model, by its index in the model's parameter list. Resolve it
+    /// ([`Scalar::resolve`]) before evaluating: [`Scalar::eval`] gives NaN for it.
+    Param(usize),
     /// −a
     Neg(Box<Scalar>),
     /// a + b
@@ -78,6 +81,7 @@ impl Scalar {
         match self {
             Scalar::Const(c) => *c,
             Scalar::Var => v,
+            Scalar::Param(_) => f64::NAN,
             Scalar::Neg(a) => -a.eval(v),
             Scalar::Add(a, b) => a.eval(v) + b.eval(v),
             Scalar::Sub(a, b) => a.eval(v) - b.eval(v),
@@ -98,11 +102,12 @@ impl Scalar {
         }
     }
 
-    /// True when the variable occurs anywhere in the tree.
+    /// True when the variable or a parameter occurs anywhere in the tree (a parameter may
+    /// change at run time, so it is not a constant).
     fn mentions_variable(&self) -> bool {
         match self {
             Scalar::Const(_) => false,
-            Scalar::Var => true,
+            Scalar::Var | Scalar::Param(_) => true,
             Scalar::Neg(a) | Scalar::Powi(a, _) | Scalar::Call(_, a) => a.mentions_variable(),
             Scalar::Add(a, b)
             | Scalar::Sub(a, b)
@@ -110,6 +115,55 @@ impl Scalar {
             | Scalar::Div(a, b)
             | Scalar::Powf(a, b) => a.mentions_variable() || b.mentions_variable(),
         }
+    }
+}
+
+impl Scalar {
+    /// The expression with parameter `i` replaced by the constant `values[i]` wherever
+    /// `replace(i)` holds (all of them, or only the ones folded at build time).
+    pub fn resolve(&self, values: &[f64], replace: &dyn Fn(usize) -> bool) -> Scalar {
+        let r = |a: &Scalar| Box::new(a.resolve(values, replace));
+        match self {
+            Scalar::Param(i) if replace(*i) => Scalar::Const(values[*i]),
+            Scalar::Const(_) | Scalar::Var | Scalar::Param(_) => self.clone(),
+            Scalar::Neg(a) => Scalar::Neg(r(a)),
+            Scalar::Add(a, b) => Scalar::Add(r(a), r(b)),
+            Scalar::Sub(a, b) => Scalar::Sub(r(a), r(b)),
+            Scalar::Mul(a, b) => Scalar::Mul(r(a), r(b)),
+            Scalar::Div(a, b) => Scalar::Div(r(a), r(b)),
+            Scalar::Powi(a, n) => Scalar::Powi(r(a), *n),
+            Scalar::Powf(a, b) => Scalar::Powf(r(a), r(b)),
+            Scalar::Call(f, a) => Scalar::Call(*f, r(a)),
+        }
+    }
+
+    /// The expression with every parameter replaced by its value.
+    pub fn resolve_all(&self, values: &[f64]) -> Scalar {
+        self.resolve(values, &|_| true)
+    }
+
+    /// The indices of the parameters the expression uses, each once, in increasing order.
+    pub fn parameters(&self) -> Vec<usize> {
+        fn walk(s: &Scalar, out: &mut Vec<usize>) {
+            match s {
+                Scalar::Param(i) => out.push(*i),
+                Scalar::Const(_) | Scalar::Var => {}
+                Scalar::Neg(a) | Scalar::Powi(a, _) | Scalar::Call(_, a) => walk(a, out),
+                Scalar::Add(a, b)
+                | Scalar::Sub(a, b)
+                | Scalar::Mul(a, b)
+                | Scalar::Div(a, b)
+                | Scalar::Powf(a, b) => {
+                    walk(a, out);
+                    walk(b, out);
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(self, &mut out);
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 }
 
@@ -190,11 +244,23 @@ fn apply(func: Func, a: f64) -> f64 {
 /// expressions nested deeper than [`MAX_NESTING`] or [`MAX_TREE_DEPTH`] or longer than
 /// [`MAX_TOKENS`] tokens (limits that keep parsing within a small stack).
 pub fn parse_expression(source: &str, variable: &str) -> Result<Scalar, ExprError> {
+    parse_expression_with(source, Some(variable), &[])
+}
+
+/// [`parse_expression`] with the model's parameters: a name in `parameters` becomes
+/// [`Scalar::Param`] with its index. Without a `variable` the expression is a value of the
+/// parameters alone (a numeric field written as `"l1/2"`).
+pub fn parse_expression_with(
+    source: &str,
+    variable: Option<&str>,
+    parameters: &[&str],
+) -> Result<Scalar, ExprError> {
     let tokens = TokenStream::from_str(source).map_err(|e| lex_error(source, &e))?;
     screen_tokens(&tokens)?;
     let expr: Expr = syn::parse2(tokens).map_err(|e| syntax_error(source, &e))?;
     Converter {
         variable,
+        parameters,
         depth: Cell::new(0),
     }
     .expr(&expr)
@@ -467,7 +533,10 @@ fn closing_of(open: char) -> char {
 
 /// Converts the syn tree to [`Scalar`], checking every node.
 struct Converter<'a> {
-    variable: &'a str,
+    /// The expression's variable, if it has one.
+    variable: Option<&'a str>,
+    /// The model's parameter names, by index.
+    parameters: &'a [&'a str],
     /// Current depth of the recursion through [`Converter::expr`].
     depth: Cell<usize>,
 }
@@ -514,8 +583,13 @@ impl Converter<'_> {
     fn path(&self, e: &syn::ExprPath) -> Result<Scalar, ExprError> {
         let names =
             plain_path(e).ok_or_else(|| ExprError::at(e, "generic paths are not allowed"))?;
-        if names.len() == 1 && names[0] == self.variable {
+        if names.len() == 1 && Some(names[0].as_str()) == self.variable {
             return Ok(Scalar::Var);
+        }
+        if let [name] = names.as_slice() {
+            if let Some(i) = self.parameters.iter().position(|p| p == name) {
+                return Ok(Scalar::Param(i));
+            }
         }
         if let Some(value) = named_constant(&names) {
             return Ok(Scalar::Const(value));
@@ -524,11 +598,20 @@ impl Converter<'_> {
         let message = if names.len() == 1 && function_by_name(&written).is_some() {
             format!("`{written}` is a function: call it, e.g. `{written}(x)` or `x.{written}()`")
         } else {
-            format!(
-                "unknown name `{written}`: the only variable allowed here is `{}`; \
-                 the constants are PI and E",
-                self.variable
-            )
+            let parameters = if self.parameters.is_empty() {
+                "the model declares no parameters (list them under `parameters:`)".to_string()
+            } else {
+                format!("the parameters are {}", self.parameters.join(", "))
+            };
+            match self.variable {
+                Some(v) => format!(
+                    "unknown name `{written}`: the only variable allowed here is `{v}`; \
+                     the constants are PI and E; {parameters}"
+                ),
+                None => {
+                    format!("unknown name `{written}`: {parameters}; the constants are PI and E")
+                }
+            }
         };
         Err(ExprError::at(e, message))
     }

@@ -43,7 +43,7 @@ mod validate;
 pub use validate::ranges;
 
 use crate::error::ModelError;
-use crate::model::Model;
+use crate::model::{Model, ParameterMode};
 use ron::extensions::Extensions;
 use scan::Document;
 use std::path::Path;
@@ -66,6 +66,18 @@ pub fn load_model(path: &Path) -> Result<Model, ModelError> {
 /// A UTF-8 byte-order mark at the start of the text (as some Windows editors write it) is
 /// skipped.
 pub fn parse_model(source: &str, file: &Path) -> Result<Model, ModelError> {
+    parse_model_with(source, file, &[], ParameterMode::AsDeclared)
+}
+
+/// [`parse_model`] with parameter values other than the file's (`overrides`, by name: each
+/// checked against the parameter's bounds and every field it changes, exactly as the file's
+/// values are) and a choice of which parameters the generated code reads at run time.
+pub fn parse_model_with(
+    source: &str,
+    file: &Path,
+    overrides: &[(String, f64)],
+    mode: ParameterMode,
+) -> Result<Model, ModelError> {
     let source = without_bom(source);
     let at = Locator::new(file, source);
     let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
@@ -74,7 +86,8 @@ pub fn parse_model(source: &str, file: &Path) -> Result<Model, ModelError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    validate::validate(&parsed, &stem, &at)
+    let options = validate::Options { overrides, mode };
+    validate::validate(&parsed, &stem, &at, &options)
 }
 
 /// An error about the value at the dotted `field` path (`bodies[2].mass`,
@@ -835,12 +848,24 @@ mod tests {
     fn ron_wrong_type_names_the_path() {
         let e = assert_rejected(
             "mass: 0.5",
+            "mass: true",
+            "bodies[1].mass",
+            21,
+            "Expected a number or a string with an expression of the parameters",
+        );
+        assert_eq!(e.column, 19, "at the value, not at the space before it");
+    }
+
+    #[test]
+    fn a_name_in_a_numeric_field_must_be_a_declared_parameter() {
+        let e = assert_rejected(
+            "mass: 0.5",
             "mass: \"heavy\"",
             "bodies[1].mass",
             21,
-            "Expected float",
+            "unknown name `heavy`: the model declares no parameters",
         );
-        assert_eq!(e.column, 19, "at the value, not at the space before it");
+        assert_eq!(e.column, 20, "inside the string, at the name");
     }
 
     #[test]

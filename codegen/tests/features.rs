@@ -2,10 +2,12 @@
 //! springs, joint dampers, a cam contact and a driven joint, each feature is removed in turn
 //! (by editing the model file's text). The functions the feature feeds must lose operations,
 //! the others must keep exactly theirs, and the emitted code of the functions it fed must no
-//! longer mention it.
+//! longer mention it. The model is compiled with every parameter folded (its numbers in
+//! place), so that a feature's constants show in the code as they would in a user's file.
 
+use camchain_codegen::ParameterMode;
 use camchain_codegen::emit::{Generated, generate};
-use camchain_codegen::schema::parse_model;
+use camchain_codegen::schema::parse_model_with;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -27,7 +29,8 @@ fn edit(text: &str, from: &str, to: &str) -> String {
 }
 
 fn generate_text(text: &str) -> Generated {
-    let model = parse_model(text, Path::new("features.ron")).unwrap_or_else(|e| panic!("{e}"));
+    let model = parse_model_with(text, Path::new("features.ron"), &[], ParameterMode::FoldAll)
+        .unwrap_or_else(|e| panic!("{e}"));
     generate(&model, "features.ron").expect("generates")
 }
 
@@ -99,11 +102,11 @@ fn removing_gravity_removes_its_operations_and_constants() {
 #[test]
 fn removing_the_springs_removes_their_operations_and_stiffnesses() {
     let mut text = full_text();
-    for (k, c) in [("15.0", "1.0"), ("40.0", "1.0"), ("18.0", "1.0")] {
+    for (name, k) in [("k2", "15.0"), ("k3", "40.0"), ("k4", "18.0")] {
         text = edit(
             &text,
-            &format!("spring: (stiffness: {k}, damping: {c}, rest: 0.0)"),
-            &format!("spring: (stiffness: 0.0, damping: {c}, rest: 0.0)"),
+            &format!("(name: \"{name}\", value: {k},"),
+            &format!("(name: \"{name}\", value: 0.0,"),
         );
     }
     let full = generate_text(&full_text());
@@ -128,11 +131,11 @@ fn removing_the_springs_removes_their_operations_and_stiffnesses() {
 #[test]
 fn removing_the_dampers_removes_their_operations() {
     let mut text = full_text();
-    for k in ["15.0", "40.0", "18.0"] {
+    for name in ["c2", "c3", "c4"] {
         text = edit(
             &text,
-            &format!("spring: (stiffness: {k}, damping: 1.0, rest: 0.0)"),
-            &format!("spring: (stiffness: {k}, damping: 0.0, rest: 0.0)"),
+            &format!("(name: \"{name}\", value: 1.0,"),
+            &format!("(name: \"{name}\", value: 0.0,"),
         );
     }
     let full = generate_text(&full_text());
@@ -161,7 +164,7 @@ fn removing_the_contact_empties_the_constraint_functions() {
     let text = full_text();
     let without = edit(
         &text,
-        "(marker: \"A\", profile: \"-0.595*x + 0.5*x*x + 0.5*x.powi(3)\"),",
+        "(marker: \"A\", profile: \"a1*x + a2*x*x + a3*x.powi(3)\"),",
         "",
     );
     let full = generate_text(&text);
@@ -195,7 +198,7 @@ fn removing_the_drive_empties_prescribed() {
     let text = full_text();
     let without = edit(
         &text,
-        "prescribed: \"-PI/2 + 0.45*(2.0*PI*t/4.0).sin()\",",
+        "prescribed: \"-PI/2 + amplitude*(2.0*PI*t/period).sin()\",",
         "",
     );
     let full = generate_text(&text);

@@ -317,7 +317,7 @@ fn exercise(scalar: &Scalar) {
     }
     let mut graph = Graph::new();
     let at = graph.var("x");
-    let ids = value_and_derivatives(&mut graph, scalar, "u", at);
+    let ids = value_and_derivatives(&mut graph, scalar, "u", at, &[]);
     let variables = graph.var_names().len();
     for v in points {
         let _ = graph.eval(&ids, &vec![v; variables]);

@@ -11,7 +11,7 @@
 //!
 //! ```
 //! use camchain_models::paper_concave::Model;
-//! let model = Model;
+//! let model = Model::default();
 //! let mut state = model.assemble().expect("the paper model assembles");
 //! model.step(&mut state, 0.01).expect("one step");
 //! ```
@@ -38,4 +38,25 @@ pub fn source(name: &str) -> Option<&'static str> {
 #[doc(hidden)]
 pub mod random_models {
     include!(concat!(env!("OUT_DIR"), "/random_models/random_models.rs"));
+}
+
+/// The built-in models compiled with every parameter folded (`ParameterMode::FoldAll`) and
+/// with every parameter read at run time (`ParameterMode::AllAtRunTime`), and the test models
+/// of `tests/parameter_models/`: what `tests/parameters.rs` compares. Compiled only with the
+/// `parameter-modes` feature, which this package's tests turn on.
+#[cfg(feature = "parameter-modes")]
+#[doc(hidden)]
+pub mod parameter_modes {
+    /// Every parameter folded.
+    pub mod folded {
+        include!(concat!(env!("OUT_DIR"), "/folded/models.rs"));
+    }
+    /// Every parameter read at run time.
+    pub mod all_at_run_time {
+        include!(concat!(env!("OUT_DIR"), "/all_at_run_time/models.rs"));
+    }
+    /// The test models of parameter checks.
+    pub mod checks {
+        include!(concat!(env!("OUT_DIR"), "/parameter_models/models.rs"));
+    }
 }

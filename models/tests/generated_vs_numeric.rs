@@ -29,7 +29,7 @@ fn every_generated_model_agrees_with_the_numeric_recursion() {
         models::ALL.len() >= 7,
         "the five paper models, the double pendulum, the spatial arm"
     );
-    for (name, generated) in models::ALL {
+    for (name, generated) in models::ALL.iter() {
         let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
         let numeric = NumericModel::load(std::path::Path::new(&path))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -73,7 +73,7 @@ fn generated_and_numeric_trajectories_coincide() {
 
 #[test]
 fn generated_mass_matrices_are_spd_and_match_the_kinetic_energy() {
-    for (name, model) in models::ALL {
+    for (name, model) in models::ALL.iter() {
         let n = model.info().n();
         let mut rng = Rng::new(99);
         for _ in 0..100 {

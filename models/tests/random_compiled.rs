@@ -50,7 +50,7 @@ fn every_compiled_random_model_agrees_with_the_numeric_recursion() {
         ],
         "the fixed set of tests/random_models/ (chain16: the large-model entry points)"
     );
-    for (name, generated) in random_models::ALL {
+    for (name, generated) in random_models::ALL.iter() {
         let numeric = numeric(name);
         assert_eq!(
             generated.info(),

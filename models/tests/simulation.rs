@@ -177,7 +177,7 @@ fn the_paper_contrast_shows_joint_4_bends_on_the_convex_cam_only() {
 #[test]
 fn stepping_the_generated_model_follows_the_simulated_trajectory() {
     use camchain_models::paper_convex::Model;
-    let model = Model;
+    let model = Model::default();
     let mut state = model.assemble().expect("assembles");
     let mut settings = model.default_settings();
     settings.t_end = 1.0;

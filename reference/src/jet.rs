@@ -230,6 +230,9 @@ pub fn eval_jet2(expr: &Scalar, x: f64) -> Jet2 {
     match expr {
         Scalar::Const(c) => Jet2::constant(*c),
         Scalar::Var => Jet2::variable(x),
+        // Validated models hand the reference their expressions with every parameter
+        // resolved to its value; an unresolved one has no value here.
+        Scalar::Param(_) => Jet2::constant(f64::NAN),
         Scalar::Neg(a) => -ev(a),
         Scalar::Add(a, b) => ev(a) + ev(b),
         Scalar::Sub(a, b) => ev(a) - ev(b),

@@ -19,11 +19,11 @@
 
 use crate::jet::eval_jet;
 use camchain_codegen::ModelError;
-use camchain_codegen::model::{Body, Contact, IntegratorChoice, JointKind, Model};
-use camchain_codegen::schema::load_model;
+use camchain_codegen::model::{Body, Contact, IntegratorChoice, JointKind, Model, ParameterMode};
+use camchain_codegen::schema::{load_model, parse_model_with};
 use camchain_runtime::{
     ContactGeometry, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics, Energy,
-    InitialGuess, IntegratorKind, ModelInfo, SimSettings,
+    InitialGuess, IntegratorKind, ModelInfo, ParameterInfo, SimSettings,
 };
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use std::path::Path;
@@ -55,6 +55,17 @@ pub fn model_info(model: &Model) -> ModelInfo {
             rtol: model.simulation.rtol,
             atol: model.simulation.atol,
         },
+        parameters: model
+            .runtime_parameters()
+            .map(|(_, p)| ParameterInfo {
+                name: p.name.clone(),
+                unit: p.unit.clone(),
+                default: p.default,
+                min: p.min,
+                max: p.max,
+                description: p.description.clone(),
+            })
+            .collect(),
     }
 }
 
@@ -353,6 +364,8 @@ impl CamPoint {
 pub struct NumericModel {
     model: Model,
     info: ModelInfo,
+    /// The values of the run-time parameters (`info.parameters` order).
+    values: Vec<f64>,
     bodies: Vec<BodyConst>,
     contacts: Vec<ContactConst>,
 }
@@ -372,6 +385,7 @@ impl NumericModel {
             .collect();
         Self {
             info: model_info(&model),
+            values: model.runtime_parameters().map(|(_, p)| p.value).collect(),
             model,
             bodies,
             contacts,
@@ -381,6 +395,38 @@ impl NumericModel {
     /// Reads, validates and wraps a RON model file.
     pub fn load(path: &Path) -> Result<Self, ModelError> {
         load_model(path).map(Self::new)
+    }
+
+    /// Reads, validates and wraps a RON model file with parameters given other values than
+    /// the file's (`(name, value)` pairs): each is checked against its declared bounds and
+    /// every field it changes, exactly as the file's values are, with the same located
+    /// errors as the generated code's `Model::new`. `mode` says which parameters may be
+    /// given values: those the generated code reads at run time
+    /// ([`ParameterMode::AsDeclared`]), or every one a field that must be constant does not
+    /// use ([`ParameterMode::AllAtRunTime`]: the numeric path has nothing folded).
+    pub fn load_with(
+        path: &Path,
+        overrides: &[(String, f64)],
+        mode: ParameterMode,
+    ) -> Result<Self, ModelError> {
+        let source = std::fs::read_to_string(path).map_err(|e| ModelError {
+            file: path.to_path_buf(),
+            line: 0,
+            column: 0,
+            field: String::new(),
+            message: format!("cannot read the file: {e}"),
+        })?;
+        Self::from_source_with(&source, path, overrides, mode)
+    }
+
+    /// [`NumericModel::load_with`] on the text of a model file (`file` names it in errors).
+    pub fn from_source_with(
+        source: &str,
+        file: &Path,
+        overrides: &[(String, f64)],
+        mode: ParameterMode,
+    ) -> Result<Self, ModelError> {
+        parse_model_with(source, file, overrides, mode).map(Self::new)
     }
 
     /// The model this reference evaluates.
@@ -509,6 +555,10 @@ impl NumericModel {
 impl Dynamics for NumericModel {
     fn info(&self) -> &ModelInfo {
         &self.info
+    }
+
+    fn parameter_values(&self) -> &[f64] {
+        &self.values
     }
 
     /// Unit-vector method: column j is the inverse dynamics with q̇ = 0, q̈ = e_j, no
@@ -691,6 +741,10 @@ mod tests {
     fn model(bodies: Vec<Body>, gravity: [f64; 3]) -> Model {
         let n = bodies.len();
         Model {
+            parameters: Vec::new(),
+            symbolic: Default::default(),
+            runtime_checks: Vec::new(),
+            parameters_at: Default::default(),
             name: "test".into(),
             description: "built in a unit test".into(),
             gravity,

@@ -451,13 +451,93 @@ const CASES: &[Case] = &[
         "gravity",
         "array of length 3 but found 2",
     ),
-    // `"0.5"` after `mass:`.
+    // `true` after `mass:`.
     case(
         "type_string_for_number.ron",
         24,
         19,
         "bodies[1].mass",
-        "Expected float",
+        "Expected a number or a string with an expression of the parameters",
+    ),
+    // `m2` inside the string after `mass:`.
+    case(
+        "parameter_undeclared.ron",
+        24,
+        20,
+        "bodies[1].mass",
+        "unknown name `m2`: the model declares no parameters",
+    ),
+    // `-40.0`, k3's value.
+    case(
+        "parameter_value_below_min.ron",
+        32,
+        29,
+        "parameters[19].value",
+        "its value is below the minimum 0 declared for `k3`",
+    ),
+    // The second `"k2"`.
+    case(
+        "parameter_duplicate.ron",
+        32,
+        16,
+        "parameters[19].name",
+        "duplicate parameter name `k2`",
+    ),
+    // `"x"`, the last parameter's name.
+    case(
+        "parameter_reserved_name.ron",
+        37,
+        16,
+        "parameters[24].name",
+        "`x` already means something in expressions",
+    ),
+    // `-1.0` after `max:`.
+    case(
+        "parameter_min_above_max.ron",
+        37,
+        65,
+        "parameters[24].max",
+        "the maximum -1 is below the minimum 1",
+    ),
+    // `"k2"`, the first component of body3's axis.
+    case(
+        "parameter_in_axis.ron",
+        76,
+        24,
+        "bodies[2].joint.axis[0]",
+        "this field must be constant, but k2 is read at run time",
+    ),
+    // `"q3"`, the last parameter's name.
+    case(
+        "parameter_named_like_coordinate.ron",
+        37,
+        16,
+        "parameters[24].name",
+        "is taken by coordinate `q3`",
+    ),
+    // The end of `"l1/"`, where the divisor is missing.
+    case(
+        "parameter_expression_syntax.ron",
+        45,
+        23,
+        "bodies[0].com[0]",
+        "not a valid expression",
+    ),
+    // `"l1/(l2 - 0.1)"`: 0.3/0.
+    case(
+        "parameter_expression_infinite.ron",
+        45,
+        19,
+        "bodies[0].com[0]",
+        "must be finite, got inf",
+    ),
+    // `"m2 - 1.0"` = -0.5.
+    case(
+        "parameter_negative_mass.ron",
+        57,
+        19,
+        "bodies[1].mass",
+        "mass must be positive and finite, got -0.5",
     ),
     // `colour`.
     case(

@@ -96,6 +96,9 @@ pub struct ModelInfo {
     pub initial: InitialGuess,
     /// Default settings.
     pub defaults: SimSettings,
+    /// The run-time parameters (those not folded at build time), in file order; their
+    /// current values are [`Dynamics::parameter_values`].
+    pub parameters: Vec<crate::parameters::ParameterInfo>,
 }
 
 impl ModelInfo {
@@ -112,6 +115,11 @@ impl ModelInfo {
     /// Index of a coordinate by name.
     pub fn coordinate_index(&self, name: &str) -> Option<usize> {
         self.coordinates.iter().position(|c| c.name == name)
+    }
+
+    /// Index of a run-time parameter by name.
+    pub fn parameter_index(&self, name: &str) -> Option<usize> {
+        self.parameters.iter().position(|p| p.name == name)
     }
 }
 
@@ -184,6 +192,12 @@ impl Energy {
 pub trait Dynamics {
     /// Static description.
     fn info(&self) -> &ModelInfo;
+
+    /// The values of the run-time parameters this instance was built with, in the order of
+    /// [`ModelInfo::parameters`] (empty for a model without run-time parameters).
+    fn parameter_values(&self) -> &[f64] {
+        &[]
+    }
 
     /// M(q), eq. (13): row-major n×n into `m`.
     fn mass_matrix(&self, q: &[f64], m: &mut [f64]);

@@ -8,6 +8,7 @@
 //! Module map:
 //! - [`assembly`]: a consistent initial state, and the report of what assembly changed.
 //! - [`dynamics`]: the [`Dynamics`] trait every model implements (eqs. 3–8, 13).
+//! - [`parameters`]: run-time parameters: declarations, checks and located errors.
 //! - [`partition`]: choice of the dependent coordinates and the reduced dynamics (15–18).
 //! - [`integrators`]: fixed-step RK4, adaptive Dormand–Prince 5(4) and 8(5,3) with dense
 //!   output.
@@ -22,6 +23,7 @@ pub mod dynamics;
 pub mod error;
 pub mod events;
 pub mod integrators;
+pub mod parameters;
 pub mod partition;
 pub mod settings;
 pub mod simulate;
@@ -29,5 +31,6 @@ pub mod unilateral;
 
 pub use dynamics::*;
 pub use error::SimError;
+pub use parameters::{ParameterError, ParameterInfo};
 pub use settings::InvalidSetting;
 pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};

@@ -1447,6 +1447,7 @@ mod tests {
             spatial: false,
             initial,
             defaults: settings(IntegratorKind::Dopri5, 1.0, 0.1, 1e-3, 1e-9),
+            parameters: Vec::new(),
         }
     }
 

@@ -80,6 +80,9 @@ impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
     fn info(&self) -> &ModelInfo {
         &self.info
     }
+    fn parameter_values(&self) -> &[f64] {
+        self.inner.parameter_values()
+    }
     fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
         self.inner.mass_matrix(q, m);
     }

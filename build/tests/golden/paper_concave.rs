@@ -9,8 +9,8 @@
 // |---|---|---|---|---|---|---|---|
 // | `mass_matrix` | 16 | 14 | 0 | 4 | 0 | 0 | 34 |
 // | `inertial_forces` | 20 | 25 | 0 | 4 | 0 | 0 | 49 |
-// | `applied_forces` | 12 | 8 | 0 | 4 | 0 | 0 | 24 |
-// | `equations` | 46 | 47 | 0 | 8 | 0 | 0 | 101 |
+// | `applied_forces` | 12 | 11 | 0 | 4 | 0 | 0 | 27 |
+// | `equations` | 46 | 50 | 0 | 8 | 0 | 0 | 104 |
 // | `constraint` | 12 | 9 | 0 | 6 | 0 | 0 | 27 |
 // | `constraint_jacobian` | 14 | 12 | 0 | 6 | 0 | 0 | 32 |
 // | `constraint_bias` | 24 | 28 | 0 | 6 | 0 | 1 | 59 |
@@ -18,10 +18,14 @@
 // | `contact_geometry` | 12 | 9 | 0 | 6 | 0 | 0 | 27 |
 // | `prescribed` | 0 | 0 | 0 | 0 | 0 | 0 | 0 |
 // | `energy` | 30 | 35 | 0 | 7 | 0 | 3 | 75 |
-// | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
+// | `damper_power` | 2 | 3 | 0 | 0 | 0 | 3 | 8 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
-// | `velocity_terms` | 68 | 80 | 0 | 0 | 0 | 1 | 149 |
+// | `velocity_terms` | 68 | 83 | 0 | 0 | 0 | 1 | 152 |
 // | `contact_kinematics_0` | 24 | 22 | 0 | 6 | 0 | 0 | 52 |
+// | `derive` | 0 | 3 | 0 | 0 | 0 | 0 | 3 |
+//
+// Read at run time: `k2`, `k3`, `k4`, `c2`, `c3`, `c4`, `swing` (see `Parameters`); `derive` computes what depends on them
+// alone once per parameter set, and the counts above do not include it.
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -29,11 +33,50 @@ use ::camchain::runtime as rt;
 /// [`Model::assemble`], [`Model::step`] and [`Model::simulate`].
 ///
 /// Paper scenario, concave cam y = -0.595x + 0.5x^2 + 0.5x^3: free swing from q1 = -pi/2 - 0.1 under gravity; base B = (0.38, 0.80).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-#[allow(dead_code)]
-pub struct Model;
+///
+/// Its run-time parameters are in [`Parameters`]: [`Model::default`] has the file's values, [`Model::new`] and [`Model::with`] others (checked as the build checks the file).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    parameters: Parameters,
+    values: [f64; 7],
+    derived: Derived,
+    info: rt::ModelInfo,
+}
+impl Default for Model {
+    /// The model with the file's values (checked when it was built).
+    fn default() -> Self {
+        Model::build(Parameters::default())
+    }
+}
 #[allow(dead_code)]
 impl Model {
+    /// The model with these parameter values, checked as the build checks the model file (declared bounds first, then every field they change: a negative mass gets the error the file would get).
+    pub fn new(parameters: Parameters) -> Result<Self, rt::ParameterError> {
+        check(&parameters)?;
+        Ok(Model::build(parameters))
+    }
+    /// The file's values with the named ones changed (`Model::with(&[("k", 40.0)])`).
+    pub fn with(values: &[(&str, f64)]) -> Result<Self, rt::ParameterError> {
+        let mut parameters = Parameters::default();
+        for &(name, value) in values {
+            parameters.set(name, value)?;
+        }
+        Model::new(parameters)
+    }
+    /// The parameter values of this model.
+    pub fn parameters(&self) -> &Parameters {
+        &self.parameters
+    }
+    fn build(parameters: Parameters) -> Self {
+        let mut info = INFO.clone();
+        initial_guess(&parameters, &mut info.initial.q, &mut info.initial.qd);
+        Model {
+            values: parameters.values(),
+            derived: derive(&parameters),
+            parameters,
+            info,
+        }
+    }
     /// Assembles the initial state from the model file's guess: held coordinates keep
     /// their values, the dependent ones are solved so that every contact point is on its cam.
     pub fn assemble(&self) -> Result<rt::State, rt::SimError> {
@@ -62,8 +105,338 @@ impl Model {
     }
     /// The default settings from the model file.
     pub fn default_settings(&self) -> rt::SimSettings {
-        INFO.defaults.clone()
+        rt::Dynamics::info(self).defaults.clone()
     }
+}
+/// The model with the file's values, shared (what `ALL` of a build's index lists).
+#[allow(dead_code)]
+pub static DEFAULT: ::std::sync::LazyLock<Model> = ::std::sync::LazyLock::new(
+    Model::default,
+);
+/// [`Model::with`], boxed for programs that choose models at run time (sweeps).
+#[allow(dead_code)]
+pub fn boxed(
+    values: &[(&str, f64)],
+) -> Result<Box<dyn rt::Dynamics + Send + Sync>, rt::ParameterError> {
+    Ok(Box::new(Model::with(values)?))
+}
+/// The model file, as the build showed it (the errors of [`Model::new`] name it).
+const FILE: &str = "models/paper_concave.ron";
+/// The run-time parameters of `paper_concave`, with the model file's values as defaults. Give them to [`Model::new`], which checks them as the build checks the file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(non_snake_case)]
+pub struct Parameters {
+    /// stiffness of the spring in joint 2 (N m/rad); default 15, at least 0.
+    pub k2: f64,
+    /// stiffness of the spring in joint 3 (N/m); default 40, at least 0.
+    pub k3: f64,
+    /// stiffness of the spring in joint 4 (N m/rad); default 18, at least 0.
+    pub k4: f64,
+    /// damping in joint 2 (N m s/rad); default 1, at least 0.
+    pub c2: f64,
+    /// damping in joint 3 (N s/m); default 1, at least 0.
+    pub c3: f64,
+    /// damping in joint 4 (N m s/rad); default 1, at least 0.
+    pub c4: f64,
+    /// initial tilt of body 1 from hanging straight down (q1 = -pi/2 - swing) (rad); default 0.1, in [-1, 1].
+    pub swing: f64,
+}
+impl Default for Parameters {
+    fn default() -> Self {
+        Parameters {
+            k2: 15.0,
+            k3: 40.0,
+            k4: 18.0,
+            c2: 1.0,
+            c3: 1.0,
+            c4: 1.0,
+            swing: 0.1,
+        }
+    }
+}
+#[allow(dead_code)]
+impl Parameters {
+    /// The parameters' names, in the order of [`Parameters::values`].
+    pub const NAMES: [&str; 7] = ["k2", "k3", "k4", "c2", "c3", "c4", "swing"];
+    /// The values, in the order of [`Parameters::NAMES`].
+    pub fn values(&self) -> [f64; 7] {
+        [self.k2, self.k3, self.k4, self.c2, self.c3, self.c4, self.swing]
+    }
+    /// The parameters from values in the order of [`Parameters::NAMES`].
+    pub fn from_values(values: [f64; 7]) -> Self {
+        Parameters {
+            k2: values[0],
+            k3: values[1],
+            k4: values[2],
+            c2: values[3],
+            c3: values[4],
+            c4: values[5],
+            swing: values[6],
+        }
+    }
+    /// The value of the parameter called `name`, if there is one.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        match name {
+            "k2" => Some(self.k2),
+            "k3" => Some(self.k3),
+            "k4" => Some(self.k4),
+            "c2" => Some(self.c2),
+            "c3" => Some(self.c3),
+            "c4" => Some(self.c4),
+            "swing" => Some(self.swing),
+            _ => None,
+        }
+    }
+    /// Sets the parameter called `name`; an unknown name, or a parameter folded at build time (`constant: true`), is an error located in the model file. The value itself is checked by [`Model::new`].
+    pub fn set(&mut self, name: &str, value: f64) -> Result<(), rt::ParameterError> {
+        match name {
+            "k2" => self.k2 = value,
+            "k3" => self.k3 = value,
+            "k4" => self.k4 = value,
+            "c2" => self.c2 = value,
+            "c3" => self.c3 = value,
+            "c4" => self.c4 = value,
+            "swing" => self.swing = value,
+            _ => {
+                let message = match FOLDED.iter().find(|(folded, _)| *folded == name) {
+                    Some(&(_, at)) => {
+                        return rt::parameters::located(
+                            at,
+                            Err(rt::parameters::checks::constant_parameter(name)),
+                        );
+                    }
+                    None => {
+                        rt::parameters::checks::unknown_parameter(
+                            name,
+                            &[
+                                "l1",
+                                "l2",
+                                "l3",
+                                "l4",
+                                "m1",
+                                "m2",
+                                "m3",
+                                "m4",
+                                "J1",
+                                "J2",
+                                "J3",
+                                "J4",
+                                "a1",
+                                "a2",
+                                "a3",
+                                "bx",
+                                "by",
+                                "g",
+                                "k2",
+                                "k3",
+                                "k4",
+                                "c2",
+                                "c3",
+                                "c4",
+                                "swing",
+                            ],
+                        )
+                    }
+                };
+                return rt::parameters::located(
+                    rt::parameters::Location::at(FILE, 14, 17, "parameters"),
+                    Err(message),
+                );
+            }
+        }
+        Ok(())
+    }
+}
+/// The parameters folded into this code (`constant: true`), with where the file says so.
+const FOLDED: &[(&str, rt::parameters::Location)] = &[
+    ("l1", rt::parameters::Location::at(FILE, 17, 65, "parameters[0].constant")),
+    ("l2", rt::parameters::Location::at(FILE, 18, 65, "parameters[1].constant")),
+    ("l3", rt::parameters::Location::at(FILE, 19, 65, "parameters[2].constant")),
+    ("l4", rt::parameters::Location::at(FILE, 20, 65, "parameters[3].constant")),
+    ("m1", rt::parameters::Location::at(FILE, 21, 66, "parameters[4].constant")),
+    ("m2", rt::parameters::Location::at(FILE, 22, 66, "parameters[5].constant")),
+    ("m3", rt::parameters::Location::at(FILE, 23, 66, "parameters[6].constant")),
+    ("m4", rt::parameters::Location::at(FILE, 24, 66, "parameters[7].constant")),
+    ("J1", rt::parameters::Location::at(FILE, 25, 71, "parameters[8].constant")),
+    ("J2", rt::parameters::Location::at(FILE, 26, 71, "parameters[9].constant")),
+    ("J3", rt::parameters::Location::at(FILE, 27, 71, "parameters[10].constant")),
+    ("J4", rt::parameters::Location::at(FILE, 28, 71, "parameters[11].constant")),
+    ("a1", rt::parameters::Location::at(FILE, 31, 58, "parameters[12].constant")),
+    ("a2", rt::parameters::Location::at(FILE, 32, 57, "parameters[13].constant")),
+    ("a3", rt::parameters::Location::at(FILE, 33, 59, "parameters[14].constant")),
+    ("bx", rt::parameters::Location::at(FILE, 35, 56, "parameters[15].constant")),
+    ("by", rt::parameters::Location::at(FILE, 36, 56, "parameters[16].constant")),
+    ("g", rt::parameters::Location::at(FILE, 37, 69, "parameters[17].constant")),
+];
+/// The quantities that depend on the run-time parameters alone, computed once per parameter set by [`derive`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Derived {
+    k2: f64,
+    k3: f64,
+    k4: f64,
+    c2: f64,
+    c3: f64,
+    c4: f64,
+    half_stiffness_q2: f64,
+    half_stiffness_q3: f64,
+    half_stiffness_q4: f64,
+}
+#[allow(clippy::approx_constant, clippy::excessive_precision)]
+/// Every quantity the generated functions read that depends on the parameters alone.
+fn derive(p: &Parameters) -> Derived {
+    let k2 = p.k2;
+    let k3 = p.k3;
+    let k4 = p.k4;
+    let c2 = p.c2;
+    let c3 = p.c3;
+    let c4 = p.c4;
+    let mut derived = Derived::default();
+    // energy
+    let half_stiffness_q2 = 0.5 * k2;
+    let half_stiffness_q3 = 0.5 * k3;
+    let half_stiffness_q4 = 0.5 * k4;
+    derived.k2 = k2;
+    derived.k3 = k3;
+    derived.k4 = k4;
+    derived.c2 = c2;
+    derived.c3 = c3;
+    derived.c4 = c4;
+    derived.half_stiffness_q2 = half_stiffness_q2;
+    derived.half_stiffness_q3 = half_stiffness_q3;
+    derived.half_stiffness_q4 = half_stiffness_q4;
+    derived
+}
+#[allow(clippy::approx_constant, clippy::excessive_precision)]
+/// The build's checks of every value that depends on the run-time parameters, with its messages and locations in the model file.
+fn check(p: &Parameters) -> Result<(), rt::ParameterError> {
+    let k2 = p.k2;
+    let k3 = p.k3;
+    let k4 = p.k4;
+    let c2 = p.c2;
+    let c3 = p.c3;
+    let c4 = p.c4;
+    let swing = p.swing;
+    let bodies_1_joint_spring_stiffness = k2;
+    let bodies_1_joint_spring_damping = c2;
+    let bodies_2_joint_spring_stiffness = k3;
+    let bodies_2_joint_spring_damping = c3;
+    let bodies_3_joint_spring_stiffness = k4;
+    let bodies_3_joint_spring_damping = c4;
+    let initial_q_0 = -1.5707963267948966 - swing;
+    rt::parameters::check_bounds(
+        "k2",
+        p.k2,
+        (Some(0.0), None),
+        [
+            rt::parameters::Location::at(FILE, 39, 29, "parameters[18].value"),
+            rt::parameters::Location::at(FILE, 39, 57, "parameters[18].min"),
+            rt::parameters::Location::at(FILE, 39, 9, "parameters[18].max"),
+        ],
+    )?;
+    rt::parameters::check_bounds(
+        "k3",
+        p.k3,
+        (Some(0.0), None),
+        [
+            rt::parameters::Location::at(FILE, 40, 29, "parameters[19].value"),
+            rt::parameters::Location::at(FILE, 40, 53, "parameters[19].min"),
+            rt::parameters::Location::at(FILE, 40, 9, "parameters[19].max"),
+        ],
+    )?;
+    rt::parameters::check_bounds(
+        "k4",
+        p.k4,
+        (Some(0.0), None),
+        [
+            rt::parameters::Location::at(FILE, 41, 29, "parameters[20].value"),
+            rt::parameters::Location::at(FILE, 41, 57, "parameters[20].min"),
+            rt::parameters::Location::at(FILE, 41, 9, "parameters[20].max"),
+        ],
+    )?;
+    rt::parameters::check_bounds(
+        "c2",
+        p.c2,
+        (Some(0.0), None),
+        [
+            rt::parameters::Location::at(FILE, 42, 29, "parameters[21].value"),
+            rt::parameters::Location::at(FILE, 42, 58, "parameters[21].min"),
+            rt::parameters::Location::at(FILE, 42, 9, "parameters[21].max"),
+        ],
+    )?;
+    rt::parameters::check_bounds(
+        "c3",
+        p.c3,
+        (Some(0.0), None),
+        [
+            rt::parameters::Location::at(FILE, 43, 29, "parameters[22].value"),
+            rt::parameters::Location::at(FILE, 43, 54, "parameters[22].min"),
+            rt::parameters::Location::at(FILE, 43, 9, "parameters[22].max"),
+        ],
+    )?;
+    rt::parameters::check_bounds(
+        "c4",
+        p.c4,
+        (Some(0.0), None),
+        [
+            rt::parameters::Location::at(FILE, 44, 29, "parameters[23].value"),
+            rt::parameters::Location::at(FILE, 44, 58, "parameters[23].min"),
+            rt::parameters::Location::at(FILE, 44, 9, "parameters[23].max"),
+        ],
+    )?;
+    rt::parameters::check_bounds(
+        "swing",
+        p.swing,
+        (Some(-1.0), Some(1.0)),
+        [
+            rt::parameters::Location::at(FILE, 45, 32, "parameters[24].value"),
+            rt::parameters::Location::at(FILE, 45, 55, "parameters[24].min"),
+            rt::parameters::Location::at(FILE, 45, 66, "parameters[24].max"),
+        ],
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 73, 37, "bodies[1].joint.spring.stiffness"),
+        rt::parameters::checks::non_negative(
+            "stiffness",
+            bodies_1_joint_spring_stiffness,
+        ),
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 73, 52, "bodies[1].joint.spring.damping"),
+        rt::parameters::checks::non_negative("damping", bodies_1_joint_spring_damping),
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 87, 37, "bodies[2].joint.spring.stiffness"),
+        rt::parameters::checks::non_negative(
+            "stiffness",
+            bodies_2_joint_spring_stiffness,
+        ),
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 87, 52, "bodies[2].joint.spring.damping"),
+        rt::parameters::checks::non_negative("damping", bodies_2_joint_spring_damping),
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 101, 37, "bodies[3].joint.spring.stiffness"),
+        rt::parameters::checks::non_negative(
+            "stiffness",
+            bodies_3_joint_spring_stiffness,
+        ),
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 101, 52, "bodies[3].joint.spring.damping"),
+        rt::parameters::checks::non_negative("damping", bodies_3_joint_spring_damping),
+    )?;
+    rt::parameters::located(
+        rt::parameters::Location::at(FILE, 112, 13, "initial.q[0]"),
+        rt::parameters::checks::finite(initial_q_0),
+    )?;
+    Ok(())
+}
+#[allow(clippy::approx_constant, clippy::excessive_precision)]
+/// Writes the initial guesses that depend on the run-time parameters.
+fn initial_guess(p: &Parameters, q: &mut [f64], _qd: &mut [f64]) {
+    let swing = p.swing;
+    q[0] = -1.5707963267948966 - swing;
 }
 /// Static description of the model.
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
@@ -110,11 +483,74 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
         rtol: 1e-10,
         atol: 1e-12,
     },
+    parameters: Vec::from([
+        rt::ParameterInfo {
+            name: "k2".to_string(),
+            unit: "N m/rad".to_string(),
+            default: 15.0,
+            min: Some(0.0),
+            max: None,
+            description: "stiffness of the spring in joint 2".to_string(),
+        },
+        rt::ParameterInfo {
+            name: "k3".to_string(),
+            unit: "N/m".to_string(),
+            default: 40.0,
+            min: Some(0.0),
+            max: None,
+            description: "stiffness of the spring in joint 3".to_string(),
+        },
+        rt::ParameterInfo {
+            name: "k4".to_string(),
+            unit: "N m/rad".to_string(),
+            default: 18.0,
+            min: Some(0.0),
+            max: None,
+            description: "stiffness of the spring in joint 4".to_string(),
+        },
+        rt::ParameterInfo {
+            name: "c2".to_string(),
+            unit: "N m s/rad".to_string(),
+            default: 1.0,
+            min: Some(0.0),
+            max: None,
+            description: "damping in joint 2".to_string(),
+        },
+        rt::ParameterInfo {
+            name: "c3".to_string(),
+            unit: "N s/m".to_string(),
+            default: 1.0,
+            min: Some(0.0),
+            max: None,
+            description: "damping in joint 3".to_string(),
+        },
+        rt::ParameterInfo {
+            name: "c4".to_string(),
+            unit: "N m s/rad".to_string(),
+            default: 1.0,
+            min: Some(0.0),
+            max: None,
+            description: "damping in joint 4".to_string(),
+        },
+        rt::ParameterInfo {
+            name: "swing".to_string(),
+            unit: "rad".to_string(),
+            default: 0.1,
+            min: Some(-1.0),
+            max: Some(1.0),
+            description: "initial tilt of body 1 from hanging straight down (q1 = -pi/2 - swing)"
+                .to_string(),
+        },
+    ]),
 });
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
 impl rt::Dynamics for Model {
     fn info(&self) -> &rt::ModelInfo {
-        &INFO
+        &self.info
+    }
+    /// The run-time parameters' values.
+    fn parameter_values(&self) -> &[f64] {
+        &self.values
     }
     /// M(q), eq. (13), row-major.
     fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
@@ -234,6 +670,13 @@ impl rt::Dynamics for Model {
         let q2_dot = qd[1];
         let q3_dot = qd[2];
         let q4_dot = qd[3];
+        // run-time parameters (values stored when they are set)
+        let k2 = self.derived.k2;
+        let k3 = self.derived.k3;
+        let k4 = self.derived.k4;
+        let c2 = self.derived.c2;
+        let c3 = self.derived.c3;
+        let c4 = self.derived.c4;
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
         // body2: joint q2, rotation, velocities and accelerations
@@ -254,9 +697,9 @@ impl rt::Dynamics for Model {
         // body1: gravity load of the subtree on joint q1
         let weight_moment_body1_z = 8.829 * c_q1 + weight_moment_body2_z;
         applied[0] = weight_moment_body1_z;
-        applied[1] = 15.0 * q2 + (q2_dot + weight_moment_body2_z);
-        applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
-        applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
+        applied[1] = q2 * k2 + q2_dot * c2 + weight_moment_body2_z;
+        applied[2] = weight_q3 + (q3 * k3 + q3_dot * c3);
+        applied[3] = q4_dot * c4 + (weight_moment_body4_z + q4 * k4);
     }
     /// M, F and Q sharing one evaluation of the kinematics.
     fn equations(
@@ -276,6 +719,13 @@ impl rt::Dynamics for Model {
         let q2_dot = qd[1];
         let q3_dot = qd[2];
         let q4_dot = qd[3];
+        // run-time parameters (values stored when they are set)
+        let k2 = self.derived.k2;
+        let k3 = self.derived.k3;
+        let k4 = self.derived.k4;
+        let c2 = self.derived.c2;
+        let c3 = self.derived.c3;
+        let c4 = self.derived.c4;
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
         let omega_body1_sq = q1_dot * q1_dot;
@@ -376,9 +826,9 @@ impl rt::Dynamics for Model {
         f[2] = -neg_f_q3;
         f[3] = moment_of_acc_body4_z;
         applied[0] = weight_moment_body1_z;
-        applied[1] = 15.0 * q2 + (q2_dot + weight_moment_body2_z);
-        applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
-        applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
+        applied[1] = q2 * k2 + q2_dot * c2 + weight_moment_body2_z;
+        applied[2] = weight_q3 + (q3 * k3 + q3_dot * c3);
+        applied[3] = q4_dot * c4 + (weight_moment_body4_z + q4 * k4);
     }
     /// h(q) = f2 − f3(f1), eq. (3).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
@@ -655,8 +1105,11 @@ impl rt::Dynamics for Model {
         let s_q4_q1_q2 = (q4 + angle_q1_q2).sin();
         // energy
         let vel_com_body2_y = vel_body2_y + 0.05 * omega_body2_z;
+        let half_stiffness_q2 = self.derived.half_stiffness_q2;
         let vel_com_body3_y = vel_body3_in_parent_y + 0.15 * omega_body2_z;
+        let half_stiffness_q3 = self.derived.half_stiffness_q3;
         let vel_com_body4_y = vel_body4_y + 0.15 * omega_body4_z;
+        let half_stiffness_q4 = self.derived.half_stiffness_q4;
         let kinetic_body1 = q1_dot * (0.06125 * q1_dot);
         let kinetic = kinetic_body1 + omega_body2_z * (0.055 * omega_body2_z)
             + (0.25 * (vel_body2_x * vel_body2_x + vel_com_body2_y * vel_com_body2_y)
@@ -670,7 +1123,8 @@ impl rt::Dynamics for Model {
             + (4.905 * pos_body2_y
                 + (4.659750000000001 * s_q1_q2
                     + (7.848000000000001 + 1.4715 * (s_q1 + s_q4_q1_q2))));
-        let spring = 9.0 * q4.powi(2) + (7.5 * q2.powi(2) + 20.0 * q3.powi(2));
+        let spring = q4.powi(2) * half_stiffness_q4
+            + (q2.powi(2) * half_stiffness_q2 + q3.powi(2) * half_stiffness_q3);
         rt::Energy {
             kinetic,
             gravity,
@@ -682,7 +1136,11 @@ impl rt::Dynamics for Model {
         let q2_dot = qd[1];
         let q3_dot = qd[2];
         let q4_dot = qd[3];
-        q4_dot.powi(2) + (q2_dot.powi(2) + q3_dot.powi(2))
+        // run-time parameters (values stored when they are set)
+        let c2 = self.derived.c2;
+        let c3 = self.derived.c3;
+        let c4 = self.derived.c4;
+        c4 * q4_dot.powi(2) + (c2 * q2_dot.powi(2) + c3 * q3_dot.powi(2))
     }
     /// h (3) and J (5b) for Newton (15) and the velocities (16), in one pass; leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
     fn position_terms(
@@ -750,6 +1208,13 @@ impl rt::Dynamics for Model {
         let q2_dot = qd[1];
         let q3_dot = qd[2];
         let q4_dot = qd[3];
+        // run-time parameters (values stored when they are set)
+        let k2 = self.derived.k2;
+        let k3 = self.derived.k3;
+        let k4 = self.derived.k4;
+        let c2 = self.derived.c2;
+        let c3 = self.derived.c3;
+        let c4 = self.derived.c4;
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = cache[0];
         let s_q1 = cache[1];
@@ -886,9 +1351,9 @@ impl rt::Dynamics for Model {
         out.inertial[2] = -neg_f_q3;
         out.inertial[3] = moment_of_acc_body4_z;
         out.applied[0] = weight_moment_body1_z;
-        out.applied[1] = 15.0 * q2 + (q2_dot + weight_moment_body2_z);
-        out.applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
-        out.applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
+        out.applied[1] = q2 * k2 + q2_dot * c2 + weight_moment_body2_z;
+        out.applied[2] = weight_q3 + (q3 * k3 + q3_dot * c3);
+        out.applied[3] = q4_dot * c4 + (weight_moment_body4_z + q4 * k4);
         out.bias[0] = a_convective_y + neg_a_convective_x * a_slope
             - a_curvature * a_x_rate.powi(2);
     }
@@ -905,13 +1370,18 @@ impl rt::Dynamics for Model {
         out: &mut rt::ContactKinematics,
     ) {
         if k == 0 {
-            contact_kinematics_0(q, qd, out);
+            contact_kinematics_0(&self.derived, q, qd, out);
         }
     }
 }
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
 /// Kinematics of contact `A` into `out` (J1 and J2 of length 4).
-fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) {
+fn contact_kinematics_0(
+    _derived: &Derived,
+    q: &[f64],
+    qd: &[f64],
+    out: &mut rt::ContactKinematics,
+) {
     let q1 = q[0];
     let q2 = q[1];
     let q3 = q[2];
@@ -988,8 +1458,8 @@ fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) 
 pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("mass_matrix", [16, 14, 0, 4, 0, 0]),
     ("inertial_forces", [20, 25, 0, 4, 0, 0]),
-    ("applied_forces", [12, 8, 0, 4, 0, 0]),
-    ("equations", [46, 47, 0, 8, 0, 0]),
+    ("applied_forces", [12, 11, 0, 4, 0, 0]),
+    ("equations", [46, 50, 0, 8, 0, 0]),
     ("constraint", [12, 9, 0, 6, 0, 0]),
     ("constraint_jacobian", [14, 12, 0, 6, 0, 0]),
     ("constraint_bias", [24, 28, 0, 6, 0, 1]),
@@ -997,8 +1467,9 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("contact_geometry", [12, 9, 0, 6, 0, 0]),
     ("prescribed", [0, 0, 0, 0, 0, 0]),
     ("energy", [30, 35, 0, 7, 0, 3]),
-    ("damper_power", [2, 0, 0, 0, 0, 3]),
+    ("damper_power", [2, 3, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
-    ("velocity_terms", [68, 80, 0, 0, 0, 1]),
+    ("velocity_terms", [68, 83, 0, 0, 0, 1]),
     ("contact_kinematics_0", [24, 22, 0, 6, 0, 0]),
+    ("derive", [0, 3, 0, 0, 0, 0]),
 ];

@@ -8,8 +8,92 @@ use serde::de::{EnumAccess, MapAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::fmt;
 
-/// Three numbers `(x, y, z)`.
-pub(super) type Vec3 = [f64; 3];
+/// Three numbers `(x, y, z)`, each a number or a parameter expression.
+pub(super) type Vec3 = [Number; 3];
+
+/// A numeric field: a number, or a string holding an expression of the model's parameters
+/// (`"m1"`, `"l1/2"`, `"2*PI*rpm/60"`).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Number {
+    /// A number as written.
+    Value(f64),
+    /// An expression of the parameters, as written inside the quotes.
+    Expr(String),
+}
+
+impl Number {
+    pub(super) const ZERO: Number = Number::Value(0.0);
+    pub(super) const ONE: Number = Number::Value(1.0);
+}
+
+impl Default for Number {
+    fn default() -> Self {
+        Number::ZERO
+    }
+}
+
+impl<'de> Deserialize<'de> for Number {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(NumberVisitor)
+    }
+}
+
+struct NumberVisitor;
+
+impl Visitor<'_> for NumberVisitor {
+    type Value = Number;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number or a string with an expression of the parameters")
+    }
+
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Number, E> {
+        Ok(Number::Value(v))
+    }
+
+    fn visit_f32<E: serde::de::Error>(self, v: f32) -> Result<Number, E> {
+        Ok(Number::Value(f64::from(v)))
+    }
+
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Number, E> {
+        Ok(Number::Value(v as f64))
+    }
+
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Number, E> {
+        Ok(Number::Value(v as f64))
+    }
+
+    fn visit_i128<E: serde::de::Error>(self, v: i128) -> Result<Number, E> {
+        Ok(Number::Value(v as f64))
+    }
+
+    fn visit_u128<E: serde::de::Error>(self, v: u128) -> Result<Number, E> {
+        Ok(Number::Value(v as f64))
+    }
+
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Number, E> {
+        Ok(Number::Expr(v.to_string()))
+    }
+}
+
+/// A parameter: a named number that fields and expressions use, with a default value that
+/// a program or the command line may change at run time (unless it is `constant`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Parameter {
+    pub name: String,
+    pub value: f64,
+    #[serde(default)]
+    pub unit: String,
+    #[serde(default)]
+    pub min: Option<f64>,
+    #[serde(default)]
+    pub max: Option<f64>,
+    #[serde(default)]
+    pub constant: bool,
+    #[serde(default)]
+    pub description: String,
+}
 
 /// The top-level unnamed struct.
 #[derive(Debug, Deserialize)]
@@ -19,6 +103,8 @@ pub(super) struct Model {
     pub name: Option<String>,
     #[serde(default)]
     pub description: String,
+    #[serde(default)]
+    pub parameters: Vec<Parameter>,
     #[serde(default)]
     pub gravity: Vec3,
     pub bodies: Vec<Body>,
@@ -38,7 +124,7 @@ pub(super) struct Model {
 pub(super) struct Body {
     pub name: String,
     pub parent: String,
-    pub mass: f64,
+    pub mass: Number,
     #[serde(default)]
     pub com: Vec3,
     pub inertia: Inertia,
@@ -50,20 +136,20 @@ pub(super) struct Body {
 #[serde(deny_unknown_fields)]
 pub(super) enum Inertia {
     /// A lamina in the body x-y plane: Ixx = Iyy = Izz / 2.
-    Izz(f64),
+    Izz(Number),
     /// Principal moments along the body axes.
-    Diagonal(f64, f64, f64),
+    Diagonal(Number, Number, Number),
     /// The full symmetric tensor; products default to zero.
     Full {
-        ixx: f64,
-        iyy: f64,
-        izz: f64,
+        ixx: Number,
+        iyy: Number,
+        izz: Number,
         #[serde(default)]
-        ixy: f64,
+        ixy: Number,
         #[serde(default)]
-        ixz: f64,
+        ixz: Number,
         #[serde(default)]
-        iyz: f64,
+        iyz: Number,
     },
 }
 
@@ -90,9 +176,9 @@ pub(super) struct Joint {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub(super) struct Spring {
-    pub stiffness: f64,
-    pub damping: f64,
-    pub rest: f64,
+    pub stiffness: Number,
+    pub damping: Number,
+    pub rest: Number,
 }
 
 #[derive(Debug, Deserialize)]
@@ -125,9 +211,9 @@ pub(super) struct Frame {
 impl Default for Frame {
     fn default() -> Self {
         Frame {
-            origin: [0.0; 3],
-            x_axis: [1.0, 0.0, 0.0],
-            y_axis: [0.0, 1.0, 0.0],
+            origin: [Number::ZERO, Number::ZERO, Number::ZERO],
+            x_axis: [Number::ONE, Number::ZERO, Number::ZERO],
+            y_axis: [Number::ZERO, Number::ONE, Number::ZERO],
         }
     }
 }
@@ -237,7 +323,7 @@ impl Default for Simulation {
 /// A `{"name": value}` map kept in file order with duplicates preserved, so that the
 /// validator can report a name given twice instead of silently keeping the last one.
 #[derive(Debug, Default)]
-pub(super) struct NamedValues(pub Vec<(String, f64)>);
+pub(super) struct NamedValues(pub Vec<(String, Number)>);
 
 impl<'de> Deserialize<'de> for NamedValues {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
@@ -256,7 +342,7 @@ impl<'de> Visitor<'de> for NamedValuesVisitor {
 
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<NamedValues, A::Error> {
         let mut values = Vec::new();
-        while let Some(entry) = map.next_entry::<String, f64>()? {
+        while let Some(entry) = map.next_entry::<String, Number>()? {
             values.push(entry);
         }
         Ok(NamedValues(values))

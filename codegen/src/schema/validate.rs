@@ -6,19 +6,16 @@ use super::Locator;
 use super::raw;
 use crate::error::ModelError;
 use crate::model::{
-    Body, Contact, Initial, IntegratorChoice, Joint, JointKind, Marker, Model, Prescribed,
-    Simulation, SpringDamper,
+    Body, Contact, Field, FieldLocation, Initial, IntegratorChoice, Joint, JointKind, Marker,
+    Model, Parameter, ParameterMode, Prescribed, RuntimeCheck, Simulation, SpringDamper,
 };
-use crate::profile::{Scalar, parse_expression};
-use nalgebra::{Matrix3, SymmetricEigen};
-use std::collections::HashMap;
+use crate::profile::{Scalar, parse_expression_with};
+use camchain_runtime::parameters::{Bound, checks};
+use std::cell::RefCell;
+use std::collections::{BTreeMap, HashMap};
 
 /// The reserved parent name of the fixed base.
 const GROUND: &str = "ground";
-
-/// Principal moments may exceed the triangle inequality by this fraction of their sum
-/// (round-off in the eigen-decomposition; the planar lamina is exactly on the boundary).
-const TRIANGLE_SLACK: f64 = 1e-12;
 
 /// Largest |x̂·ŷ| accepted for the cam plane axes after normalisation.
 const ORTHOGONALITY_TOLERANCE: f64 = 1e-9;
@@ -34,19 +31,41 @@ const KEYWORDS: [&str; 53] = [
 
 type Checked<T> = Result<T, ModelError>;
 
+/// What a file is validated with besides its text.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Options<'o> {
+    /// Parameters given other values than the file's, by name.
+    pub overrides: &'o [(String, f64)],
+    /// Which parameters are read at run time.
+    pub mode: ParameterMode,
+}
+
 /// Validates the whole file; `stem` is the file stem used as the default model name.
-pub(super) fn validate(file: &raw::Model, stem: &str, at: &Locator) -> Checked<Model> {
+pub(super) fn validate(
+    file: &raw::Model,
+    stem: &str,
+    at: &Locator,
+    options: &Options,
+) -> Checked<Model> {
     let name = model_name(file.name.as_deref(), stem, at)?;
-    let gravity = finite3(at, "gravity", file.gravity)?;
+    let parameters = parameters(file, options, at)?;
+    let table = Table::new(&parameters, at);
+    let cx = Context { at, table: &table };
+    let gravity = cx.vector("gravity", &file.gravity, Some(Field::Gravity))?;
     let tree = BodyTree::new(&file.bodies, at)?;
-    let bodies = tree.bodies(&file.bodies, at)?;
-    let markers = markers(&file.markers, &tree, at)?;
-    let contacts = contacts(&file.contacts, &markers, at)?;
-    let initial = initial(&file.initial, &bodies, at)?;
+    let bodies = tree.bodies(&file.bodies, &cx)?;
+    parameter_names_free(&parameters, &bodies, at)?;
+    let markers = markers(&file.markers, &tree, &cx)?;
+    let contacts = contacts(&file.contacts, &markers, &cx)?;
+    let initial = initial(&file.initial, &bodies, &cx)?;
     let simulation = simulation(&file.simulation, at)?;
     Ok(Model {
         name,
         description: file.description.clone(),
+        parameters,
+        symbolic: table.symbolic.into_inner(),
+        runtime_checks: table.checks.into_inner(),
+        parameters_at: location(at, "parameters"),
         gravity,
         bodies,
         markers,
@@ -54,6 +73,373 @@ pub(super) fn validate(file: &raw::Model, stem: &str, at: &Locator) -> Checked<M
         initial,
         simulation,
     })
+}
+
+/// Where `field` is written.
+fn location(at: &Locator, field: &str) -> FieldLocation {
+    let e = at.error(field, "");
+    FieldLocation {
+        field: field.to_string(),
+        line: e.line,
+        column: e.column,
+    }
+}
+
+/// Names that expressions already give a meaning to.
+const RESERVED_IN_EXPRESSIONS: [&str; 16] = [
+    "x", "t", "PI", "E", "sin", "cos", "tan", "exp", "ln", "sqrt", "sinh", "cosh", "tanh", "atan",
+    "powi", "powf",
+];
+
+/// The parameters with their effective values (the file's, or an override) and whether the
+/// generated code folds them (`constant`, after the mode is applied).
+fn parameters(file: &raw::Model, options: &Options, at: &Locator) -> Checked<Vec<Parameter>> {
+    let list = &file.parameters;
+    let index = unique_names(
+        at,
+        list.iter()
+            .enumerate()
+            .map(|(i, p)| (format!("parameters[{i}].name"), p.name.as_str())),
+        "parameter name",
+    )?;
+    let mut out = Vec::with_capacity(list.len());
+    for (i, p) in list.iter().enumerate() {
+        let path = format!("parameters[{i}]");
+        if RESERVED_IN_EXPRESSIONS.contains(&p.name.as_str()) || p.name.starts_with("__") {
+            return Err(at.error(
+                &format!("{path}.name"),
+                format!(
+                    "`{}` already means something in expressions (the variables x and t, the \
+                     constants PI and E, the math functions; names starting with `__` are \
+                     reserved): choose another parameter name",
+                    p.name
+                ),
+            ));
+        }
+        let value = finite(at, &format!("{path}.value"), p.value)?;
+        let min = p
+            .min
+            .map(|m| finite(at, &format!("{path}.min"), m))
+            .transpose()?;
+        let max = p
+            .max
+            .map(|m| finite(at, &format!("{path}.max"), m))
+            .transpose()?;
+        if let (Some(low), Some(high)) = (min, max) {
+            if low > high {
+                return Err(at.error(
+                    &format!("{path}.max"),
+                    format!("the maximum {high} is below the minimum {low}"),
+                ));
+            }
+        }
+        let parameter = Parameter {
+            name: p.name.clone(),
+            value,
+            default: value,
+            unit: p.unit.clone(),
+            min,
+            max,
+            constant: p.constant,
+            description: p.description.clone(),
+            constant_at: location(at, &format!("{path}.constant")),
+        };
+        within_bounds(at, &path, &parameter, "its value")?;
+        out.push(parameter);
+    }
+    match options.mode {
+        ParameterMode::AsDeclared => {}
+        ParameterMode::FoldAll => out.iter_mut().for_each(|p| p.constant = true),
+        ParameterMode::AllAtRunTime => {
+            let structural = structural_parameters(file, &out);
+            for (i, p) in out.iter_mut().enumerate() {
+                p.constant = structural.contains(&i);
+            }
+        }
+    }
+    for (name, value) in options.overrides {
+        let Some(&i) = index.get(name.as_str()) else {
+            let known: Vec<&str> = list.iter().map(|p| p.name.as_str()).collect();
+            return Err(at.error("parameters", checks::unknown_parameter(name, &known)));
+        };
+        let path = format!("parameters[{i}]");
+        if out[i].constant {
+            return Err(at.error(
+                &format!("{path}.constant"),
+                checks::constant_parameter(name),
+            ));
+        }
+        out[i].value = *value;
+        within_bounds(at, &path, &out[i], &format!("{name} = {value}"))?;
+    }
+    Ok(out)
+}
+
+/// The parameters used by fields that must be constant (joint axes, cam plane axes): they
+/// stay folded in [`ParameterMode::AllAtRunTime`].
+fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usize> {
+    let names: Vec<&str> = parameters.iter().map(|p| p.name.as_str()).collect();
+    let axes = file.bodies.iter().flat_map(|b| b.joint.axis.iter()).chain(
+        file.contacts
+            .iter()
+            .flat_map(|c| c.frame.x_axis.iter().chain(c.frame.y_axis.iter())),
+    );
+    let mut used: Vec<usize> = axes
+        .filter_map(|n| match n {
+            raw::Number::Expr(source) => parse_expression_with(source, None, &names).ok(),
+            raw::Number::Value(_) => None,
+        })
+        .flat_map(|e| e.parameters())
+        .collect();
+    used.sort_unstable();
+    used.dedup();
+    used
+}
+
+/// The parameter's value against its declared bounds; `what` names the value in messages.
+/// The file's own value is reported where it is written (`.value`); a value given from
+/// outside at the bound it breaks (`.min`, `.max`), as the generated code reports it.
+fn within_bounds(at: &Locator, path: &str, p: &Parameter, what: &str) -> Checked<()> {
+    let own = what == "its value";
+    checks::within_bounds(&p.name, p.value, (p.min, p.max), what)
+        .map(|_| ())
+        .map_err(|(side, message)| {
+            let side = if own { Bound::Value } else { side };
+            at.error(&format!("{path}.{}", bound_field(side)), message)
+        })
+}
+
+/// The field of `parameters[i]` a bound failure is reported at.
+fn bound_field(side: Bound) -> &'static str {
+    match side {
+        Bound::Min => "min",
+        Bound::Max => "max",
+        Bound::Value => "value",
+    }
+}
+
+/// Parameter names must differ from the coordinates' names and their velocities'
+/// (`q1`, `q1_dot`): the generated code names its inputs so.
+fn parameter_names_free(parameters: &[Parameter], bodies: &[Body], at: &Locator) -> Checked<()> {
+    for (i, p) in parameters.iter().enumerate() {
+        let clash = bodies
+            .iter()
+            .map(|b| &b.joint.coordinate)
+            .find(|c| p.name == **c || p.name.strip_suffix("_dot") == Some(c.as_str()));
+        if let Some(coordinate) = clash {
+            return Err(at.error(
+                &format!("parameters[{i}].name"),
+                format!(
+                    "`{}` is taken by coordinate `{coordinate}` (or its velocity): choose \
+                     another parameter name",
+                    p.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The parameters as expressions see them, the run-time-dependent fields found so far and
+/// the checks the generated code must repeat on them.
+struct Table<'a> {
+    names: Vec<String>,
+    values: Vec<f64>,
+    constant: Vec<bool>,
+    symbolic: RefCell<BTreeMap<Field, Scalar>>,
+    checks: RefCell<Vec<RuntimeCheck>>,
+    at: &'a Locator<'a>,
+}
+
+impl<'a> Table<'a> {
+    fn new(parameters: &[Parameter], at: &'a Locator<'a>) -> Self {
+        let checks = parameters
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| !p.constant)
+            .map(|(i, _)| RuntimeCheck::Bounds {
+                parameter: i,
+                at: ["value", "min", "max"].map(|f| location(at, &format!("parameters[{i}].{f}"))),
+            })
+            .collect();
+        Table {
+            names: parameters.iter().map(|p| p.name.clone()).collect(),
+            values: parameters.iter().map(|p| p.value).collect(),
+            constant: parameters.iter().map(|p| p.constant).collect(),
+            symbolic: RefCell::new(BTreeMap::new()),
+            checks: RefCell::new(checks),
+            at,
+        }
+    }
+
+    /// Parses `source` (with `variable`, if any) and folds the constant parameters in:
+    /// (the expression with only run-time parameters left, the fully resolved one).
+    fn expression(
+        &self,
+        field: &str,
+        source: &str,
+        variable: Option<&str>,
+    ) -> Checked<(Scalar, Scalar)> {
+        let names: Vec<&str> = self.names.iter().map(String::as_str).collect();
+        let parsed = parse_expression_with(source, variable, &names)
+            .map_err(|e| self.at.error_in_string(field, e.offset, e.message))?;
+        let folded = parsed.resolve(&self.values, &|i| self.constant[i]);
+        let resolved = parsed.resolve_all(&self.values);
+        Ok((folded, resolved))
+    }
+
+    /// Multiplies the recorded expression of `field`, if any, by `factor`.
+    fn scale(&self, field: Field, factor: f64) {
+        if factor != 1.0 {
+            if let Some(expr) = self.symbolic.borrow_mut().get_mut(&field) {
+                let inner = std::mem::replace(expr, Scalar::Const(0.0));
+                *expr = Scalar::Mul(Box::new(Scalar::Const(factor)), Box::new(inner));
+            }
+        }
+    }
+
+    /// Records that `field` depends on run-time parameters through `expr`; true if it does.
+    fn record(&self, field: Field, expr: Scalar) -> bool {
+        let runtime = !expr.parameters().is_empty();
+        if runtime {
+            self.symbolic.borrow_mut().insert(field, expr);
+        }
+        runtime
+    }
+
+    /// True when `field` depends on run-time parameters.
+    fn is_runtime(&self, field: Field) -> bool {
+        self.symbolic.borrow().contains_key(&field)
+    }
+
+    /// Adds a check for the generated code.
+    fn check(&self, check: RuntimeCheck) {
+        self.checks.borrow_mut().push(check);
+    }
+}
+
+/// What field validation needs: the locator and the parameters.
+struct Context<'a> {
+    at: &'a Locator<'a>,
+    table: &'a Table<'a>,
+}
+
+impl Context<'_> {
+    /// The value of a numeric field; `key` records it when it depends on run-time
+    /// parameters, and `None` refuses such a dependence (a field that must be constant).
+    fn number(&self, field: &str, n: &raw::Number, key: Option<Field>) -> Checked<f64> {
+        let value = self.raw_number(field, n, key, true)?;
+        finite(self.at, field, value)
+    }
+
+    /// The value of a numeric field, not yet checked to be finite (the caller checks what
+    /// the field needs); with `finite_at_run_time`, a field that depends on run-time
+    /// parameters gets a finiteness check in the generated code.
+    fn raw_number(
+        &self,
+        field: &str,
+        n: &raw::Number,
+        key: Option<Field>,
+        finite_at_run_time: bool,
+    ) -> Checked<f64> {
+        let source = match n {
+            raw::Number::Value(v) => return Ok(*v),
+            raw::Number::Expr(source) => source,
+        };
+        let (folded, resolved) = self.table.expression(field, source, None)?;
+        let runtime = folded.parameters();
+        match key {
+            Some(key) => {
+                let recorded = self.table.record(key, folded);
+                if recorded && finite_at_run_time {
+                    self.table
+                        .check(RuntimeCheck::Finite(key, location(self.at, field)));
+                }
+            }
+            None if !runtime.is_empty() => {
+                let names: Vec<&str> = runtime
+                    .iter()
+                    .map(|&i| self.table.names[i].as_str())
+                    .collect();
+                return Err(self.at.error(
+                    field,
+                    format!(
+                        "this field must be constant, but {} {} read at run time: mark {} \
+                         `constant: true`",
+                        names.join(", "),
+                        if names.len() == 1 { "is" } else { "are" },
+                        if names.len() == 1 { "it" } else { "them" }
+                    ),
+                ));
+            }
+            None => {}
+        }
+        Ok(resolved.eval(0.0))
+    }
+
+    /// A numeric field that must be positive (a mass): checked now, and at run time when it
+    /// depends on run-time parameters.
+    fn positive(
+        &self,
+        field: &str,
+        n: &raw::Number,
+        key: Field,
+        what: &'static str,
+    ) -> Checked<f64> {
+        let value = self.raw_number(field, n, Some(key), false)?;
+        if self.table.is_runtime(key) {
+            self.table
+                .check(RuntimeCheck::Positive(key, what, location(self.at, field)));
+        }
+        positive(self.at, field, what, value)
+    }
+
+    /// A numeric field that must be non-negative (a stiffness, a damping).
+    fn non_negative(
+        &self,
+        field: &str,
+        n: &raw::Number,
+        key: Field,
+        what: &'static str,
+    ) -> Checked<f64> {
+        let value = self.raw_number(field, n, Some(key), false)?;
+        if self.table.is_runtime(key) {
+            self.table.check(RuntimeCheck::NonNegative(
+                key,
+                what,
+                location(self.at, field),
+            ));
+        }
+        non_negative(self.at, field, what, value)
+    }
+
+    /// Three numeric fields `field[0..3]`, keyed by component.
+    fn vector(
+        &self,
+        field: &str,
+        v: &[raw::Number; 3],
+        key: Option<fn(usize) -> Field>,
+    ) -> Checked<[f64; 3]> {
+        let mut out = [0.0; 3];
+        for (k, n) in v.iter().enumerate() {
+            out[k] = self.number(&format!("{field}[{k}]"), n, key.map(|f| f(k)))?;
+        }
+        Ok(out)
+    }
+
+    /// [`Context::vector`] with a key that needs an index (`Com(body, k)`).
+    fn vector_of(
+        &self,
+        field: &str,
+        v: &[raw::Number; 3],
+        key: impl Fn(usize) -> Field,
+    ) -> Checked<[f64; 3]> {
+        let mut out = [0.0; 3];
+        for (k, n) in v.iter().enumerate() {
+            out[k] = self.number(&format!("{field}[{k}]"), n, Some(key(k)))?;
+        }
+        Ok(out)
+    }
 }
 
 /// The model's name: `name:`, or the file stem. Any non-empty text: only the build needs a
@@ -94,11 +480,7 @@ fn identifier(at: &Locator, field: &str, name: &str, what: &str) -> Checked<()> 
 }
 
 fn finite(at: &Locator, field: &str, value: f64) -> Checked<f64> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(at.error(field, format!("must be finite, got {value}")))
-    }
+    checks::finite(value).map_err(|m| at.error(field, m))
 }
 
 fn finite3(at: &Locator, field: &str, v: [f64; 3]) -> Checked<[f64; 3]> {
@@ -109,25 +491,11 @@ fn finite3(at: &Locator, field: &str, v: [f64; 3]) -> Checked<[f64; 3]> {
 }
 
 fn positive(at: &Locator, field: &str, what: &str, value: f64) -> Checked<f64> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(at.error(
-            field,
-            format!("{what} must be positive and finite, got {value}"),
-        ))
-    }
+    checks::positive(what, value).map_err(|m| at.error(field, m))
 }
 
 fn non_negative(at: &Locator, field: &str, what: &str, value: f64) -> Checked<f64> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(at.error(
-            field,
-            format!("{what} must be non-negative and finite, got {value}"),
-        ))
-    }
+    checks::non_negative(what, value).map_err(|m| at.error(field, m))
 }
 
 /// `v / |v|`, or `None` for a zero or non-finite vector.
@@ -233,12 +601,13 @@ impl<'f> BodyTree<'f> {
     }
 
     /// The validated bodies, parents first.
-    fn bodies(&self, bodies: &[raw::Body], at: &Locator) -> Checked<Vec<Body>> {
+    fn bodies(&self, bodies: &[raw::Body], cx: &Context) -> Checked<Vec<Body>> {
         self.order
             .iter()
-            .map(|&i| {
+            .enumerate()
+            .map(|(sorted, &i)| {
                 let parent = self.parents[i].map(|p| self.sorted_index[p]);
-                body(at, i, &bodies[i], parent)
+                body(cx, i, sorted, &bodies[i], parent)
             })
             .collect()
     }
@@ -331,33 +700,44 @@ fn cycle_error(at: &Locator, bodies: &[raw::Body], cycle: &[usize]) -> ModelErro
     )
 }
 
-fn body(at: &Locator, i: usize, b: &raw::Body, parent: Option<usize>) -> Checked<Body> {
+fn body(
+    cx: &Context,
+    i: usize,
+    sorted: usize,
+    b: &raw::Body,
+    parent: Option<usize>,
+) -> Checked<Body> {
     let path = format!("bodies[{i}]");
+    let mass_field = format!("{path}.mass");
+    let mass = cx.positive(&mass_field, &b.mass, Field::Mass(sorted), "mass")?;
     Ok(Body {
         name: b.name.clone(),
         parent,
-        mass: positive(at, &format!("{path}.mass"), "mass", b.mass)?,
-        com: finite3(at, &format!("{path}.com"), b.com)?,
-        inertia: inertia(at, &format!("{path}.inertia"), &b.inertia)?,
-        joint: joint(at, &format!("{path}.joint"), &b.joint)?,
+        mass,
+        com: cx.vector_of(&format!("{path}.com"), &b.com, |k| Field::Com(sorted, k))?,
+        inertia: inertia(cx, &format!("{path}.inertia"), &b.inertia, sorted)?,
+        joint: joint(cx, &format!("{path}.joint"), &b.joint, sorted)?,
     })
 }
 
-/// The tensor as a matrix, and each number written in the file with its path suffix.
-fn inertia_entries(inertia: &raw::Inertia) -> ([[f64; 3]; 3], Vec<(&'static str, f64)>) {
-    match *inertia {
-        raw::Inertia::Izz(izz) => (
-            [
-                [izz / 2.0, 0.0, 0.0],
-                [0.0, izz / 2.0, 0.0],
-                [0.0, 0.0, izz],
-            ],
-            vec![("[0]", izz)],
-        ),
-        raw::Inertia::Diagonal(ixx, iyy, izz) => (
-            [[ixx, 0.0, 0.0], [0.0, iyy, 0.0], [0.0, 0.0, izz]],
-            vec![("[0]", ixx), ("[1]", iyy), ("[2]", izz)],
-        ),
+/// Where each tensor entry (r, c) comes from: the written number (by its path suffix) and
+/// a factor (Izz(e) gives e/2 on the diagonal's first two entries); `None` for a zero.
+type InertiaSource<'r> = [[Option<(&'static str, &'r raw::Number, f64)>; 3]; 3];
+
+/// The written numbers of an inertia form, placed in the tensor.
+fn inertia_sources(inertia: &raw::Inertia) -> InertiaSource<'_> {
+    let mut s: InertiaSource = Default::default();
+    match inertia {
+        raw::Inertia::Izz(izz) => {
+            s[0][0] = Some(("[0]", izz, 0.5));
+            s[1][1] = Some(("[0]", izz, 0.5));
+            s[2][2] = Some(("[0]", izz, 1.0));
+        }
+        raw::Inertia::Diagonal(ixx, iyy, izz) => {
+            s[0][0] = Some(("[0]", ixx, 1.0));
+            s[1][1] = Some(("[1]", iyy, 1.0));
+            s[2][2] = Some(("[2]", izz, 1.0));
+        }
         raw::Inertia::Full {
             ixx,
             iyy,
@@ -365,97 +745,111 @@ fn inertia_entries(inertia: &raw::Inertia) -> ([[f64; 3]; 3], Vec<(&'static str,
             ixy,
             ixz,
             iyz,
-        } => (
-            [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]],
-            vec![
-                (".ixx", ixx),
-                (".iyy", iyy),
-                (".izz", izz),
-                (".ixy", ixy),
-                (".ixz", ixz),
-                (".iyz", iyz),
-            ],
-        ),
+        } => {
+            s[0][0] = Some((".ixx", ixx, 1.0));
+            s[1][1] = Some((".iyy", iyy, 1.0));
+            s[2][2] = Some((".izz", izz, 1.0));
+            for (r, c, name, n) in [
+                (0, 1, ".ixy", ixy),
+                (0, 2, ".ixz", ixz),
+                (1, 2, ".iyz", iyz),
+            ] {
+                s[r][c] = Some((name, n, 1.0));
+                s[c][r] = Some((name, n, 1.0));
+            }
+        }
     }
+    s
 }
 
 /// Finite, positive definite, principal moments obeying the triangle inequality.
-fn inertia(at: &Locator, field: &str, raw: &raw::Inertia) -> Checked<[[f64; 3]; 3]> {
-    let (matrix, entries) = inertia_entries(raw);
-    for (suffix, value) in entries {
-        finite(at, &format!("{field}{suffix}"), value)?;
+fn inertia(cx: &Context, field: &str, raw: &raw::Inertia, body: usize) -> Checked<[[f64; 3]; 3]> {
+    let at = cx.at;
+    let mut matrix = [[0.0; 3]; 3];
+    for (r, row) in inertia_sources(raw).iter().enumerate() {
+        for (c, source) in row.iter().enumerate() {
+            let Some((suffix, number, factor)) = source else {
+                continue;
+            };
+            let key = Field::Inertia(body, r, c);
+            let value = cx.number(&format!("{field}{suffix}"), number, Some(key))?;
+            cx.table.scale(key, *factor);
+            matrix[r][c] = factor * value;
+        }
     }
-    let mut moments: Vec<f64> = SymmetricEigen::new(Matrix3::from_fn(|r, c| matrix[r][c]))
-        .eigenvalues
-        .iter()
-        .copied()
-        .collect();
-    moments.sort_by(f64::total_cmp);
-    let [small, middle, large] = [moments[0], moments[1], moments[2]];
-    let listed = format!("{small}, {middle}, {large}");
-    if small <= 0.0 {
-        return Err(at.error(
-            field,
-            format!(
-                "the inertia tensor must be positive definite; its principal moments are {listed}"
-            ),
-        ));
+    let runtime = (0..3).any(|r| (0..3).any(|c| cx.table.is_runtime(Field::Inertia(body, r, c))));
+    if runtime {
+        cx.table
+            .check(RuntimeCheck::Inertia(body, location(at, field)));
     }
-    if large > (small + middle) + TRIANGLE_SLACK * (small + middle + large) {
-        return Err(at.error(
-            field,
-            format!(
-                "the principal moments {listed} violate the triangle inequality (the largest \
-                 may not exceed the sum of the other two): no rigid body has this inertia"
-            ),
-        ));
-    }
+    checks::inertia(&matrix).map_err(|m| at.error(field, m))?;
     Ok(matrix)
 }
 
-fn joint(at: &Locator, path: &str, j: &raw::Joint) -> Checked<Joint> {
+fn joint(cx: &Context, path: &str, j: &raw::Joint, body: usize) -> Checked<Joint> {
+    let axis = cx.vector(&format!("{path}.axis"), &j.axis, None)?;
     Ok(Joint {
         kind: match j.kind {
             raw::JointKind::Revolute => JointKind::Revolute,
             raw::JointKind::Prismatic => JointKind::Prismatic,
         },
-        axis: unit_vector(at, &format!("{path}.axis"), "the joint axis", j.axis)?,
-        anchor: finite3(at, &format!("{path}.anchor"), j.anchor)?,
+        axis: unit_vector(cx.at, &format!("{path}.axis"), "the joint axis", axis)?,
+        anchor: cx.vector_of(&format!("{path}.anchor"), &j.anchor, |k| {
+            Field::Anchor(body, k)
+        })?,
         coordinate: j.coordinate.clone(),
         spring: j
             .spring
             .as_ref()
-            .map(|s| spring(at, &format!("{path}.spring"), s))
+            .map(|s| spring(cx, &format!("{path}.spring"), s, body))
             .transpose()?,
         prescribed: j
             .prescribed
             .as_ref()
-            .map(|source| prescribed(at, &format!("{path}.prescribed"), source))
+            .map(|source| prescribed(cx, &format!("{path}.prescribed"), source, body))
             .transpose()?,
     })
 }
 
-fn spring(at: &Locator, path: &str, s: &raw::Spring) -> Checked<SpringDamper> {
+fn spring(cx: &Context, path: &str, s: &raw::Spring, body: usize) -> Checked<SpringDamper> {
+    let (k, c, rest) = (
+        format!("{path}.stiffness"),
+        format!("{path}.damping"),
+        format!("{path}.rest"),
+    );
+    let stiffness = cx.non_negative(&k, &s.stiffness, Field::Stiffness(body), "stiffness")?;
+    let damping = cx.non_negative(&c, &s.damping, Field::Damping(body), "damping")?;
     Ok(SpringDamper {
-        stiffness: non_negative(at, &format!("{path}.stiffness"), "stiffness", s.stiffness)?,
-        damping: non_negative(at, &format!("{path}.damping"), "damping", s.damping)?,
-        rest: finite(at, &format!("{path}.rest"), s.rest)?,
+        stiffness,
+        damping,
+        rest: cx.number(&rest, &s.rest, Some(Field::Rest(body)))?,
     })
 }
 
-/// Parses an expression in `variable`, locating errors inside the string literal.
-fn expression(at: &Locator, field: &str, source: &str, variable: &str) -> Checked<Scalar> {
-    parse_expression(source, variable).map_err(|e| at.error_in_string(field, e.offset, e.message))
+/// Parses an expression of `variable` and the parameters, locating errors inside the
+/// string literal; records it under `key` when it uses run-time parameters and returns it
+/// with every parameter resolved.
+fn expression(
+    cx: &Context,
+    field: &str,
+    source: &str,
+    variable: &str,
+    key: Field,
+) -> Checked<Scalar> {
+    let (folded, resolved) = cx.table.expression(field, source, Some(variable))?;
+    cx.table.record(key, folded);
+    Ok(resolved)
 }
 
-fn prescribed(at: &Locator, field: &str, source: &str) -> Checked<Prescribed> {
+fn prescribed(cx: &Context, field: &str, source: &str, body: usize) -> Checked<Prescribed> {
     Ok(Prescribed {
         source: source.to_string(),
-        expr: expression(at, field, source, "t")?,
+        expr: expression(cx, field, source, "t", Field::Drive(body))?,
     })
 }
 
-fn markers(list: &[raw::Marker], tree: &BodyTree, at: &Locator) -> Checked<Vec<Marker>> {
+fn markers(list: &[raw::Marker], tree: &BodyTree, cx: &Context) -> Checked<Vec<Marker>> {
+    let at = cx.at;
     unique_names(
         at,
         list.iter()
@@ -469,13 +863,16 @@ fn markers(list: &[raw::Marker], tree: &BodyTree, at: &Locator) -> Checked<Vec<M
             Ok(Marker {
                 name: m.name.clone(),
                 body: tree.sorted_body(at, &format!("markers[{i}].body"), &m.body)?,
-                position: finite3(at, &format!("markers[{i}].position"), m.position)?,
+                position: cx.vector_of(&format!("markers[{i}].position"), &m.position, |k| {
+                    Field::Marker(i, k)
+                })?,
             })
         })
         .collect()
 }
 
-fn contacts(list: &[raw::Contact], markers: &[Marker], at: &Locator) -> Checked<Vec<Contact>> {
+fn contacts(list: &[raw::Contact], markers: &[Marker], cx: &Context) -> Checked<Vec<Contact>> {
+    let at = cx.at;
     let by_name: HashMap<&str, usize> = markers
         .iter()
         .enumerate()
@@ -494,29 +891,42 @@ fn contacts(list: &[raw::Contact], markers: &[Marker], at: &Locator) -> Checked<
                 );
                 return Err(at.error(&field, message));
             }
-            contact(at, i, c, marker)
+            contact(cx, i, c, marker)
         })
         .collect()
 }
 
-fn contact(at: &Locator, i: usize, c: &raw::Contact, marker: usize) -> Checked<Contact> {
+fn contact(cx: &Context, i: usize, c: &raw::Contact, marker: usize) -> Checked<Contact> {
     let path = format!("contacts[{i}]");
-    let (x_axis, y_axis) = cam_axes(at, &format!("{path}.frame"), &c.frame)?;
+    let (x_axis, y_axis) = cam_axes(cx, &format!("{path}.frame"), &c.frame)?;
     Ok(Contact {
         name: c.marker.clone(),
         marker,
         profile_source: c.profile.clone(),
-        profile: expression(at, &format!("{path}.profile"), &c.profile, "x")?,
-        origin: finite3(at, &format!("{path}.frame.origin"), c.frame.origin)?,
+        profile: expression(
+            cx,
+            &format!("{path}.profile"),
+            &c.profile,
+            "x",
+            Field::Profile(i),
+        )?,
+        origin: cx.vector_of(&format!("{path}.frame.origin"), &c.frame.origin, |k| {
+            Field::Origin(i, k)
+        })?,
         x_axis,
         y_axis,
     })
 }
 
-/// Unit, orthogonal in-plane axes of the cam frame.
-fn cam_axes(at: &Locator, path: &str, frame: &raw::Frame) -> Checked<([f64; 3], [f64; 3])> {
-    let x = unit_vector(at, &format!("{path}.x_axis"), "x_axis", frame.x_axis)?;
-    let y = unit_vector(at, &format!("{path}.y_axis"), "y_axis", frame.y_axis)?;
+/// Unit, orthogonal in-plane axes of the cam frame (constant: they fix the plane's
+/// orientation in the generated code).
+fn cam_axes(cx: &Context, path: &str, frame: &raw::Frame) -> Checked<([f64; 3], [f64; 3])> {
+    let at = cx.at;
+    let (x_field, y_field) = (format!("{path}.x_axis"), format!("{path}.y_axis"));
+    let x = cx.vector(&x_field, &frame.x_axis, None)?;
+    let y = cx.vector(&y_field, &frame.y_axis, None)?;
+    let x = unit_vector(at, &x_field, "x_axis", x)?;
+    let y = unit_vector(at, &y_field, "y_axis", y)?;
     let dot: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
     if dot.abs() > ORTHOGONALITY_TOLERANCE {
         return Err(at.error(
@@ -529,14 +939,15 @@ fn cam_axes(at: &Locator, path: &str, frame: &raw::Frame) -> Checked<([f64; 3], 
     Ok((x, y))
 }
 
-fn initial(file: &raw::Initial, bodies: &[Body], at: &Locator) -> Checked<Initial> {
+fn initial(file: &raw::Initial, bodies: &[Body], cx: &Context) -> Checked<Initial> {
+    let at = cx.at;
     let by_name: HashMap<&str, usize> = bodies
         .iter()
         .enumerate()
         .map(|(i, b)| (b.joint.coordinate.as_str(), i))
         .collect();
-    let (q, given_q) = coordinate_values(at, "initial.q", &file.q, &by_name)?;
-    let (qd, given_qd) = coordinate_values(at, "initial.qd", &file.qd, &by_name)?;
+    let (q, given_q) = coordinate_values(cx, "initial.q", &file.q, &by_name, Field::InitialQ)?;
+    let (qd, given_qd) = coordinate_values(cx, "initial.qd", &file.qd, &by_name, Field::InitialQd)?;
     let mut hold: Vec<bool> = bodies
         .iter()
         .map(|b| b.joint.prescribed.is_some())
@@ -562,11 +973,13 @@ fn initial(file: &raw::Initial, bodies: &[Body], at: &Locator) -> Checked<Initia
 /// `{"name": value}` → a value per coordinate in body order, 0 where absent, and which
 /// were given.
 fn coordinate_values(
-    at: &Locator,
+    cx: &Context,
     path: &str,
     values: &raw::NamedValues,
     index: &HashMap<&str, usize>,
+    key: fn(usize) -> Field,
 ) -> Checked<(Vec<f64>, Vec<bool>)> {
+    let at = cx.at;
     let mut out = vec![0.0; index.len()];
     let mut given = vec![false; index.len()];
     for (k, (name, value)) in values.0.iter().enumerate() {
@@ -581,11 +994,13 @@ fn coordinate_values(
             let message = format!("coordinate `{name}` is given twice");
             return Err(at.error_located(&field, &entry, message));
         }
-        out[i] = if value.is_finite() {
-            *value
-        } else {
-            let message = format!("must be finite, got {value}");
-            return Err(at.error_located(&field, &entry, message));
+        out[i] = match value {
+            raw::Number::Value(v) if !v.is_finite() => {
+                let message = format!("must be finite, got {v}");
+                return Err(at.error_located(&field, &entry, message));
+            }
+            raw::Number::Value(v) => *v,
+            expr => cx.number(&entry, expr, Some(key(i)))?,
         };
     }
     Ok((out, given))

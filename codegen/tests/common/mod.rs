@@ -68,6 +68,10 @@ pub fn paper_concave() -> Model {
         prescribed: None,
     };
     Model {
+        parameters: Vec::new(),
+        symbolic: Default::default(),
+        runtime_checks: Vec::new(),
+        parameters_at: Default::default(),
         name: "paper_concave".into(),
         description: String::new(),
         gravity: [0.0, -9.81, 0.0],
@@ -180,6 +184,10 @@ pub fn spatial_tree() -> Model {
     let s = 0.6f64;
     let c = 0.8f64;
     Model {
+        parameters: Vec::new(),
+        symbolic: Default::default(),
+        runtime_checks: Vec::new(),
+        parameters_at: Default::default(),
         name: "spatial_tree".into(),
         description: String::new(),
         gravity: [0.0, 0.0, -9.81],

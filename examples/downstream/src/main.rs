@@ -6,7 +6,7 @@ mod follower {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let model = follower::Model;
+    let model = follower::Model::default();
     let mut state = model.assemble()?;
     model.step(&mut state, 1.0)?;
     let sample = model.sample(&state)?;

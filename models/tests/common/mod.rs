@@ -3,7 +3,6 @@
 #![allow(dead_code)]
 
 use camchain::runtime::Dynamics;
-use camchain_reference::NumericModel;
 use std::cell::Cell;
 
 /// A tiny deterministic generator (xorshift64) so random states are reproducible.
@@ -64,7 +63,7 @@ fn assert_close_recorded(a: &[f64], b: &[f64], tol: f64, what: &str, worst: &Cel
 pub fn compare_dynamics(
     name: &str,
     generated: &dyn Dynamics,
-    numeric: &NumericModel,
+    numeric: &dyn Dynamics,
     tol: f64,
 ) -> f64 {
     let worst = Cell::new(0.0);

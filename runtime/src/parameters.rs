@@ -1,0 +1,352 @@
+//! Run-time parameters of a model: their declarations, the errors a bad value gets, and the
+//! checks both the build and the running program make.
+//!
+//! A model file may declare parameters (`parameters: [(name: "k", value: 40.0, unit: "N/m",
+//! min: 0.0)]`) and use them in any numeric field and expression. Parameters marked
+//! `constant: true` are folded into the generated code as plain numbers; the others are read
+//! at run time, so that a program (or `camchain sweep`) can change them without rebuilding.
+//! A value given at run time is checked exactly as the build checks the file's default:
+//! against the declared bounds, and every field it changes against that field's rules (a
+//! mass stays positive, an inertia tensor physical). The messages come from [`checks`],
+//! which the build's validator uses too, so a bad value gets the same located error
+//! (`file:line:column: field: message`) whichever way it arrives.
+
+use std::fmt;
+
+/// The declaration of one run-time parameter (from the model file's `parameters:` list).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterInfo {
+    /// Name, as used in the model's expressions (`k`, `omega`, `m1`).
+    pub name: String,
+    /// Unit, free text from the file (`N/m`); may be empty.
+    pub unit: String,
+    /// The file's value.
+    pub default: f64,
+    /// Smallest accepted value (inclusive), if declared.
+    pub min: Option<f64>,
+    /// Largest accepted value (inclusive), if declared.
+    pub max: Option<f64>,
+    /// Free text from the file.
+    pub description: String,
+}
+
+/// A parameter value refused at run time, located in the model file like a build error:
+/// displayed as `file:line:column: field: message`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub struct ParameterError {
+    /// The model file, as the build showed it.
+    pub file: String,
+    /// 1-based line of the field (0 when unknown).
+    pub line: usize,
+    /// 1-based column of the field (0 when unknown).
+    pub column: usize,
+    /// Dotted path of the field at fault (`bodies[0].mass`, `parameters[2].max`).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ParameterError {
+    /// The format of the build's errors (`camchain_codegen::ModelError`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if self.line > 0 {
+            write!(f, ":{}:{}", self.line, self.column)?;
+        }
+        if !self.field.is_empty() {
+            write!(f, ": {}", self.field)?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+/// Where a field is written in the model file: what generated code passes to [`located`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Location {
+    /// The model file, as the build showed it.
+    pub file: &'static str,
+    /// 1-based line (0 when unknown).
+    pub line: usize,
+    /// 1-based column (0 when unknown).
+    pub column: usize,
+    /// Dotted path of the field.
+    pub field: &'static str,
+}
+
+impl Location {
+    /// The location of `field` at `line`:`column` of `file` (what generated code writes).
+    pub const fn at(file: &'static str, line: usize, column: usize, field: &'static str) -> Self {
+        Location {
+            file,
+            line,
+            column,
+            field,
+        }
+    }
+}
+
+/// Attaches a location to the outcome of a check.
+pub fn located<T>(at: Location, outcome: Result<T, String>) -> Result<T, ParameterError> {
+    outcome.map_err(|message| ParameterError {
+        file: at.file.to_string(),
+        line: at.line,
+        column: at.column,
+        field: at.field.to_string(),
+        message,
+    })
+}
+
+/// A run-time parameter's value against its declared range, located at the parameter's
+/// `value`, `min` or `max` (`at`, in that order): what generated code calls first when it is
+/// given parameters. The message names the value as `name = value`, as the build does for a
+/// value given on the command line.
+pub fn check_bounds(
+    name: &str,
+    value: f64,
+    range: (Option<f64>, Option<f64>),
+    at: [Location; 3],
+) -> Result<(), ParameterError> {
+    let what = format!("{name} = {value}");
+    checks::within_bounds(name, value, range, &what)
+        .map(|_| ())
+        .map_err(|(side, message)| {
+            let at = match side {
+                Bound::Value => at[0],
+                Bound::Min => at[1],
+                Bound::Max => at[2],
+            };
+            ParameterError {
+                file: at.file.to_string(),
+                line: at.line,
+                column: at.column,
+                field: at.field.to_string(),
+                message,
+            }
+        })
+}
+
+/// Which side of a parameter's declared range a value fell out of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bound {
+    /// Below `min`.
+    Min,
+    /// Above `max`.
+    Max,
+    /// Not a finite number (reported at the parameter's `value`).
+    Value,
+}
+
+/// The checks a field's value must pass, with the messages of the build's validator.
+///
+/// Each returns the value or the message (without location); `what` names the quantity in
+/// the message (`mass`, `stiffness`).
+pub mod checks {
+    use super::Bound;
+
+    /// Largest relative violation of the triangle inequality of principal moments that is
+    /// taken as round-off (a thin rod or a lamina sits exactly on the boundary).
+    pub const TRIANGLE_SLACK: f64 = 1e-9;
+
+    /// A finite number.
+    pub fn finite(value: f64) -> Result<f64, String> {
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(format!("must be finite, got {value}"))
+        }
+    }
+
+    /// A finite number > 0.
+    pub fn positive(what: &str, value: f64) -> Result<f64, String> {
+        if value.is_finite() && value > 0.0 {
+            Ok(value)
+        } else {
+            Err(format!("{what} must be positive and finite, got {value}"))
+        }
+    }
+
+    /// A finite number ≥ 0.
+    pub fn non_negative(what: &str, value: f64) -> Result<f64, String> {
+        if value.is_finite() && value >= 0.0 {
+            Ok(value)
+        } else {
+            Err(format!(
+                "{what} must be non-negative and finite, got {value}"
+            ))
+        }
+    }
+
+    /// A parameter's value against its declared range; `what` names the value (`its value`
+    /// for the file's default, `k = -1` for a value given at run time). On failure, the side
+    /// at fault and the message.
+    pub fn within_bounds(
+        name: &str,
+        value: f64,
+        (min, max): (Option<f64>, Option<f64>),
+        what: &str,
+    ) -> Result<f64, (Bound, String)> {
+        if !value.is_finite() {
+            return Err((Bound::Value, format!("{what} is not a finite number")));
+        }
+        if let Some(low) = min.filter(|&low| value < low) {
+            let message = format!("{what} is below the minimum {low} declared for `{name}`");
+            return Err((Bound::Min, message));
+        }
+        if let Some(high) = max.filter(|&high| value > high) {
+            let message = format!("{what} is above the maximum {high} declared for `{name}`");
+            return Err((Bound::Max, message));
+        }
+        Ok(value)
+    }
+
+    /// An inertia tensor about the centre of mass (row-major, symmetric): positive definite,
+    /// principal moments obeying the triangle inequality.
+    pub fn inertia(tensor: &[[f64; 3]; 3]) -> Result<(), String> {
+        let matrix = nalgebra::Matrix3::from_fn(|r, c| tensor[r][c]);
+        let mut moments: Vec<f64> = nalgebra::SymmetricEigen::new(matrix)
+            .eigenvalues
+            .iter()
+            .copied()
+            .collect();
+        moments.sort_by(f64::total_cmp);
+        let [small, middle, large] = [moments[0], moments[1], moments[2]];
+        let listed = format!("{small}, {middle}, {large}");
+        if small.is_nan() || small <= 0.0 {
+            return Err(format!(
+                "the inertia tensor must be positive definite; its principal moments are {listed}"
+            ));
+        }
+        if large > (small + middle) + TRIANGLE_SLACK * (small + middle + large) {
+            return Err(format!(
+                "the principal moments {listed} violate the triangle inequality (the largest \
+                 may not exceed the sum of the other two): no rigid body has this inertia"
+            ));
+        }
+        Ok(())
+    }
+
+    /// "unknown parameter `name`; known: a, b" (the names sorted), or a note that the model
+    /// has none.
+    pub fn unknown_parameter(name: &str, known: &[&str]) -> String {
+        if known.is_empty() {
+            return format!("unknown parameter `{name}`: this model declares no parameter");
+        }
+        let mut sorted = known.to_vec();
+        sorted.sort_unstable();
+        format!("unknown parameter `{name}`; known: {}", sorted.join(", "))
+    }
+
+    /// The message for a value given to a parameter folded at build time.
+    pub fn constant_parameter(name: &str) -> String {
+        format!(
+            "parameter `{name}` is constant (folded into the generated code): remove \
+             `constant: true` to give it another value"
+        )
+    }
+}
+
+/// Resolves `(name, value)` pairs against a model's run-time parameters: the values in
+/// declaration order, defaults where not given. Unknown names and non-finite values are
+/// refused here (`file`, `line`, `column` locate the `parameters` list); the model checks
+/// the bounds and the fields when it is built from the values.
+pub fn resolve(
+    declared: &[ParameterInfo],
+    given: &[(&str, f64)],
+) -> Result<Vec<f64>, UnknownParameter> {
+    let mut values: Vec<f64> = declared.iter().map(|p| p.default).collect();
+    for &(name, value) in given {
+        let Some(i) = declared.iter().position(|p| p.name == name) else {
+            let known: Vec<&str> = declared.iter().map(|p| p.name.as_str()).collect();
+            return Err(UnknownParameter {
+                name: name.to_string(),
+                message: checks::unknown_parameter(name, &known),
+            });
+        };
+        values[i] = value;
+    }
+    Ok(values)
+}
+
+/// A name that is not one of the model's run-time parameters.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{message}")]
+pub struct UnknownParameter {
+    /// The name given.
+    pub name: String,
+    /// The explanation, listing the known names.
+    pub message: String,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::checks::*;
+    use super::*;
+
+    #[test]
+    fn checks_accept_good_values_and_explain_bad_ones() {
+        assert_eq!(positive("mass", 2.0), Ok(2.0));
+        assert_eq!(
+            positive("mass", -1.0),
+            Err("mass must be positive and finite, got -1".to_string())
+        );
+        assert!(positive("mass", f64::NAN).is_err());
+        assert_eq!(non_negative("stiffness", 0.0), Ok(0.0));
+        assert!(non_negative("stiffness", -0.5).is_err());
+        assert!(finite(f64::INFINITY).is_err());
+        let lamina = [[0.05, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.0, 0.1]];
+        assert_eq!(inertia(&lamina), Ok(()));
+        let impossible = [[0.01, 0.0, 0.0], [0.0, 0.01, 0.0], [0.0, 0.0, 0.1]];
+        assert!(inertia(&impossible).unwrap_err().contains("triangle"));
+        let negative = [[-0.01, 0.0, 0.0], [0.0, 0.01, 0.0], [0.0, 0.0, 0.01]];
+        assert!(
+            inertia(&negative)
+                .unwrap_err()
+                .contains("positive definite")
+        );
+    }
+
+    #[test]
+    fn bounds_name_the_side_at_fault() {
+        let range = (Some(0.0), Some(10.0));
+        assert_eq!(within_bounds("k", 5.0, range, "k = 5"), Ok(5.0));
+        assert_eq!(
+            within_bounds("k", -1.0, range, "k = -1").unwrap_err().0,
+            Bound::Min
+        );
+        assert_eq!(
+            within_bounds("k", 11.0, range, "k = 11").unwrap_err().0,
+            Bound::Max
+        );
+        assert_eq!(
+            within_bounds("k", f64::NAN, range, "k = NaN")
+                .unwrap_err()
+                .0,
+            Bound::Value
+        );
+    }
+
+    #[test]
+    fn resolve_fills_defaults_and_refuses_unknown_names() {
+        let declared = vec![
+            ParameterInfo {
+                name: "k".into(),
+                unit: "N/m".into(),
+                default: 40.0,
+                min: Some(0.0),
+                max: None,
+                description: String::new(),
+            },
+            ParameterInfo {
+                name: "omega".into(),
+                unit: "rad/s".into(),
+                default: 5.0,
+                min: None,
+                max: None,
+                description: String::new(),
+            },
+        ];
+        assert_eq!(resolve(&declared, &[("omega", 7.0)]), Ok(vec![40.0, 7.0]));
+        let e = resolve(&declared, &[("omegaa", 7.0)]).unwrap_err();
+        assert_eq!(e.message, "unknown parameter `omegaa`; known: k, omega");
+    }
+}
