@@ -163,7 +163,12 @@ pub fn generate_with(
     }
     for (spec, given) in &fused_specs {
         let given = [given.clone(), derived("self.")].concat();
-        let (text, count) = emit_function_given(&d, spec, "", true, &given);
+        let memo: &[TrigMemo] = if spec.name == "position_terms" {
+            &fused.memo
+        } else {
+            &[]
+        };
+        let (text, count) = emit_function_full(&d, spec, "", true, &given, memo);
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
@@ -171,7 +176,7 @@ pub fn generate_with(
         functions,
         "/// Entries of the cache `position_terms` fills for `velocity_terms`.\n\
          fn cache_len(&self) -> usize {{ {} }}",
-        fused.cached.len()
+        fused.cache_len()
     );
     let helpers =
         contact_kinematics_helpers(model, &d, &mut op_counts, runtime.is_some(), &derived(""));
@@ -886,14 +891,66 @@ fn multiset_sum(p: &[u32], r: &[u32]) -> Vec<u32> {
     all
 }
 
+/// The sine–cosine pairs of joint angles (a coordinate or a sum of them) among the
+/// `reachable` nodes, each given three cache entries in creation order.
+fn trig_pairs(g: &Graph, reachable: &[bool], params: &[Id]) -> Vec<TrigMemo> {
+    let mut sines: HashMap<Id, Id> = HashMap::new();
+    let mut cosines: HashMap<Id, Id> = HashMap::new();
+    for (i, &needed) in reachable.iter().enumerate() {
+        let id = id_at(g, i);
+        let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+            continue;
+        };
+        let mut vars = Vec::new();
+        if !needed || !angle_vars(g, arg, &mut vars) {
+            continue;
+        }
+        if vars.iter().any(|&k| params.contains(&g.var_id(k))) {
+            continue;
+        }
+        if f == Func::Sin {
+            sines.insert(arg, id);
+        } else {
+            cosines.insert(arg, id);
+        }
+    }
+    let mut pairs: Vec<(Id, Id)> = sines
+        .iter()
+        .filter_map(|(arg, &sin)| cosines.get(arg).map(|&cos| (sin, cos)))
+        .collect();
+    pairs.sort_unstable();
+    pairs
+        .into_iter()
+        .enumerate()
+        .map(|(k, (sin, cos))| TrigMemo {
+            sin,
+            cos,
+            slot: 3 * k,
+        })
+        .collect()
+}
+
 /// The two functions a right-hand side calls, position level (h, J) then velocity level
 /// (M, F, Q, c), and the q-only values the first hands to the second through `cache`.
 struct FusedTerms {
     /// Nodes both levels need whose computation is worth a store and a load: elementary
     /// functions (sines, cosines, profile terms), powers and divisions.
     cached: Vec<Id>,
+    /// The sine–cosine pairs of joint angles the position level computes, each with three
+    /// cache entries (angle, sine, cosine) at the start of the cache: the position level
+    /// reuses them when it is evaluated again at the same angles (Newton moving a sliding
+    /// coordinate, the step's end evaluated again), and the velocity level reads them.
+    memo: Vec<TrigMemo>,
     position: Vec<(String, Id)>,
     velocity: Vec<(String, Id)>,
+}
+
+/// A sine and a cosine of one angle, kept in the cache entries `slot..slot + 3`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct TrigMemo {
+    sin: Id,
+    cos: Id,
+    slot: usize,
 }
 
 impl FusedTerms {
@@ -934,23 +991,41 @@ impl FusedTerms {
             .map(|i| id_at(g, i))
             .filter(|&id| matches!(g.node(id), Node::Call(..) | Node::Powf(..) | Node::Div(..)))
             .collect();
+        let memo = trig_pairs(g, &in_position, &d.symbols.params);
         FusedTerms {
             cached,
+            memo,
             position,
             velocity,
         }
     }
 
+    /// The cached nodes that are not in a memo triple, with their cache index.
+    fn plain_cached(&self) -> Vec<(usize, Id)> {
+        let in_memo = |id: Id| self.memo.iter().any(|m| m.sin == id || m.cos == id);
+        self.cached
+            .iter()
+            .filter(|&&id| !in_memo(id))
+            .enumerate()
+            .map(|(k, &id)| (3 * self.memo.len() + k, id))
+            .collect()
+    }
+
+    /// Entries of the cache.
+    fn cache_len(&self) -> usize {
+        3 * self.memo.len() + self.plain_cached().len()
+    }
+
     /// The two function specifications, each with the nodes it reads from the cache.
     fn specs(&self, d: &Derivation) -> Vec<(FunctionSpec, Vec<(Id, String)>)> {
-        let uses_cache = !self.cached.is_empty();
+        let uses_cache = self.cache_len() > 0;
         let cache_param = |ty| Param {
             name: "cache",
             ty,
             always_used: uses_cache,
         };
         let mut position_outputs = self.position.clone();
-        for (k, &id) in self.cached.iter().enumerate() {
+        for (k, id) in self.plain_cached() {
             position_outputs.push((format!("cache[{k}]"), id));
         }
         let position = FunctionSpec {
@@ -989,12 +1064,15 @@ impl FusedTerms {
             outputs: self.velocity.clone(),
             tail: String::new(),
         };
-        let given: Vec<(Id, String)> = self
-            .cached
-            .iter()
-            .enumerate()
-            .map(|(k, &id)| (id, format!("cache[{k}]")))
+        let mut given: Vec<(Id, String)> = self
+            .plain_cached()
+            .into_iter()
+            .map(|(k, id)| (id, format!("cache[{k}]")))
             .collect();
+        for m in &self.memo {
+            given.push((m.sin, format!("cache[{}]", m.slot + 1)));
+            given.push((m.cos, format!("cache[{}]", m.slot + 2)));
+        }
         let _ = d;
         vec![(position, Vec::new()), (velocity, given)]
     }
@@ -1044,7 +1122,7 @@ fn fused_count(d: &Derivation, spec: &FunctionSpec, given: &[(Id, String)]) -> u
 /// The body of `name` as a call of the fused pair, with stack scratch for the outputs it
 /// does not return; `None` for the functions that keep their own expressions.
 fn wrapper(model: &Model, fused: &FusedTerms, name: &str) -> Option<String> {
-    let (n, nc, cl) = (model.n(), model.contacts.len(), fused.cached.len());
+    let (n, nc, cl) = (model.n(), model.contacts.len(), fused.cache_len());
     let position = |h: &str, j: &str| {
         format!(
             "let mut cache = [0.0; {cl}];
@@ -1320,11 +1398,28 @@ fn emit_function_given(
     method: bool,
     given: &[(Id, String)],
 ) -> (String, OpCount) {
+    emit_function_full(d, spec, prelude, method, given, &[])
+}
+
+/// [`emit_function_given`], the sine–cosine pairs of `memo` computed through the cache
+/// (`rt::sin_cos_memo`).
+fn emit_function_full(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    prelude: &str,
+    method: bool,
+    given: &[(Id, String)],
+    memo: &[TrigMemo],
+) -> (String, OpCount) {
     let g = &d.graph;
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
     let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
     let count = g.op_count_until(&roots, &given_set);
     let mut body = Emitter::new(g, &spec.outputs, given, &d.symbols.params);
+    for m in memo {
+        body.memo.insert(m.sin, *m);
+        body.memo.insert(m.cos, *m);
+    }
     let (bindings, used_vars) = body.bindings();
     let inputs = input_bindings(d, &used_vars);
     let mut used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
@@ -1585,6 +1680,8 @@ struct Emitter<'g> {
     vars: Names,
     /// The variables of the run-time parameters.
     parameters: HashSet<Id>,
+    /// Sines and cosines computed together through the cache (by either node of a pair).
+    memo: HashMap<Id, TrigMemo>,
 }
 
 impl<'g> Emitter<'g> {
@@ -1626,6 +1723,7 @@ impl<'g> Emitter<'g> {
             names: HashMap::new(),
             vars: Names::of_vars(g),
             parameters: params.iter().copied().collect(),
+            memo: HashMap::new(),
         }
     }
 
@@ -1682,7 +1780,7 @@ impl<'g> Emitter<'g> {
             if matches!(self.g.node(id), Node::Var(_)) && !self.given.contains_key(&id) {
                 used_vars.insert(id);
             }
-            if !self.wants_binding(id) {
+            if !self.wants_binding(id) || self.names.contains_key(&id) {
                 continue;
             }
             let this_section = self.g.section_of(id).map(str::to_string);
@@ -1692,6 +1790,11 @@ impl<'g> Emitter<'g> {
                     let _ = writeln!(text, "{SECTION_MACRO}!(\"{clean}\");");
                 }
                 section = this_section;
+            }
+            if let Some(m) = self.memo.get(&id).copied() {
+                let line = self.memo_binding(m, &mut taken);
+                text.push_str(&line);
+                continue;
             }
             let expr = match self.given.get(&id) {
                 Some(source) => source.clone(),
@@ -1768,6 +1871,25 @@ impl<'g> Emitter<'g> {
             }
             k += 1;
         }
+    }
+
+    /// `let (s_a, c_a) = rt::sin_cos_memo(a, &mut cache[k..k + 3]);`, naming both nodes.
+    fn memo_binding(&mut self, m: TrigMemo, taken: &mut HashSet<String>) -> String {
+        let angle = match self.g.node(m.sin) {
+            Node::Call(_, angle) => angle,
+            _ => m.sin,
+        };
+        let sin = self.fresh_name(m.sin, taken);
+        let cos = self.fresh_name(m.cos, taken);
+        let line = format!(
+            "let ({sin}, {cos}) = rt::sin_cos_memo({}, &mut cache[{}..{}]);\n",
+            self.print(angle, 0),
+            m.slot,
+            m.slot + 3
+        );
+        self.names.insert(m.sin, sin);
+        self.names.insert(m.cos, cos);
+        line
     }
 
     /// The field a given node is read from (`k2` for `self.derived.k2`), as its name.

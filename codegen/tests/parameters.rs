@@ -4,9 +4,10 @@
 //! written in place. `plain_models/` holds those files as they were before the models
 //! declared parameters (the repository's model files of that commit, unchanged).
 //!
-//! The paper model's folded code is moreover byte-identical in every generated function to
-//! the golden copy of that time (`build/tests/golden/paper_concave_folded.rs`, checked by
-//! `build/tests/golden.rs`).
+//! The paper model's folded code is moreover under review as a golden copy
+//! (`build/tests/golden/paper_concave_folded.rs`, checked by `build/tests/golden.rs`); when
+//! parameters came in, every one of its generated functions was byte-identical to the
+//! golden copy of the model with its numbers written in place.
 
 use camchain_codegen::schema::{parse_model, parse_model_with};
 use camchain_codegen::{Generated, ParameterMode, emit};

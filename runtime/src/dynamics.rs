@@ -277,7 +277,10 @@ pub trait Dynamics {
     /// J (5b) at q, for Newton (15) and the velocity relation (16). Generated models also
     /// write into `cache` the q-only quantities (sines, cosines, profile values) that
     /// [`Dynamics::velocity_terms`] reuses at the same q, so that no sine is computed twice
-    /// per right-hand side.
+    /// per right-hand side, and read back the sines and cosines of joint angles that have
+    /// not changed since the last call with this cache ([`sin_cos_memo`]): Newton moving a
+    /// sliding coordinate evaluates again without trigonometry. Give each state its own
+    /// cache (the runtime's workspace does).
     fn position_terms(&self, q: &[f64], h: &mut [f64], j: &mut [f64], cache: &mut [f64]) {
         let _ = cache;
         self.constraint(q, h);
@@ -304,4 +307,25 @@ pub struct VelocityTerms<'a> {
     pub applied: &'a mut [f64],
     /// c(q, q̇), eqs. (7, 8).
     pub bias: &'a mut [f64],
+}
+
+/// sin and cos of `angle`, reusing `slot` = [angle, sin, cos] when it holds this very angle
+/// (bit for bit) from an earlier call, and storing them there otherwise.
+///
+/// Generated `position_terms` computes the sines and cosines of the joint angles so: Newton
+/// (15) evaluating again after moving a sliding coordinate, or a step's end evaluated once
+/// more, then costs no trigonometry. A slot not written by this function (zeros, NaN) is
+/// never taken for a stored result: its sine and cosine would not have a unit norm.
+#[inline]
+pub fn sin_cos_memo(angle: f64, slot: &mut [f64]) -> (f64, f64) {
+    if let [stored, sin, cos] = slot {
+        if stored.to_bits() == angle.to_bits() && (*sin * *sin + *cos * *cos - 1.0).abs() < 1e-12 {
+            return (*sin, *cos);
+        }
+        let (s, c) = angle.sin_cos();
+        (*stored, *sin, *cos) = (angle, s, c);
+        (s, c)
+    } else {
+        angle.sin_cos()
+    }
 }

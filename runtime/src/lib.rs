@@ -14,6 +14,8 @@
 //!   output.
 //! - [`settings`]: the ranges of the settings a run accepts, checked before it starts.
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
+//! - [`metrics`]: runs that keep a summary (extreme forces, lift-off, drift) instead of a
+//!   trajectory, for parameter sweeps.
 //! - [`unilateral`]: one-sided contact: lift-off, flight, impact with restitution.
 //! - [`events`]: contact events (force sign changes, lift-off, impact) and their location.
 //! - [`error`]: simulation errors with time and state.
@@ -23,6 +25,7 @@ pub mod dynamics;
 pub mod error;
 pub mod events;
 pub mod integrators;
+pub mod metrics;
 pub mod parameters;
 pub mod partition;
 pub mod settings;
@@ -31,6 +34,7 @@ pub mod unilateral;
 
 pub use dynamics::*;
 pub use error::SimError;
+pub use metrics::{MetricsFailure, MetricsOptions, RunMetrics};
 pub use parameters::{ParameterError, ParameterInfo};
 pub use settings::InvalidSetting;
 pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};

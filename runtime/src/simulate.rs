@@ -14,8 +14,10 @@ use crate::dynamics::{ContactGeometry, Dynamics, Energy, IntegratorKind, SimSett
 use crate::error::SimError;
 use crate::events::{ContactEvent, EVENT_TIME_TOLERANCE, EventKind, changes_sign, locate_root};
 use crate::integrators::{Adaptive, Counters, Dop853, Dopri5, Rk4, Tolerances};
+use crate::metrics::{MetricsFailure, MetricsOptions, RunMetrics};
 use crate::partition::{
-    Partition, REPARTITION_RATIO, Workspace, choose_dependent, conditioning, normal_force,
+    NEWTON_SLACK_PER_RTOL, Partition, REPARTITION_RATIO, Workspace, choose_dependent, conditioning,
+    normal_force,
 };
 
 /// A step ending within this fraction of a step before an output time is stretched to land
@@ -42,23 +44,26 @@ pub struct State {
     pub q: Vec<f64>,
     /// Generalised velocities.
     pub qd: Vec<f64>,
-    partition: Partition,
+    pub(crate) partition: Partition,
     dissipated: f64,
     driven_work: f64,
-    engine: Engine,
+    pub(crate) engine: Engine,
 }
 
 /// Integration buffers of a [`State`].
 #[derive(Debug, Clone)]
-struct Engine {
-    ws: Workspace,
+pub(crate) struct Engine {
+    pub(crate) ws: Workspace,
     /// y = (u, u̇, dissipated, driven work).
-    y: Vec<f64>,
+    pub(crate) y: Vec<f64>,
     rk4: Rk4,
     dopri: Dopri5,
     dop853: Dop853,
     /// Step proposed by the adaptive integrator's controller.
     h_next: Option<f64>,
+    /// The workspace holds the solved state at the end of the last accepted step (the
+    /// step's last right-hand side was evaluated there and nothing since).
+    pub(crate) at_step_end: bool,
     /// (t, q, q̇) as last written by a step: a difference means the user changed the state.
     synced_t: f64,
     synced_q: Vec<f64>,
@@ -75,6 +80,7 @@ impl State {
             dopri: Dopri5::new(dim, 2 * nu),
             dop853: Dop853::new(dim, 2 * nu),
             h_next: None,
+            at_step_end: false,
             synced_t: t,
             synced_q: ws.q().to_vec(),
             synced_qd: ws.qd().to_vec(),
@@ -96,6 +102,14 @@ impl State {
     /// Length of the integrated vector y = (u, u̇, dissipated, driven work, v, v̇).
     pub fn integrated_len(&self) -> usize {
         integrated_len(&self.partition)
+    }
+
+    /// Forgets the values the last right-hand side left for the next one (the sines and
+    /// cosines of the joint angles a generated model keeps in its cache, see
+    /// [`crate::sin_cos_memo`]), so that the next evaluation computes everything afresh: for
+    /// benchmarks of one right-hand side at a new state. Results are the same either way.
+    pub fn clear_evaluation_cache(&mut self) {
+        self.engine.ws.clear_cache();
     }
 
     /// Dependent coordinates v of the current partition (one per contact).
@@ -153,6 +167,7 @@ impl State {
         y[2 * nu + 1] = self.driven_work;
         store_dependent(&self.partition, y, &self.q, &self.qd);
         self.engine.ws.set_state(&self.q, &self.qd);
+        self.engine.at_step_end = false;
         self.set_newton_anchor();
         self.engine.dopri.invalidate_fsal();
         self.engine.dop853.invalidate_fsal();
@@ -320,7 +335,10 @@ pub trait Simulate: Dynamics {
         if state.modified_since_last_step() {
             state.load_integrated_state();
         }
-        let Engine { ws, y, .. } = &mut state.engine;
+        let Engine {
+            ws, y, at_step_end, ..
+        } = &mut state.engine;
+        *at_step_end = false;
         evaluate_rhs(self, &state.partition, ws, state.t, y, dy)
     }
 
@@ -359,6 +377,19 @@ pub trait Simulate: Dynamics {
         run(self, state, settings, SampleLevel::State, &mut |_| {
             Observed::Continue(())
         })
+    }
+
+    /// A run that keeps a summary instead of its trajectory (what a parameter sweep keeps):
+    /// extreme normal forces, the first lift-off, the largest constraint residual, the
+    /// energy drift and the work done, evaluated at the start and at every accepted step
+    /// (and at the output times with [`MetricsOptions::grid`]); see [`crate::metrics`].
+    fn simulate_metrics(
+        &self,
+        state: State,
+        settings: &SimSettings,
+        options: MetricsOptions,
+    ) -> Result<RunMetrics, Box<MetricsFailure>> {
+        crate::metrics::run_metrics(self, state, settings, options)
     }
 
     /// [`Simulate::simulate`] with one-sided contact: the follower lifts off where the
@@ -650,6 +681,11 @@ impl Grid {
     /// The next output time, if any is left.
     fn pending(&self, settings: &SimSettings) -> Option<f64> {
         (self.next <= self.intervals).then(|| self.time(self.next, settings))
+    }
+
+    /// [`Grid::pending`] for the other modules of the crate.
+    pub(crate) fn pending_time(&self, settings: &SimSettings) -> Option<f64> {
+        self.pending(settings)
     }
 }
 
@@ -948,11 +984,12 @@ fn output_time(t0: f64, k: usize, intervals: usize, settings: &SimSettings) -> f
     }
 }
 
-fn sample_in_place<D: Dynamics + ?Sized>(
+pub(crate) fn sample_in_place<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     level: SampleLevel,
 ) -> Result<Sample, SimError> {
+    state.engine.at_step_end = false;
     let mut ws = std::mem::replace(&mut state.engine.ws, Workspace::new(0, 0, 0));
     let sample = compute_sample(model, state, &mut ws, level);
     state.engine.ws = ws;
@@ -1100,7 +1137,7 @@ fn advance_steps<D: Dynamics + ?Sized>(
 }
 
 /// Step of the fixed step `dt`, shortened to land on `t_target`; returns the new time.
-fn rk4_step<D: Dynamics + ?Sized>(
+pub(crate) fn rk4_step<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     t_target: f64,
@@ -1108,6 +1145,9 @@ fn rk4_step<D: Dynamics + ?Sized>(
 ) -> Result<f64, SimError> {
     let remaining = t_target - state.t;
     let lands = remaining <= dt * (1.0 + LANDING_SLACK);
+    // No error control to absorb a looser Newton: the strict test.
+    state.engine.ws.set_newton_slack(0.0);
+    state.engine.at_step_end = false;
     let h = if lands { remaining } else { dt };
     let Engine {
         ws,
@@ -1127,7 +1167,7 @@ fn rk4_step<D: Dynamics + ?Sized>(
 
 /// One accepted step of the chosen adaptive integrator towards `t_target` (clipped to land
 /// on it); returns the new time and keeps the controller's proposal for the next step.
-fn adaptive_step<D: Dynamics + ?Sized>(
+pub(crate) fn adaptive_step<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     t_target: f64,
@@ -1141,6 +1181,7 @@ fn adaptive_step<D: Dynamics + ?Sized>(
         h_next,
         ..
     } = &mut state.engine;
+    ws.set_newton_slack(NEWTON_SLACK_PER_RTOL * settings.rtol);
     let parts = StepParts {
         model,
         partition: &state.partition,
@@ -1148,11 +1189,14 @@ fn adaptive_step<D: Dynamics + ?Sized>(
         y,
         h_next,
     };
-    if settings.integrator == IntegratorKind::Dop853 {
+    let t_new = if settings.integrator == IntegratorKind::Dop853 {
         parts.step(dop853, state.t, t_target, settings)
     } else {
         parts.step(dopri, state.t, t_target, settings)
-    }
+    };
+    // Both methods end an accepted step with f(t + h, y_new) (first same as last).
+    state.engine.at_step_end = t_new.is_ok();
+    t_new
 }
 
 /// What an adaptive step works on, borrowed from a [`State`].
@@ -1218,7 +1262,7 @@ pub(crate) fn validate_run<D: Dynamics + ?Sized>(
 }
 
 /// The counters of the three integrators of an engine.
-fn all_counters(engine: &Engine) -> [Counters; 3] {
+pub(crate) fn all_counters(engine: &Engine) -> [Counters; 3] {
     [
         engine.rk4.counters,
         engine.dopri.counters,
@@ -1227,7 +1271,7 @@ fn all_counters(engine: &Engine) -> [Counters; 3] {
 }
 
 /// Adds to `stats` the work the engine's integrators did since `before`.
-fn add_counters_since(stats: &mut Stats, engine: &Engine, before: [Counters; 3]) {
+pub(crate) fn add_counters_since(stats: &mut Stats, engine: &Engine, before: [Counters; 3]) {
     for (after, before) in all_counters(engine).into_iter().zip(before) {
         stats.add_counters(after, before);
     }
@@ -1235,7 +1279,7 @@ fn add_counters_since(stats: &mut Stats, engine: &Engine, before: [Counters; 3])
 
 /// Interpolates y at `t` inside the state's last accepted adaptive step (preparing the
 /// interpolant first: DOP853 spends three right-hand sides on it, once per step).
-fn interpolate_last_step<D: Dynamics + ?Sized>(
+pub(crate) fn interpolate_last_step<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     settings: &SimSettings,
@@ -1243,8 +1287,13 @@ fn interpolate_last_step<D: Dynamics + ?Sized>(
     out: &mut [f64],
 ) -> Result<(), SimError> {
     let Engine {
-        ws, dopri, dop853, ..
+        ws,
+        dopri,
+        dop853,
+        at_step_end,
+        ..
     } = &mut state.engine;
+    *at_step_end = false;
     let partition = &state.partition;
     let mut rhs = |t: f64, y: &[f64], dy: &mut [f64]| evaluate_rhs(model, partition, ws, t, y, dy);
     if settings.integrator == IntegratorKind::Dop853 {
@@ -1307,7 +1356,7 @@ fn evaluate_rhs<D: Dynamics + ?Sized>(
 
 /// Full q, q̇ at (t, y): prescribed motion, u and u̇ from y, v by Newton (15) and v̇ by
 /// (16). Leaves J(q) evaluated and J_v factored in the workspace.
-fn load_state<D: Dynamics + ?Sized>(
+pub(crate) fn load_state<D: Dynamics + ?Sized>(
     model: &D,
     partition: &Partition,
     ws: &mut Workspace,
@@ -1356,14 +1405,18 @@ fn solve_positions_with_restart<D: Dynamics + ?Sized>(
 /// After an accepted step: writes t, q, q̇ and the quadratures back to the state, then
 /// re-chooses the dependent coordinates if the partition's conditioning fell below
 /// [`REPARTITION_RATIO`]. Returns true on a re-partition.
-fn finish_step<D: Dynamics + ?Sized>(
+pub(crate) fn finish_step<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     t_new: f64,
 ) -> Result<bool, SimError> {
     let nu = state.partition.independent().len();
-    let Engine { ws, y, .. } = &mut state.engine;
-    load_state(model, &state.partition, ws, t_new, y)?;
+    let Engine {
+        ws, y, at_step_end, ..
+    } = &mut state.engine;
+    if !std::mem::replace(at_step_end, false) {
+        load_state(model, &state.partition, ws, t_new, y)?;
+    }
     state.t = t_new;
     state.q.copy_from_slice(ws.q());
     state.qd.copy_from_slice(ws.qd());

@@ -1155,18 +1155,18 @@ impl rt::Dynamics for Model {
         let q3 = q[2];
         let q4 = q[3];
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = q1.cos();
-        let s_q1 = q1.sin();
+        let (s_q1, c_q1) = rt::sin_cos_memo(q1, &mut cache[0..3]);
         // body2: joint q2, rotation, velocities and accelerations
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::sin_cos_memo(angle_q1_q2, &mut cache[3..6]);
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
-        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let (s_q4_q1_q2, c_q4_q1_q2) = rt::sin_cos_memo(
+            angle_q4_q1_q2,
+            &mut cache[6..9],
+        );
         // contact A: position on the cam, J1, J2, convective terms, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
@@ -1185,12 +1185,6 @@ impl rt::Dynamics for Model {
         j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
         j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
-        cache[0] = c_q1;
-        cache[1] = s_q1;
-        cache[2] = c_q1_q2;
-        cache[3] = s_q1_q2;
-        cache[4] = c_q4_q1_q2;
-        cache[5] = s_q4_q1_q2;
     }
     /// M, F, Q (13) and c (8) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
@@ -1216,14 +1210,14 @@ impl rt::Dynamics for Model {
         let c3 = self.derived.c3;
         let c4 = self.derived.c4;
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = cache[0];
+        let c_q1 = cache[2];
         let s_q1 = cache[1];
         let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
         let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
         let omega_body2_z = q1_dot + q2_dot;
-        let c_q1_q2 = cache[2];
-        let s_q1_q2 = cache[3];
+        let c_q1_q2 = cache[5];
+        let s_q1_q2 = cache[4];
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         let omega_body2_sq = omega_body2_z * omega_body2_z;
@@ -1240,8 +1234,8 @@ impl rt::Dynamics for Model {
         // body4: joint q4, rotation, velocities and accelerations
         let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
         let omega_body4_z = q4_dot + omega_body2_z;
-        let c_q4_q1_q2 = cache[4];
-        let s_q4_q1_q2 = cache[5];
+        let c_q4_q1_q2 = cache[8];
+        let s_q4_q1_q2 = cache[7];
         let omega_body4_sq = omega_body4_z * omega_body4_z;
         let rel_rot_body4_11 = c_q1_q2 * c_q4_q1_q2 + s_q1_q2 * s_q4_q1_q2;
         let neg_rel_rot_body4_12 = c_q1_q2 * s_q4_q1_q2 - s_q1_q2 * c_q4_q1_q2;
@@ -1359,7 +1353,7 @@ impl rt::Dynamics for Model {
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
     fn cache_len(&self) -> usize {
-        6
+        9
     }
     /// f1, f2, J1, J2 and the convective terms of contact `k` into `out` (unchanged for an unknown k).
     fn contact_kinematics_into(
