@@ -86,6 +86,40 @@ pub enum Command {
                       cargo run --release -- stress --quick --out /tmp/STRESS.md"
     )]
     Stress(StressArgs),
+    /// Run a model over a grid or a Latin hypercube of its run-time parameters, in parallel;
+    /// one CSV row of metrics per run, figures of each metric against the parameters.
+    #[command(
+        long_about = "Run a model over a grid or a Latin hypercube of its run-time parameters \
+                      (those `camchain list` shows), in parallel over every core; each run's \
+                      metrics are one CSV row, streamed as the runs finish (nothing else of a \
+                      run is kept), and each metric is drawn against the swept parameters (a \
+                      heat map for two).\n\n\
+                      VALUES: a:b:n (n values from a to b), a:b:n:log (in log scale), a,b,c (a \
+                      list), a (one value), or a:b with --samples (an interval of the Latin \
+                      hypercube).\n\n\
+                      Every value is checked against the parameter's declared bounds, every \
+                      option and the output before any run starts. A run that fails (Newton, \
+                      step size, a value the model's own checks refuse) is a row with its \
+                      error; the sweep goes on. --shard I/N runs every N-th run from the I-th \
+                      (for a batch array on a cluster); `camchain merge` joins the shards.\n\n\
+                      Exit codes: 0 every run completed; 3 + (failed runs - 1), at most 127, \
+                      when runs failed; 1 a file could not be written; 2 a usage error; 130 \
+                      interrupted by Ctrl-C (the rows so far stay in <name>.partial.csv).",
+        after_help = "Examples:\n  \
+                      camchain sweep paper_concave --param swing=-0.5:0.5:21 --param k3=20,40,80\n  \
+                      camchain sweep driven_convex --param period=1:8:50 --metric first_lift_off\n  \
+                      camchain sweep paper_concave --param k2=5:30 --param k4=5:30 --samples 2000 --seed 3\n  \
+                      camchain sweep paper_concave --numeric --param m4=0.5:2:16   # a folded parameter\n  \
+                      camchain sweep my_cam.ron --param k=10:100:10 --shard 3/8 --csv part-3.csv"
+    )]
+    Sweep(SweepArgs),
+    /// Join the CSVs of the shards of one sweep (`camchain sweep --shard I/N`), checking
+    /// that none is missing, repeated or from another sweep; write the whole CSV and its
+    /// figures.
+    #[command(after_help = "Examples:\n  \
+                      camchain merge shards/*.csv --out results\n  \
+                      camchain merge part-*.csv --csv sweep.csv --no-plots")]
+    Merge(MergeArgs),
 }
 
 /// Options of `bench`.
@@ -137,6 +171,144 @@ pub struct StressArgs {
     pub figures: Option<PathBuf>,
 }
 
+/// Options of `sweep`.
+#[derive(Debug, Clone, Default, Args)]
+#[command(allow_negative_numbers = true)]
+pub struct SweepArgs {
+    /// A built-in model's name or a path to a .ron model file (which runs on the numeric
+    /// reference)
+    #[arg(value_name = "MODEL")]
+    pub model: String,
+
+    /// A parameter and its values, NAME=VALUES (repeat for several; see above)
+    #[arg(
+        long = "param",
+        value_name = "NAME=VALUES",
+        required = true,
+        allow_hyphen_values = true
+    )]
+    pub params: Vec<String>,
+
+    /// Draw this many runs as a Latin hypercube over the intervals a:b of the parameters
+    /// [default: every combination of the values]
+    #[arg(long, value_name = "N")]
+    pub samples: Option<usize>,
+
+    /// Seed of the Latin hypercube (the same seed gives the same runs)
+    #[arg(long, value_name = "SEED", default_value_t = 1, requires = "samples")]
+    pub seed: u64,
+
+    /// Metrics drawn in the figures, comma-separated [default:
+    /// max_normal_force,min_normal_force,first_lift_off,energy_drift]
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub metric: Vec<String>,
+
+    /// Runs at a time [default: the number of cores]
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+
+    /// Run only the I-th of N disjoint slices of the sweep (every N-th run from the I-th)
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+
+    /// Run a built-in model on the numeric reference: every parameter can then be swept,
+    /// also those its generated code folds
+    #[arg(long)]
+    pub numeric: bool,
+
+    /// Also evaluate the metrics at every output time t0 + k·dt_out (extremes as in a full
+    /// run's CSV; about twice the work) [default: at the integrator's steps]
+    #[arg(long)]
+    pub grid: bool,
+
+    /// End time in seconds [default: the model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub t_end: Option<f64>,
+
+    /// Output interval in seconds, for --grid [default: the model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub dt_out: Option<f64>,
+
+    /// Integrator [default: the model's]
+    #[arg(long, value_enum, value_name = "NAME", ignore_case = true)]
+    pub integrator: Option<IntegratorArg>,
+
+    /// Step in seconds: fixed step of rk4, first step of dopri5 and dop853 [default: the
+    /// model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
+
+    /// Relative tolerance of dopri5 and dop853 [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = relative_tolerance, allow_hyphen_values = true)]
+    pub rtol: Option<f64>,
+
+    /// Absolute tolerance of dopri5 and dop853 [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = absolute_tolerance, allow_hyphen_values = true)]
+    pub atol: Option<f64>,
+
+    /// Write the CSV to FILE (`-`: standard output); nothing else is written unless --out
+    /// is given too [default: DIR/<model>_sweep/<model>_sweep.csv]
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+
+    /// Directory for the CSV and figures [default: out, or none with --csv]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Write no figures
+    #[arg(long)]
+    pub no_plots: bool,
+
+    /// Print nothing but errors
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+impl SweepArgs {
+    /// The model's default settings overridden by the options that were given.
+    pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
+        SimSettings {
+            t_end: self.t_end.unwrap_or(defaults.t_end),
+            dt_out: self.dt_out.unwrap_or(defaults.dt_out),
+            integrator: self
+                .integrator
+                .map_or(defaults.integrator, IntegratorArg::kind),
+            dt: self.dt.unwrap_or(defaults.dt),
+            rtol: self.rtol.unwrap_or(defaults.rtol),
+            atol: self.atol.unwrap_or(defaults.atol),
+        }
+    }
+}
+
+/// Options of `merge`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct MergeArgs {
+    /// The shards' CSV files (every shard of one sweep, in any order)
+    #[arg(value_name = "FILE", required = true)]
+    pub files: Vec<PathBuf>,
+
+    /// Write the merged CSV to FILE (`-`: standard output); nothing else is written unless
+    /// --out is given too [default: DIR/<model>_sweep.csv]
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+
+    /// Directory for the merged CSV and figures [default: out, or none with --csv]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Metrics drawn, comma-separated [default: as in sweep]
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub metric: Vec<String>,
+
+    /// Write no figures
+    #[arg(long)]
+    pub no_plots: bool,
+
+    /// Print nothing but errors
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
 /// Options of `simulate`.
 #[derive(Debug, Clone, Default, Args)]
 #[command(allow_negative_numbers = true)]
@@ -151,6 +323,12 @@ pub struct SimulateArgs {
     /// code (to compare the two) [default: generated code]
     #[arg(long)]
     pub numeric: bool,
+
+    /// Give a run-time parameter another value than the model file's, NAME=VALUE (repeat
+    /// for several; `camchain list` shows them); checked as the build checks the file. On
+    /// the numeric path every parameter can be set, also those the generated code folds
+    #[arg(long = "param", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    pub params: Vec<String>,
 
     /// End time in seconds [default: the model's, see `camchain list`]
     #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
@@ -212,6 +390,28 @@ pub struct SimulateArgs {
 }
 
 impl SimulateArgs {
+    /// The `--param NAME=VALUE` pairs, checked: each a number, no name twice.
+    pub fn parameter_values(&self) -> Result<Vec<(String, f64)>, String> {
+        let mut out: Vec<(String, f64)> = Vec::new();
+        for text in &self.params {
+            let Some((name, value)) = text.split_once('=') else {
+                return Err(format!("--param `{text}` is not NAME=VALUE (e.g. k3=60)"));
+            };
+            let (name, value) = (name.trim(), value.trim());
+            let number: f64 = value
+                .parse()
+                .map_err(|_| format!("--param {name}: `{value}` is not a number"))?;
+            if name.is_empty() {
+                return Err(format!("--param `{text}`: the name is missing before `=`"));
+            }
+            if out.iter().any(|(n, _)| n == name) {
+                return Err(format!("--param {name} is given twice"));
+            }
+            out.push((name.to_string(), number));
+        }
+        Ok(out)
+    }
+
     /// The model's default settings overridden by the options that were given.
     pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
         SimSettings {

@@ -13,12 +13,15 @@
 //! - `ops`: the `ops` command (operation counts of the generated functions);
 //! - `stress`: the `stress` command (numerical stability stress suite, `STRESS.md`), over the
 //!   scenarios of [`scenarios`];
-//! - `bench`: the `bench` command (the measurements of `BENCHMARKS.md`).
+//! - `bench`: the `bench` command (the measurements of `BENCHMARKS.md`);
+//! - `sweep`: the `sweep` and `merge` commands (parameter studies, in parallel and in
+//!   shards).
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
 //! for a usage error (bad option or value, unknown model name), 130 for a run interrupted
-//! by Ctrl-C and 1 for anything else (a model file missing or invalid, a failed run, a file
-//! that could not be written).
+//! by Ctrl-C, 3 and up for a sweep some of whose runs failed (3 + failed − 1, at most 127),
+//! and 1 for anything else (a model file missing or invalid, a failed run, a file that could
+//! not be written).
 
 mod args;
 mod bench;
@@ -37,6 +40,7 @@ mod simulate;
 mod source;
 mod stress;
 mod summary;
+mod sweep;
 
 use args::{Cli, Command};
 use clap::Parser;
@@ -54,6 +58,9 @@ pub enum CliError {
     Reported,
     /// Interrupted by Ctrl-C, already reported (exit code 130).
     Interrupted,
+    /// This many runs of a sweep failed, reported in their rows and the summary (exit code
+    /// 3 + (failed − 1), at most 127).
+    RunsFailed(usize),
 }
 
 impl std::fmt::Display for CliError {
@@ -62,6 +69,7 @@ impl std::fmt::Display for CliError {
             CliError::Usage(message) | CliError::Failed(message) => f.write_str(message),
             CliError::Reported => f.write_str("failed (reported above)"),
             CliError::Interrupted => f.write_str("interrupted (reported above)"),
+            CliError::RunsFailed(n) => write!(f, "{n} runs failed"),
         }
     }
 }
@@ -72,8 +80,15 @@ impl CliError {
             CliError::Usage(_) => ExitCode::from(2),
             CliError::Failed(_) | CliError::Reported => ExitCode::from(1),
             CliError::Interrupted => ExitCode::from(interrupt::EXIT_CODE),
+            CliError::RunsFailed(n) => ExitCode::from(sweep_exit_code(*n)),
         }
     }
+}
+
+/// The exit code of a sweep whose `failed` runs failed: 3 for one, one more per failure, at
+/// most 127 (below 130, Ctrl-C's).
+pub fn sweep_exit_code(failed: usize) -> u8 {
+    (3 + failed.saturating_sub(1)).min(127) as u8
 }
 
 /// Parses the command line, runs the command and returns the process's exit code.
@@ -90,6 +105,8 @@ pub fn main() -> ExitCode {
             let _ = std::io::stdout().write_all(text.as_bytes());
         }),
         Some(Command::Stress(args)) => stress::run(&args),
+        Some(Command::Sweep(args)) => sweep::run(&args),
+        Some(Command::Merge(args)) => sweep::merge(&args),
         Some(Command::List) => {
             // A closed pipe (`camchain list | head`) is not an error worth a panic.
             let _ = std::io::stdout().write_all(list::render().as_bytes());
@@ -104,6 +121,7 @@ pub fn main() -> ExitCode {
                     eprintln!("error: {message}");
                 }
                 CliError::Reported | CliError::Interrupted => {}
+                CliError::RunsFailed(n) => eprintln!("error: {n} runs failed (see their rows)"),
             }
             error.exit_code()
         }

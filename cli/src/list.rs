@@ -42,11 +42,51 @@ fn describe(name: &str, info: &ModelInfo) -> String {
     let kind = if info.spatial { "spatial" } else { "planar" };
     let _ = writeln!(text, "  contacts:    {contacts} ({kind})");
     let _ = writeln!(text, "  defaults:    {}", defaults(&info.defaults));
+    text.push_str(&parameters(name, info));
     let _ = writeln!(
         text,
         "  file:        {} (compiled in; `--numeric` runs it on the reference)",
         builtin_file(name).display()
     );
+    text
+}
+
+/// The run-time parameters (`--param NAME=VALUE`, `camchain sweep`), and how many the
+/// generated code folds.
+fn parameters(name: &str, info: &ModelInfo) -> String {
+    let mut text = String::new();
+    if info.parameters.is_empty() {
+        let _ = writeln!(text, "  parameters:  none at run time");
+    } else {
+        let _ = writeln!(text, "  parameters (--param NAME=VALUE, camchain sweep):");
+        for p in &info.parameters {
+            let unit = if p.unit.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", p.unit)
+            };
+            let range = match (p.min, p.max) {
+                (Some(a), Some(b)) => format!(" in [{a}, {b}]"),
+                (Some(a), None) => format!(" ≥ {a}"),
+                (None, Some(b)) => format!(" ≤ {b}"),
+                (None, None) => String::new(),
+            };
+            let _ = writeln!(
+                text,
+                "    {:<12} {}{unit}{range}  {}",
+                p.name, p.default, p.description
+            );
+        }
+    }
+    let folded = super::source::builtin_description(name)
+        .map(|m| m.parameters.iter().filter(|p| p.constant).count())
+        .unwrap_or(0);
+    if folded > 0 {
+        let _ = writeln!(
+            text,
+            "    and {folded} folded into the generated code (constant: true; --numeric sets them too)"
+        );
+    }
     text
 }
 

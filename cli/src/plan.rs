@@ -42,10 +42,11 @@ pub fn plan(args: &SimulateArgs) -> Result<Vec<Job>, CliError> {
             names.len()
         )));
     }
+    let values = args.parameter_values().map_err(CliError::Usage)?;
     let mut origins: HashMap<String, String> = HashMap::new();
     let mut jobs = Vec::new();
     for name in &names {
-        let model = source::load(name, args.numeric)?;
+        let model = source::load_with(name, args.numeric, &values)?;
         if let Some(first) = origins.insert(model.label.clone(), model.origin.clone()) {
             return Err(given_twice(&model, &first));
         }

@@ -62,6 +62,46 @@ pub enum Panel {
     Mechanism(MechanismPanel),
     /// Only a message (e.g. why a snapshot cannot be drawn).
     Message(String),
+    /// Values on a grid of two parameters, as colours, with a colour bar.
+    Heat(HeatPanel),
+    /// Points without lines (a scatter), failed points marked.
+    Points(PointsPanel),
+}
+
+/// Values z(x, y) on the grid of the x and y values, drawn as coloured cells.
+pub struct HeatPanel {
+    /// Caption above the chart.
+    pub title: String,
+    /// Axis descriptions, with units.
+    pub x_label: String,
+    /// Axis descriptions, with units.
+    pub y_label: String,
+    /// The value's description, with its unit (the colour bar's label).
+    pub z_label: String,
+    /// The grid's x values, increasing.
+    pub x: Vec<f64>,
+    /// The grid's y values, increasing.
+    pub y: Vec<f64>,
+    /// `z[i][j]` at (x[i], y[j]); `None` where the run failed or has no value (drawn grey).
+    pub z: Vec<Vec<Option<f64>>>,
+}
+
+/// Points on one pair of axes.
+pub struct PointsPanel {
+    /// Caption above the chart.
+    pub title: String,
+    /// Axis descriptions, with units.
+    pub x_label: String,
+    /// Axis descriptions, with units.
+    pub y_label: String,
+    /// Axis ranges.
+    pub x_range: (f64, f64),
+    /// Axis ranges.
+    pub y_range: (f64, f64),
+    /// The points.
+    pub points: Vec<(f64, f64)>,
+    /// x of the runs without a value (failed, or no lift-off): small crosses on the x axis.
+    pub missing: Vec<f64>,
 }
 
 /// Curves on one pair of axes.
@@ -224,6 +264,8 @@ impl Figure {
                     Panel::Lines(p) => draw_lines(cell, p, target)?,
                     Panel::Mechanism(p) => draw_mechanism(cell, p)?,
                     Panel::Message(text) => draw_message(cell, text)?,
+                    Panel::Heat(p) => draw_heat(cell, p)?,
+                    Panel::Points(p) => draw_points(cell, p)?,
                 }
             }
         }
@@ -342,6 +384,167 @@ fn draw_lines<DB: DrawingBackend>(
             .label_font((FONT, LEGEND_SIZE))
             .draw()?;
     }
+    Ok(())
+}
+
+/// The cell edges around increasing grid values: midway between neighbours, half a gap
+/// beyond the ends (a single value gets ±5 % of itself, or ±0.5).
+fn cell_edges(values: &[f64]) -> Vec<f64> {
+    match values {
+        [] => vec![0.0, 1.0],
+        [v] => {
+            let half = if *v == 0.0 { 0.5 } else { 0.05 * v.abs() };
+            vec![v - half, v + half]
+        }
+        _ => {
+            let n = values.len();
+            let mut edges = Vec::with_capacity(n + 1);
+            edges.push(values[0] - 0.5 * (values[1] - values[0]));
+            edges.extend(values.windows(2).map(|w| 0.5 * (w[0] + w[1])));
+            edges.push(values[n - 1] + 0.5 * (values[n - 1] - values[n - 2]));
+            edges
+        }
+    }
+}
+
+/// The viridis colour map over [0, 1].
+pub fn viridis(f: f64) -> RGBColor {
+    const STOPS: [[f64; 3]; 5] = [
+        [68.0, 1.0, 84.0],
+        [59.0, 82.0, 139.0],
+        [33.0, 145.0, 140.0],
+        [94.0, 201.0, 98.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let x = 4.0
+        * if f.is_finite() {
+            f.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+    let i = (x.floor() as usize).min(3);
+    let u = x - i as f64;
+    let mix = |k: usize| (STOPS[i][k] + u * (STOPS[i + 1][k] - STOPS[i][k])).round() as u8;
+    RGBColor(mix(0), mix(1), mix(2))
+}
+
+fn draw_heat<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &HeatPanel,
+) -> Result<(), PlotError> {
+    let area = caption(area, &p.title)?;
+    let (w, _) = area.dim_in_pixel();
+    let (map, bar) = area.split_horizontally(w.saturating_sub(130));
+    let (xe, ye) = (cell_edges(&p.x), cell_edges(&p.y));
+    let (x0, x1) = (xe[0], xe[xe.len() - 1]);
+    let (y0, y1) = (ye[0], ye[ye.len() - 1]);
+    let values: Vec<f64> = p.z.iter().flatten().flatten().copied().collect();
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let (lo, hi) = if lo.is_finite() && hi > lo {
+        (lo, hi)
+    } else if lo.is_finite() {
+        (lo - 0.5, lo + 0.5)
+    } else {
+        (0.0, 1.0)
+    };
+    let mut chart = ChartBuilder::on(&map)
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    let (x_format, y_format) = (tick_format((x0, x1)), tick_format((y0, y1)));
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(p.x_label.as_str())
+        .y_desc(p.y_label.as_str())
+        .x_label_formatter(&x_format)
+        .y_label_formatter(&y_format)
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_SIZE))
+        .draw()?;
+    let mut cells = Vec::new();
+    for (i, column) in p.z.iter().enumerate() {
+        for (j, z) in column.iter().enumerate() {
+            let color = match z {
+                Some(v) => viridis((v - lo) / (hi - lo)).filled(),
+                None => GRID_BOLD.filled(),
+            };
+            cells.push(Rectangle::new(
+                [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
+                color,
+            ));
+        }
+    }
+    chart.draw_series(cells)?;
+    let (power, z_label) = scaled_axis((lo, hi), &p.z_label);
+    let scale = 10f64.powi(-power);
+    let mut legend = ChartBuilder::on(&bar)
+        .margin(MARGIN)
+        .margin_left(4)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(0)
+        .right_y_label_area_size(90)
+        .build_cartesian_2d(0.0..1.0, (lo * scale)..(hi * scale))?
+        .set_secondary_coord(0.0..1.0, (lo * scale)..(hi * scale));
+    let z_format = tick_format((lo * scale, hi * scale));
+    legend
+        .configure_secondary_axes()
+        .y_desc(z_label.as_str())
+        .y_label_formatter(&z_format)
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_SIZE))
+        .draw()?;
+    let steps = 64;
+    legend.draw_series((0..steps).map(|k| {
+        let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
+        let (za, zb) = ((lo + a * (hi - lo)) * scale, (lo + b * (hi - lo)) * scale);
+        Rectangle::new([(0.0, za), (1.0, zb)], viridis(a).filled())
+    }))?;
+    Ok(())
+}
+
+fn draw_points<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &PointsPanel,
+) -> Result<(), PlotError> {
+    let area = caption(area, &p.title)?;
+    let (x0, x1) = p.x_range;
+    let (power, y_label) = scaled_axis(p.y_range, &p.y_label);
+    let scale = 10f64.powi(-power);
+    let (y0, y1) = (p.y_range.0 * scale, p.y_range.1 * scale);
+    let mut chart = ChartBuilder::on(&area)
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    let (x_format, y_format) = (tick_format(p.x_range), tick_format((y0, y1)));
+    chart
+        .configure_mesh()
+        .x_desc(p.x_label.as_str())
+        .y_desc(y_label.as_str())
+        .x_label_formatter(&x_format)
+        .y_label_formatter(&y_format)
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_SIZE))
+        .bold_line_style(GRID_BOLD)
+        .light_line_style(GRID_LIGHT)
+        .draw()?;
+    let color = RGBColor(31, 119, 180);
+    chart.draw_series(
+        p.points
+            .iter()
+            .map(|&(x, y)| Circle::new((x, y * scale), 3, color.filled())),
+    )?;
+    chart.draw_series(
+        p.missing
+            .iter()
+            .map(|&x| Cross::new((x, y0), 4, RGBColor(200, 40, 40).stroke_width(2))),
+    )?;
     Ok(())
 }
 

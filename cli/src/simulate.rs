@@ -97,6 +97,24 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
 }
 
+/// `generated code, k3 = 60, swing = 0.3`: the path and the run-time parameters whose values
+/// differ from the model file's.
+fn with_changed_parameters(path: &str, model: &dyn camchain_runtime::Dynamics) -> String {
+    let changed: Vec<String> = model
+        .info()
+        .parameters
+        .iter()
+        .zip(model.parameter_values())
+        .filter(|(p, v)| p.default != **v)
+        .map(|(p, v)| format!("{} = {v}", p.name))
+        .collect();
+    if changed.is_empty() {
+        path.to_string()
+    } else {
+        format!("{path} with {}", changed.join(", "))
+    }
+}
+
 /// Runs one job: assembly, simulation with the CSV streamed, then (complete runs) the
 /// figures and the summary. Problems are reported here.
 fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interrupt) -> Outcome {
@@ -179,9 +197,10 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     if let (Some(dir), true) = (&job.dir, ok) {
         remove_stale_outputs(dir, label, &written);
     }
+    let engine = with_changed_parameters(model.engine.describe(), dynamics);
     console.say(&summary::render(&RunReport {
         label,
-        engine: model.engine.describe(),
+        engine: &engine,
         info,
         settings,
         samples: &trajectory.samples,

@@ -7,8 +7,9 @@
 
 use super::CliError;
 use super::kinematics::Geometry;
+use camchain_codegen::ParameterMode;
 use camchain_codegen::model::Model;
-use camchain_codegen::schema::parse_model;
+use camchain_codegen::schema::{parse_model, parse_model_with};
 use camchain_models as models;
 use camchain_reference::NumericModel;
 use camchain_runtime::Dynamics;
@@ -18,6 +19,8 @@ use std::path::{Path, PathBuf};
 pub enum Engine {
     /// Code generated at build time (`camchain_models::<name>`).
     Generated(&'static (dyn Dynamics + Sync)),
+    /// Generated code built with other run-time parameter values.
+    Parametrised(Box<dyn Dynamics + Send + Sync>),
     /// The numeric recursive Newton–Euler reference on a model loaded at run time.
     Numeric(Box<NumericModel>),
 }
@@ -27,6 +30,7 @@ impl Engine {
     pub fn dynamics(&self) -> &dyn Dynamics {
         match self {
             Engine::Generated(model) => *model,
+            Engine::Parametrised(model) => model.as_ref(),
             Engine::Numeric(model) => model.as_ref(),
         }
     }
@@ -39,7 +43,7 @@ impl Engine {
     /// How the summary names the path.
     pub fn describe(&self) -> &'static str {
         match self {
-            Engine::Generated(_) => "generated code",
+            Engine::Generated(_) | Engine::Parametrised(_) => "generated code",
             Engine::Numeric(_) => "numeric recursive reference (no rebuild)",
         }
     }
@@ -83,6 +87,74 @@ pub fn builtin_description(name: &str) -> Result<Model, CliError> {
 /// True when the argument is to be read as a path rather than a built-in name.
 fn looks_like_path(arg: &str) -> bool {
     arg.ends_with(".ron") || arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR)
+}
+
+/// [`load`] with run-time parameters set to other values (`--param`): a built-in model's
+/// generated code is built with them (a parameter it folds, or a value its checks refuse, is
+/// a usage error naming the model file's field); on the numeric path the file is validated
+/// again with them, and every parameter can be set.
+pub fn load_with(
+    arg: &str,
+    numeric: bool,
+    values: &[(String, f64)],
+) -> Result<LoadedModel, CliError> {
+    if values.is_empty() {
+        return load(arg, numeric);
+    }
+    let given = |e: String| {
+        let names: Vec<String> = values.iter().map(|(n, v)| format!("{n}={v}")).collect();
+        CliError::Usage(format!("--param {}: {e}", names.join(" ")))
+    };
+    if !looks_like_path(arg) && !numeric {
+        let mut loaded = load(arg, false)?;
+        let constructor = models::WITH_PARAMETERS
+            .iter()
+            .find(|(n, _)| *n == arg)
+            .map(|(_, c)| *c)
+            .ok_or_else(|| CliError::Failed(format!("{arg} has no constructor")))?;
+        let pairs: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let model = constructor(&pairs).map_err(|e| {
+            let hint = if e.message.contains("is constant") {
+                ", or set it on the numeric reference (--numeric)"
+            } else {
+                ""
+            };
+            given(format!("{e}{hint}"))
+        })?;
+        loaded.engine = Engine::Parametrised(model);
+        loaded.geometry = described_with(arg, values).and_then(|m| Geometry::new(&m));
+        return Ok(loaded);
+    }
+    let (source, file) = if looks_like_path(arg) {
+        let file = PathBuf::from(arg);
+        let source = std::fs::read_to_string(&file).map_err(|e| {
+            CliError::Failed(format!("cannot read model file {}: {e}", file.display()))
+        })?;
+        (source, file)
+    } else {
+        let source =
+            models::source(arg).ok_or_else(|| CliError::Usage(format!("unknown model `{arg}`")))?;
+        (source.to_string(), builtin_file(arg))
+    };
+    // The file as the build checks it first (its own values), then with the given ones.
+    let mut loaded = load(arg, numeric)?;
+    let model = parse_model_with(&source, &file, values, ParameterMode::AllAtRunTime)
+        .map_err(|e| given(e.to_string().replace('\n', " ")))?;
+    loaded.geometry = Geometry::new(&model);
+    loaded.engine = Engine::Numeric(Box::new(NumericModel::new(model)));
+    Ok(loaded)
+}
+
+/// A built-in model's description with other parameter values (for drawing it).
+fn described_with(name: &str, values: &[(String, f64)]) -> Result<Model, String> {
+    let source = models::source(name).ok_or_else(|| format!("unknown model `{name}`"))?;
+    parse_model_with(
+        source,
+        &builtin_file(name),
+        values,
+        ParameterMode::AllAtRunTime,
+    )
+    .map_err(|e| e.to_string())
 }
 
 /// Resolves one MODEL argument. An unknown name is a usage error; a file that cannot be

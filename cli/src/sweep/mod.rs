@@ -1,0 +1,763 @@
+//! `camchain sweep`: a model run over a grid or a Latin hypercube of its run-time
+//! parameters, in parallel; `camchain merge`: the shards of a sweep joined.
+//!
+//! Everything that can be checked is checked before the first run (the model, every
+//! parameter's name and every value against its declared bounds, the settings, the shard,
+//! the output); then `--jobs` workers take the runs in index order from a shared counter,
+//! and the main thread writes each row as soon as every earlier one is written (at most a
+//! few rows wait: memory does not grow with the number of runs). A run that fails is a row
+//! with its error. Figures are drawn at the end from the rows kept for them (at most
+//! [`PLOTTED_RUNS`]).
+
+pub mod figures;
+mod merge;
+mod progress;
+pub mod spec;
+pub mod table;
+
+pub use merge::run as merge;
+
+use super::CliError;
+use super::args::{SweepArgs, integrator_name};
+use super::interrupt::Interrupt;
+use super::output;
+use super::source::{builtin_description, builtin_file, builtin_names};
+use camchain_codegen::ParameterMode;
+use camchain_models as models;
+use camchain_reference::NumericModel;
+use camchain_runtime::{Dynamics, MetricsOptions, ParameterInfo, SimSettings, Simulate};
+use spec::{Design, Runs, Shard};
+use std::collections::BTreeMap;
+use std::fs;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::Instant;
+use table::{Preamble, Row};
+
+/// Above this many runs no figure is drawn (their data would not stay small); the CSV has
+/// everything.
+pub const PLOTTED_RUNS: usize = 200_000;
+
+/// Where each run's model comes from.
+pub enum Factory {
+    /// Generated code, built with other parameter values by its constructor.
+    Generated {
+        /// Its constructor (`camchain_models::WITH_PARAMETERS`).
+        constructor: models::Constructor,
+    },
+    /// The numeric reference, the model file validated again with the run's values.
+    Numeric {
+        /// The file's text.
+        source: String,
+        /// The file as messages name it.
+        file: PathBuf,
+    },
+}
+
+impl Factory {
+    /// The model with these values.
+    pub fn build(&self, values: &[(&str, f64)]) -> Result<Box<dyn Dynamics + Send + Sync>, String> {
+        match self {
+            Factory::Generated { constructor, .. } => {
+                constructor(values).map_err(|e| e.to_string())
+            }
+            Factory::Numeric { source, file } => {
+                let owned: Vec<(String, f64)> =
+                    values.iter().map(|(n, v)| (n.to_string(), *v)).collect();
+                NumericModel::from_source_with(source, file, &owned, ParameterMode::AllAtRunTime)
+                    .map(|m| Box::new(m) as Box<dyn Dynamics + Send + Sync>)
+                    .map_err(|e| e.to_string().replace('\n', " "))
+            }
+        }
+    }
+
+    /// How summaries name the path.
+    fn describe(&self) -> &'static str {
+        match self {
+            Factory::Generated { .. } => "generated code",
+            Factory::Numeric { .. } => "numeric reference",
+        }
+    }
+}
+
+/// Everything a sweep needs, checked.
+pub struct Plan {
+    /// The model's name.
+    pub model: String,
+    /// The run's label in file names (`paper_concave`, `paper_concave_numeric`, a file stem).
+    pub label: String,
+    /// The model of each run.
+    pub factory: Factory,
+    /// The runs.
+    pub runs: Runs,
+    /// This process's slice.
+    pub shard: Shard,
+    /// Integration settings.
+    pub settings: SimSettings,
+    /// Where the metrics are evaluated.
+    pub options: MetricsOptions,
+    /// Workers.
+    pub jobs: usize,
+    /// Where the CSV goes (`None`: standard output).
+    pub csv: Option<PathBuf>,
+    /// Where the figures go, if anywhere.
+    pub figures: Option<PathBuf>,
+    /// The metrics drawn.
+    pub plotted: Vec<String>,
+    /// No summary, no progress.
+    pub quiet: bool,
+}
+
+/// `camchain sweep`.
+pub fn run(args: &SweepArgs) -> Result<(), CliError> {
+    let plan = plan(args)?;
+    let interrupt = Interrupt::install();
+    execute(&plan, &interrupt)
+}
+
+/// Checks everything and decides the files, before any run.
+pub fn plan(args: &SweepArgs) -> Result<Plan, CliError> {
+    let usage = CliError::Usage;
+    let (model, label, factory, declared, folded, defaults) = resolve_model(args)?;
+    let swept = args
+        .params
+        .iter()
+        .map(|p| spec::parse_param(p).map_err(|e| usage(format!("--param {e}"))))
+        .collect::<Result<Vec<_>, _>>()?;
+    for s in &swept {
+        check_parameter(&model, s, &declared, &folded, args.numeric)?;
+    }
+    let design = match args.samples {
+        Some(samples) => Design::LatinHypercube {
+            samples,
+            seed: args.seed,
+        },
+        None => Design::Product,
+    };
+    let runs = Runs::new(swept, design).map_err(usage)?;
+    let shard = match &args.shard {
+        Some(text) => spec::parse_shard(text).map_err(|e| usage(format!("--shard {e}")))?,
+        None => Shard::ALL,
+    };
+    let settings = args.settings(&defaults);
+    settings
+        .validate_integration()
+        .and_then(|()| settings.validate_output(0.0))
+        .map_err(|e| usage(format!("settings: {e}")))?;
+    let jobs = match args.jobs {
+        Some(0) => return Err(usage("--jobs must be at least 1".to_string())),
+        Some(n) => n,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let plotted = plotted_metrics(&args.metric)?;
+    let stem = match (shard.count, &args.shard) {
+        (1, _) | (_, None) => format!("{label}_sweep"),
+        _ => format!("{label}_sweep.shard-{}-of-{}", shard.index, shard.count),
+    };
+    let (csv, figures) = destinations(args, &label, &stem)?;
+    Ok(Plan {
+        model,
+        label,
+        factory,
+        runs,
+        shard,
+        settings,
+        options: MetricsOptions { grid: args.grid },
+        jobs,
+        csv,
+        figures,
+        plotted,
+        quiet: args.quiet,
+    })
+}
+
+/// The model: its name, label, factory, run-time parameters, folded parameters' names and
+/// default settings.
+type Resolved = (
+    String,
+    String,
+    Factory,
+    Vec<ParameterInfo>,
+    Vec<String>,
+    SimSettings,
+);
+
+fn resolve_model(args: &SweepArgs) -> Result<Resolved, CliError> {
+    let arg = args.model.as_str();
+    let is_path =
+        arg.ends_with(".ron") || arg.contains('/') || arg.contains(std::path::MAIN_SEPARATOR);
+    if !is_path {
+        let Some(generated) = models::by_name(arg) else {
+            return Err(CliError::Usage(format!(
+                "unknown model `{arg}`: built-in models are {} (or give a path to a .ron file)",
+                builtin_names().join(", ")
+            )));
+        };
+        if args.numeric {
+            let source = models::source(arg).unwrap_or_default().to_string();
+            let file = builtin_file(arg);
+            return numeric(arg.to_string(), format!("{arg}_numeric"), source, file);
+        }
+        let constructor = models::WITH_PARAMETERS
+            .iter()
+            .find(|(n, _)| *n == arg)
+            .map(|(_, c)| *c)
+            .ok_or_else(|| CliError::Failed(format!("{arg} has no constructor")))?;
+        let folded = builtin_description(arg)?
+            .parameters
+            .iter()
+            .filter(|p| p.constant)
+            .map(|p| p.name.clone())
+            .collect();
+        let info = generated.info();
+        return Ok((
+            arg.to_string(),
+            arg.to_string(),
+            Factory::Generated { constructor },
+            info.parameters.clone(),
+            folded,
+            info.defaults.clone(),
+        ));
+    }
+    let path = Path::new(arg);
+    let source = fs::read_to_string(path)
+        .map_err(|e| CliError::Failed(format!("cannot read {}: {e}", path.display())))?;
+    let label = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "model".to_string());
+    numeric(label.clone(), label, source, path.to_path_buf())
+}
+
+/// A model on the numeric reference: validated once now with its file's values.
+fn numeric(
+    name: String,
+    label: String,
+    source: String,
+    file: PathBuf,
+) -> Result<Resolved, CliError> {
+    let checked = camchain_codegen::check_source(&source, &file)
+        .map_err(|e| CliError::Failed(e.to_string().replace('\n', " ")))?;
+    let model = NumericModel::from_source_with(&source, &file, &[], ParameterMode::AllAtRunTime)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let info = model.info();
+    let structural = checked
+        .parameters
+        .iter()
+        .filter(|p| !info.parameters.iter().any(|q| q.name == p.name))
+        .map(|p| p.name.clone())
+        .collect();
+    let (parameters, defaults) = (info.parameters.clone(), info.defaults.clone());
+    let name = if checked.name.is_empty() {
+        name
+    } else {
+        checked.name
+    };
+    Ok((
+        name,
+        label,
+        Factory::Numeric { source, file },
+        parameters,
+        structural,
+        defaults,
+    ))
+}
+
+/// A swept parameter must be one of the model's run-time parameters, every value within its
+/// declared bounds.
+fn check_parameter(
+    model: &str,
+    swept: &spec::Swept,
+    declared: &[ParameterInfo],
+    folded: &[String],
+    numeric: bool,
+) -> Result<(), CliError> {
+    let Some(p) = declared.iter().find(|p| p.name == swept.name) else {
+        let message = if folded.contains(&swept.name) && !numeric {
+            format!(
+                "--param {}: `{}` is folded into {model}'s generated code (constant: true in \
+                 its file); sweep it on the numeric reference (--numeric), or remove \
+                 `constant: true` and rebuild",
+                swept.name, swept.name
+            )
+        } else if folded.contains(&swept.name) {
+            format!(
+                "--param {}: `{}` fixes a joint or cam axis (a field that must be constant)",
+                swept.name, swept.name
+            )
+        } else {
+            let mut known: Vec<&str> = declared.iter().map(|p| p.name.as_str()).collect();
+            known.sort_unstable();
+            let known = if known.is_empty() {
+                "it has none".to_string()
+            } else {
+                format!("they are {}", known.join(", "))
+            };
+            format!(
+                "--param {}: {model} has no run-time parameter `{}` ({known})",
+                swept.name, swept.name
+            )
+        };
+        return Err(CliError::Usage(message));
+    };
+    for value in swept.extremes() {
+        let range = (p.min, p.max);
+        if let Err((_, message)) = camchain_runtime::parameters::checks::within_bounds(
+            &p.name,
+            value,
+            range,
+            &format!("{} = {value}", p.name),
+        ) {
+            return Err(CliError::Usage(format!(
+                "--param {}={}: {message}",
+                swept.name, swept.spec
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `--metric` names, checked.
+pub(crate) fn plotted_metrics(given: &[String]) -> Result<Vec<String>, CliError> {
+    if given.is_empty() {
+        return Ok(table::DEFAULT_PLOTTED
+            .iter()
+            .map(|s| s.to_string())
+            .collect());
+    }
+    for name in given {
+        if !table::PLOTTABLE.contains(&name.as_str()) {
+            return Err(CliError::Usage(format!(
+                "--metric: unknown metric `{name}`; the metrics are {}",
+                table::PLOTTABLE.join(", ")
+            )));
+        }
+    }
+    Ok(given.to_vec())
+}
+
+/// The CSV's path (`None`: standard output) and the figures' directory, checked writable.
+fn destinations(
+    args: &SweepArgs,
+    label: &str,
+    stem: &str,
+) -> Result<(Option<PathBuf>, Option<PathBuf>), CliError> {
+    let dir = match (&args.out, &args.csv) {
+        (Some(dir), _) => Some(dir.join(format!("{label}_sweep"))),
+        (None, Some(_)) => None,
+        (None, None) => {
+            Some(PathBuf::from(super::args::DEFAULT_OUT).join(format!("{label}_sweep")))
+        }
+    };
+    if let Some(dir) = &dir {
+        output::create_dir(dir).map_err(CliError::Failed)?;
+    }
+    let csv = match &args.csv {
+        Some(path) if path.as_os_str() == "-" => None,
+        Some(path) => {
+            output::check_csv_destination(path).map_err(CliError::Failed)?;
+            Some(path.clone())
+        }
+        None => dir.as_ref().map(|d| d.join(format!("{stem}.csv"))),
+    };
+    let figures = if args.no_plots { None } else { dir };
+    Ok((csv, figures))
+}
+
+/// The `#` lines of this sweep.
+pub fn preamble(plan: &Plan) -> Preamble {
+    let s = &plan.settings;
+    let tolerances = if s.integrator.is_adaptive() {
+        format!("rtol {:e} atol {:e}", s.rtol, s.atol)
+    } else {
+        format!("dt {:e} s", s.dt)
+    };
+    let sampling = if plan.options.grid {
+        format!("metrics at the step ends and every {} s", s.dt_out)
+    } else {
+        "metrics at the step ends".to_string()
+    };
+    Preamble {
+        sweep: format!(
+            "camchain sweep of {} ({}): {} runs",
+            plan.model,
+            plan.factory.describe(),
+            plan.runs.len()
+        ),
+        shard: (plan.shard.index, plan.shard.count),
+        parameters: plan.runs.describe(),
+        settings: format!(
+            "{} {tolerances} t_end {} s, {sampling}",
+            integrator_name(s.integrator),
+            s.t_end
+        ),
+    }
+}
+
+/// One run: the model with the run's values, assembly, a metrics run.
+pub fn run_one(plan: &Plan, run: usize) -> Row {
+    let start = Instant::now();
+    let values = plan.runs.values(run);
+    let names: Vec<&str> = plan.runs.swept.iter().map(|s| s.name.as_str()).collect();
+    let pairs: Vec<(&str, f64)> = names.iter().copied().zip(values.iter().copied()).collect();
+    let (metrics, error) = match plan.factory.build(&pairs) {
+        Err(e) => (None, Some(e)),
+        Ok(model) => match model.assemble(0.0) {
+            Err(e) => (None, Some(format!("assembly: {e}"))),
+            Ok(state) => match model.simulate_metrics(state, &plan.settings, plan.options) {
+                Ok(m) => (Some(m), None),
+                Err(failure) => (Some(failure.partial), Some(failure.error.to_string())),
+            },
+        },
+    };
+    Row {
+        run,
+        values,
+        metrics,
+        error,
+        wall_time: start.elapsed().as_secs_f64(),
+    }
+}
+
+/// Where the rows go while the sweep runs: a regular (or new) file through
+/// `<name>.partial.csv` renamed when complete, or standard output and special files
+/// directly.
+enum Sink {
+    Partial {
+        dest: PathBuf,
+        partial: PathBuf,
+        out: BufWriter<fs::File>,
+    },
+    Direct(Box<dyn Write>),
+}
+
+impl Sink {
+    fn open(csv: &Option<PathBuf>) -> Result<Self, String> {
+        let Some(path) = csv else {
+            return Ok(Sink::Direct(Box::new(BufWriter::new(io::stdout()))));
+        };
+        match output::destination(path) {
+            Ok(output::Destination::Replaceable(dest)) => {
+                let partial = output::partial_path(&dest);
+                let file = fs::File::create(&partial)
+                    .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+                Ok(Sink::Partial {
+                    dest,
+                    partial,
+                    out: BufWriter::new(file),
+                })
+            }
+            Ok(output::Destination::Special) => {
+                let file = fs::OpenOptions::new()
+                    .write(true)
+                    .open(path)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                Ok(Sink::Direct(Box::new(BufWriter::new(file))))
+            }
+            Err(e) => Err(format!("cannot write {}: {e}", path.display())),
+        }
+    }
+
+    fn out(&mut self) -> &mut dyn Write {
+        match self {
+            Sink::Partial { out, .. } => out,
+            Sink::Direct(out) => out.as_mut(),
+        }
+    }
+
+    /// Complete: the partial file takes the final name.
+    fn finish(mut self) -> Result<Option<PathBuf>, String> {
+        self.out().flush().map_err(|e| e.to_string())?;
+        match self {
+            Sink::Partial { dest, partial, out } => {
+                let file = out.into_inner().map_err(|e| e.to_string())?;
+                file.sync_all().map_err(|e| e.to_string())?;
+                fs::rename(&partial, &dest).map_err(|e| {
+                    format!(
+                        "cannot rename {} to {}: {e}",
+                        partial.display(),
+                        dest.display()
+                    )
+                })?;
+                Ok(Some(dest))
+            }
+            Sink::Direct(_) => Ok(None),
+        }
+    }
+
+    /// Interrupted or failed: the partial file stays (flushed); its path.
+    fn abandon(mut self) -> Option<PathBuf> {
+        let _ = self.out().flush();
+        match self {
+            Sink::Partial { partial, .. } => Some(partial),
+            Sink::Direct(_) => None,
+        }
+    }
+}
+
+/// The rows kept for the figures (parameters and the plotted metrics), while there are few
+/// enough.
+pub struct PlotData {
+    /// The plotted metrics' names.
+    pub metrics: Vec<String>,
+    /// Per run: its parameter values and the plotted metrics (None where empty).
+    pub rows: Vec<(Vec<f64>, Vec<Option<f64>>)>,
+    /// False once there were more than [`PLOTTED_RUNS`] rows.
+    pub complete: bool,
+}
+
+impl PlotData {
+    pub(crate) fn new(metrics: &[String]) -> Self {
+        PlotData {
+            metrics: metrics.to_vec(),
+            rows: Vec::new(),
+            complete: true,
+        }
+    }
+
+    fn add(&mut self, row: &Row) {
+        let metrics = self.metrics.iter().map(|m| row.metric(m)).collect();
+        self.add_values(row.values.clone(), metrics);
+    }
+
+    /// Keeps one run's parameters and plotted metrics (until there are too many).
+    pub(crate) fn add_values(&mut self, values: Vec<f64>, metrics: Vec<Option<f64>>) {
+        if !self.complete {
+            return;
+        }
+        if self.rows.len() == PLOTTED_RUNS {
+            self.rows = Vec::new();
+            self.complete = false;
+            return;
+        }
+        self.rows.push((values, metrics));
+    }
+}
+
+/// Runs the plan: workers, the ordered writer, the summary, the figures.
+pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
+    let preamble = preamble(plan);
+    let names: Vec<String> = plan.runs.swept.iter().map(|s| s.name.clone()).collect();
+    let mut sink = Sink::open(&plan.csv).map_err(CliError::Failed)?;
+    let header = table::header(&names).join(",");
+    preamble
+        .write(sink.out())
+        .and_then(|()| writeln!(sink.out(), "{header}"))
+        .map_err(|e| CliError::Failed(format!("cannot write the CSV: {e}")))?;
+    let total = plan.shard.len(plan.runs.len());
+    let mut progress =
+        progress::Progress::new(&format!("{} sweep", plan.label), total, !plan.quiet);
+    let start = Instant::now();
+    let mut plot = PlotData::new(&plan.plotted);
+    let mut written = 0;
+    let mut failed = 0;
+    let mut write_error: Option<String> = None;
+    let stop = AtomicBool::new(false);
+    let next = AtomicUsize::new(0);
+    let runs: Vec<usize> = plan.shard.runs(plan.runs.len()).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(plan.jobs)
+        .build()
+        .map_err(|e| CliError::Failed(format!("cannot start {} workers: {e}", plan.jobs)))?;
+    let (tx, rx) = mpsc::sync_channel::<(usize, Row)>(4 * plan.jobs);
+    pool.in_place_scope(|scope| {
+        for _ in 0..plan.jobs {
+            let tx = tx.clone();
+            let (next, stop, runs) = (&next, &stop, &runs);
+            scope.spawn(move |_| {
+                loop {
+                    if stop.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&run) = runs.get(k) else {
+                        break;
+                    };
+                    if tx.send((k, run_one(plan, run))).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(tx);
+        // Rows in run order: a finished row waits until every earlier one is written.
+        let mut waiting: BTreeMap<usize, Row> = BTreeMap::new();
+        for (k, row) in rx.iter() {
+            waiting.insert(k, row);
+            while let Some(row) = waiting.remove(&written) {
+                if write_error.is_none() {
+                    if let Err(e) = writeln!(sink.out(), "{}", row.cells().join(",")) {
+                        write_error = Some(e.to_string());
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                }
+                failed += usize::from(row.error.is_some());
+                plot.add(&row);
+                written += 1;
+                progress.update(written, failed);
+            }
+            if interrupt.requested() {
+                stop.store(true, Ordering::Relaxed);
+            }
+        }
+    });
+    progress.finish();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(e) = write_error {
+        let kept = sink.abandon();
+        return Err(CliError::Failed(format!(
+            "cannot write the CSV: {e}{}",
+            kept.map_or(String::new(), |p| format!(
+                " (rows so far in {})",
+                p.display()
+            ))
+        )));
+    }
+    if written < total {
+        let kept = sink.abandon();
+        eprintln!(
+            "{} sweep: interrupted after {written} of {total} runs{}",
+            plan.label,
+            kept.map_or(String::new(), |p| format!(
+                "; the rows so far are in {}",
+                p.display()
+            ))
+        );
+        return Err(CliError::Interrupted);
+    }
+    let saved = sink.finish().map_err(CliError::Failed)?;
+    let drawn = match (&plan.figures, plot.complete) {
+        (Some(dir), true) => figures::draw(dir, plan, &plot)
+            .map_err(|e| CliError::Failed(format!("figures: {e}")))?,
+        _ => Vec::new(),
+    };
+    if !plan.quiet {
+        summary(
+            plan,
+            &plot,
+            (written, failed, elapsed),
+            saved.as_deref(),
+            &drawn,
+        );
+    }
+    if failed > 0 {
+        return Err(CliError::RunsFailed(failed));
+    }
+    Ok(())
+}
+
+/// Six significant digits: plain for ordinary magnitudes, scientific for tiny or huge ones.
+fn significant(v: f64) -> String {
+    let magnitude = v.abs();
+    if v == 0.0 || (1e-3..1e6).contains(&magnitude) {
+        let decimals = (5 - magnitude.log10().floor().max(0.0) as i32).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.5e}")
+    }
+}
+
+/// What the sweep did, on standard error when the CSV went to standard output.
+fn summary(
+    plan: &Plan,
+    plot: &PlotData,
+    (runs, failed, elapsed): (usize, usize, f64),
+    csv: Option<&Path>,
+    figures: &[PathBuf],
+) {
+    let mut text = String::new();
+    let shard = if plan.shard.count > 1 {
+        format!(", shard {} (every {}-th run)", plan.shard, plan.shard.count)
+    } else {
+        String::new()
+    };
+    text.push_str(&format!(
+        "{} sweep — {}, {} runs{shard} over {}, {} worker{}\n",
+        plan.model,
+        plan.factory.describe(),
+        runs,
+        plan.runs.describe(),
+        plan.jobs,
+        if plan.jobs == 1 { "" } else { "s" }
+    ));
+    text.push_str(&format!(
+        "  {runs} runs in {elapsed:.2} s ({:.0} runs/s); {failed} failed{}\n",
+        runs as f64 / elapsed.max(1e-9),
+        if failed > 0 {
+            " (their rows have the error)"
+        } else {
+            ""
+        }
+    ));
+    for (k, metric) in plot.metrics.iter().enumerate() {
+        let values: Vec<(f64, &Vec<f64>)> = plot
+            .rows
+            .iter()
+            .filter_map(|(v, m)| m[k].map(|x| (x, v)))
+            .collect();
+        if values.is_empty() {
+            text.push_str(&format!("  {metric}: no value\n"));
+            continue;
+        }
+        let (lo, at_lo) = values.iter().fold((f64::INFINITY, None), |acc, &(x, v)| {
+            if x < acc.0 { (x, Some(v)) } else { acc }
+        });
+        let (hi, at_hi) = values
+            .iter()
+            .fold((f64::NEG_INFINITY, None), |acc, &(x, v)| {
+                if x > acc.0 { (x, Some(v)) } else { acc }
+            });
+        let unit = table::METRICS
+            .iter()
+            .find(|(n, _)| n == metric)
+            .map_or("", |(_, u)| *u);
+        let at = |v: Option<&Vec<f64>>| {
+            v.map(|v| {
+                plan.runs
+                    .swept
+                    .iter()
+                    .zip(v)
+                    .map(|(s, x)| format!("{} = {x}", s.name))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            })
+            .unwrap_or_default()
+        };
+        text.push_str(&format!(
+            "  {metric}: {} … {} {unit} (smallest at {}; largest at {}); {} of {runs} runs\n",
+            significant(lo),
+            significant(hi),
+            at(at_lo),
+            at(at_hi),
+            values.len()
+        ));
+    }
+    if !plot.complete {
+        text.push_str(&format!(
+            "  no figures: more than {PLOTTED_RUNS} runs (plot the CSV)\n"
+        ));
+    }
+    match csv {
+        Some(path) => text.push_str(&format!("  wrote {}\n", path.display())),
+        None if plan.csv.is_none() => {}
+        None => {}
+    }
+    if let Some(dir) = figures.first().and_then(|p| p.parent()) {
+        let names: Vec<String> = figures
+            .iter()
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect();
+        text.push_str(&format!(
+            "  wrote {}/: {}\n",
+            dir.display(),
+            names.join(", ")
+        ));
+    }
+    if plan.csv.is_none() {
+        eprint!("{text}");
+    } else {
+        print!("{text}");
+    }
+}
