@@ -151,6 +151,8 @@ pub enum BenchWhat {
     WorkPrecision,
     /// One evaluation of each term, generated against numeric, side by side.
     Evaluations,
+    /// Whole-run overhead, sweep throughput with 1 and 2 workers, sweep memory.
+    Sweep,
     /// Draw the scaling figure from the scaling example's CSV (--scaling-csv).
     ScalingFigure,
 }

@@ -392,6 +392,11 @@ fn model_type(model: &Model, source: &str, parametric: bool) -> String {
          /// Simulates from `state` with `settings`, sampling every `settings.dt_out`.\n\
          pub fn simulate(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::Trajectory, Box<rt::SimFailure>> {{\n\
          rt::Simulate::simulate(self, state, settings)\n}}\n\
+         /// Simulates from `state` with `settings`, keeping a summary instead of a trajectory\n\
+         /// (extreme normal forces, first lift-off, max |h|, energy drift): what a parameter\n\
+         /// sweep keeps of a run.\n\
+         pub fn simulate_metrics(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::RunMetrics, Box<rt::MetricsFailure>> {{\n\
+         rt::Simulate::simulate_metrics(self, state, settings, rt::MetricsOptions::default())\n}}\n\
          /// The default settings from the model file.\n\
          pub fn default_settings(&self) -> rt::SimSettings {{\n\
          rt::Dynamics::info(self).defaults.clone()\n}}\n\

@@ -103,6 +103,21 @@ impl Model {
     ) -> Result<rt::Trajectory, Box<rt::SimFailure>> {
         rt::Simulate::simulate(self, state, settings)
     }
+    /// Simulates from `state` with `settings`, keeping a summary instead of a trajectory
+    /// (extreme normal forces, first lift-off, max |h|, energy drift): what a parameter
+    /// sweep keeps of a run.
+    pub fn simulate_metrics(
+        &self,
+        state: rt::State,
+        settings: &rt::SimSettings,
+    ) -> Result<rt::RunMetrics, Box<rt::MetricsFailure>> {
+        rt::Simulate::simulate_metrics(
+            self,
+            state,
+            settings,
+            rt::MetricsOptions::default(),
+        )
+    }
     /// The default settings from the model file.
     pub fn default_settings(&self) -> rt::SimSettings {
         rt::Dynamics::info(self).defaults.clone()

@@ -5,6 +5,8 @@
 //!   and tolerances, on the reference models, against a checked reference solution;
 //! - `evaluations`: one evaluation of M+F+Q, the constraint terms, the reduced right-hand
 //!   side and one RK4 step, generated code against the numeric recursion, on the same states;
+//! - `sweep`: the whole-run overhead of a metrics run, the throughput of `camchain sweep` with
+//!   1 and 2 workers, and its memory against the number of runs;
 //! - `scaling-figure`: the figure of the scaling study from the CSV of
 //!   `cargo run --release -p camchain-codegen --example scaling -- OUTDIR --build`.
 //!
@@ -14,6 +16,7 @@
 mod evaluations;
 mod markdown;
 mod scaling;
+mod sweep;
 mod timing;
 mod work_precision;
 
@@ -45,6 +48,11 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         scaling::run(csv, &args.figures)?;
         println!("wrote {}/scaling.png and .svg", args.figures.display());
         return Ok(());
+    }
+    if matches!(args.what, BenchWhat::Sweep | BenchWhat::All) {
+        let section = sweep::run(args.quick)?;
+        markdown::replace_section(report, "sweep", &section)?;
+        println!("updated {} (section sweep)", report.display());
     }
     if matches!(args.what, BenchWhat::WorkPrecision | BenchWhat::All) {
         let section = work_precision::run(args.quick, &args.figures)?;

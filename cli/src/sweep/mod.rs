@@ -497,6 +497,47 @@ impl Sink {
     }
 }
 
+/// The smallest and largest value of each plotted metric and the parameters of their runs,
+/// kept as the rows go by (constant memory, whatever the number of runs).
+pub struct Extremes {
+    metrics: Vec<String>,
+    /// Per metric, once it has a value.
+    seen: Vec<Option<Extreme>>,
+}
+
+/// The extremes of one metric: the value and the run's parameter values, and how many runs
+/// had a value.
+type Extreme = ((f64, Vec<f64>), (f64, Vec<f64>), usize);
+
+impl Extremes {
+    fn new(metrics: &[String]) -> Self {
+        Extremes {
+            metrics: metrics.to_vec(),
+            seen: vec![None; metrics.len()],
+        }
+    }
+
+    fn add(&mut self, row: &Row) {
+        for (k, metric) in self.metrics.iter().enumerate() {
+            let Some(x) = row.metric(metric) else {
+                continue;
+            };
+            match &mut self.seen[k] {
+                None => self.seen[k] = Some(((x, row.values.clone()), (x, row.values.clone()), 1)),
+                Some((lo, hi, count)) => {
+                    *count += 1;
+                    if x < lo.0 {
+                        *lo = (x, row.values.clone());
+                    }
+                    if x > hi.0 {
+                        *hi = (x, row.values.clone());
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The rows kept for the figures (parameters and the plotted metrics), while there are few
 /// enough.
 pub struct PlotData {
@@ -550,7 +591,10 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
     let mut progress =
         progress::Progress::new(&format!("{} sweep", plan.label), total, !plan.quiet);
     let start = Instant::now();
+    // Rows are kept only for figures, and only up to PLOTTED_RUNS.
     let mut plot = PlotData::new(&plan.plotted);
+    plot.complete = plan.figures.is_some();
+    let mut extremes = Extremes::new(&plan.plotted);
     let mut written = 0;
     let mut failed = 0;
     let mut write_error: Option<String> = None;
@@ -595,6 +639,7 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
                 }
                 failed += usize::from(row.error.is_some());
                 plot.add(&row);
+                extremes.add(&row);
                 written += 1;
                 progress.update(written, failed);
             }
@@ -634,18 +679,22 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
         _ => Vec::new(),
     };
     if !plan.quiet {
-        summary(
-            plan,
-            &plot,
-            (written, failed, elapsed),
-            saved.as_deref(),
-            &drawn,
-        );
+        let too_many = plan.figures.is_some() && !plot.complete;
+        let counts = (written, failed, elapsed);
+        summary(plan, &extremes, too_many, counts, saved.as_deref(), &drawn);
     }
     if failed > 0 {
         return Err(CliError::RunsFailed(failed));
     }
     Ok(())
+}
+
+/// The process's peak resident memory (MB), where the system says (Linux: VmHWM).
+pub fn peak_memory_mb() -> Option<f64> {
+    let status = fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
 }
 
 /// Six significant digits: plain for ordinary magnitudes, scientific for tiny or huge ones.
@@ -662,7 +711,8 @@ fn significant(v: f64) -> String {
 /// What the sweep did, on standard error when the CSV went to standard output.
 fn summary(
     plan: &Plan,
-    plot: &PlotData,
+    extremes: &Extremes,
+    too_many: bool,
     (runs, failed, elapsed): (usize, usize, f64),
     csv: Option<&Path>,
     figures: &[PathBuf],
@@ -691,53 +741,39 @@ fn summary(
             ""
         }
     ));
-    for (k, metric) in plot.metrics.iter().enumerate() {
-        let values: Vec<(f64, &Vec<f64>)> = plot
-            .rows
+    let at = |v: &[f64]| {
+        plan.runs
+            .swept
             .iter()
-            .filter_map(|(v, m)| m[k].map(|x| (x, v)))
-            .collect();
-        if values.is_empty() {
+            .zip(v)
+            .map(|(s, x)| format!("{} = {x}", s.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    for (metric, seen) in extremes.metrics.iter().zip(&extremes.seen) {
+        let Some(((lo, at_lo), (hi, at_hi), count)) = seen else {
             text.push_str(&format!("  {metric}: no value\n"));
             continue;
-        }
-        let (lo, at_lo) = values.iter().fold((f64::INFINITY, None), |acc, &(x, v)| {
-            if x < acc.0 { (x, Some(v)) } else { acc }
-        });
-        let (hi, at_hi) = values
-            .iter()
-            .fold((f64::NEG_INFINITY, None), |acc, &(x, v)| {
-                if x > acc.0 { (x, Some(v)) } else { acc }
-            });
+        };
         let unit = table::METRICS
             .iter()
             .find(|(n, _)| n == metric)
             .map_or("", |(_, u)| *u);
-        let at = |v: Option<&Vec<f64>>| {
-            v.map(|v| {
-                plan.runs
-                    .swept
-                    .iter()
-                    .zip(v)
-                    .map(|(s, x)| format!("{} = {x}", s.name))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            })
-            .unwrap_or_default()
-        };
         text.push_str(&format!(
-            "  {metric}: {} … {} {unit} (smallest at {}; largest at {}); {} of {runs} runs\n",
-            significant(lo),
-            significant(hi),
+            "  {metric}: {} … {} {unit} (smallest at {}; largest at {}); {count} of {runs} runs\n",
+            significant(*lo),
+            significant(*hi),
             at(at_lo),
             at(at_hi),
-            values.len()
         ));
     }
-    if !plot.complete {
+    if too_many {
         text.push_str(&format!(
             "  no figures: more than {PLOTTED_RUNS} runs (plot the CSV)\n"
         ));
+    }
+    if let Some(peak) = peak_memory_mb() {
+        text.push_str(&format!("  peak memory {peak:.1} MB\n"));
     }
     match csv {
         Some(path) => text.push_str(&format!("  wrote {}\n", path.display())),
