@@ -526,3 +526,66 @@ fn simulate_takes_parameter_values_checked_as_the_file() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("with l1 = 0.4"));
 }
+
+#[test]
+fn ctrl_c_keeps_the_rows_so_far_and_an_older_result_as_it_was() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let dir = scratch("sweep-interrupt");
+    let precious = dir.join("big.csv");
+    std::fs::write(&precious, "an older result\n").expect("write");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_camchain"))
+        .args([
+            "sweep",
+            "paper_concave",
+            "--param",
+            "swing=-0.5:0.5:300",
+            "--param",
+            "k3=20:80:300",
+            "--rtol",
+            "1e-12",
+            "--atol",
+            "1e-12",
+            "--csv",
+            "big.csv",
+        ])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary starts");
+    let partial = dir.join("big.partial.csv");
+    let start = Instant::now();
+    let streamed = loop {
+        let rows = std::fs::read_to_string(&partial).map_or(0, |t| t.lines().count());
+        if rows > 20 || start.elapsed() > Duration::from_secs(30) {
+            break rows;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(streamed > 20, "rows streamed within 30 s: {streamed}");
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success());
+    let output = child.wait_with_output().expect("it ends");
+    assert_eq!(output.status.code(), Some(130));
+    let err = text(&output.stderr);
+    assert!(
+        err.contains("interrupted after") && err.contains("big.partial.csv"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&precious).expect("read"),
+        "an older result\n",
+        "the older result is untouched"
+    );
+    let content = std::fs::read_to_string(&partial).expect("the partial CSV");
+    assert!(content.ends_with('\n'), "the last row is whole");
+    let (_, rows) = rows(&partial);
+    assert!(rows.len() >= 20);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], k.to_string(), "rows in run order, none missing");
+    }
+}

@@ -628,6 +628,7 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
         drop(tx);
         // Rows in run order: a finished row waits until every earlier one is written.
         let mut waiting: BTreeMap<usize, Row> = BTreeMap::new();
+        let mut flushed = Instant::now();
         for (k, row) in rx.iter() {
             waiting.insert(k, row);
             while let Some(row) = waiting.remove(&written) {
@@ -642,6 +643,12 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
                 extremes.add(&row);
                 written += 1;
                 progress.update(written, failed);
+            }
+            // What is computed reaches the file at least every second (a crash or a killed
+            // batch job keeps it).
+            if flushed.elapsed().as_secs() >= 1 {
+                let _ = sink.out().flush();
+                flushed = Instant::now();
             }
             if interrupt.requested() {
                 stop.store(true, Ordering::Relaxed);
