@@ -534,7 +534,7 @@ fn ctrl_c_keeps_the_rows_so_far_and_an_older_result_as_it_was() {
     let dir = scratch("sweep-interrupt");
     let precious = dir.join("big.csv");
     std::fs::write(&precious, "an older result\n").expect("write");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_camchain"))
+    let child = Command::new(env!("CARGO_BIN_EXE_camchain"))
         .args([
             "sweep",
             "paper_concave",
