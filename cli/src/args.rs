@@ -223,30 +223,9 @@ pub struct SweepArgs {
     #[arg(long)]
     pub grid: bool,
 
-    /// End time in seconds [default: the model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
-    pub t_end: Option<f64>,
-
-    /// Output interval in seconds, for --grid [default: the model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
-    pub dt_out: Option<f64>,
-
-    /// Integrator [default: the model's]
-    #[arg(long, value_enum, value_name = "NAME", ignore_case = true)]
-    pub integrator: Option<IntegratorArg>,
-
-    /// Step in seconds: fixed step of rk4, first step of dopri5 and dop853 [default: the
-    /// model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
-    pub dt: Option<f64>,
-
-    /// Relative tolerance of dopri5 and dop853 [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = relative_tolerance, allow_hyphen_values = true)]
-    pub rtol: Option<f64>,
-
-    /// Absolute tolerance of dopri5 and dop853 [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = absolute_tolerance, allow_hyphen_values = true)]
-    pub atol: Option<f64>,
+    /// End time, output interval (for --grid), integrator, step and tolerances.
+    #[command(flatten)]
+    pub integration: IntegrationArgs,
 
     /// Write the CSV to FILE (`-`: standard output); nothing else is written unless --out
     /// is given too [default: DIR/<model>_sweep/<model>_sweep.csv]
@@ -266,7 +245,40 @@ pub struct SweepArgs {
     pub quiet: bool,
 }
 
-impl SweepArgs {
+/// The options of a run's integration, shared by `simulate` and `sweep`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct IntegrationArgs {
+    /// End time in seconds [default: the model's, see `camchain list`]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub t_end: Option<f64>,
+
+    /// Output interval in seconds: one CSV row and one plotted point per interval (for a
+    /// sweep, the grid of --grid) [default: the model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub dt_out: Option<f64>,
+
+    /// Integrator, in any letter case as in model files: rk4 (fixed step --dt), dopri5 or
+    /// dop853 (adaptive, --rtol/--atol, first step --dt; dop853 is the fastest at tight
+    /// tolerances) [default: the model's]
+    #[arg(long, value_enum, value_name = "NAME", ignore_case = true)]
+    pub integrator: Option<IntegratorArg>,
+
+    /// Step in seconds: fixed step of rk4, first step of dopri5 and dop853 [default: the
+    /// model's]
+    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
+
+    /// Relative tolerance of dopri5 and dop853, in [1e-14, 0.1] [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = relative_tolerance, allow_hyphen_values = true)]
+    pub rtol: Option<f64>,
+
+    /// Absolute tolerance of dopri5 and dop853 (rad, m, rad/s, m/s), in [1e-18, 1]
+    /// [default: the model's]
+    #[arg(long, value_name = "TOL", value_parser = absolute_tolerance, allow_hyphen_values = true)]
+    pub atol: Option<f64>,
+}
+
+impl IntegrationArgs {
     /// The model's default settings overridden by the options that were given.
     pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
         SimSettings {
@@ -279,6 +291,13 @@ impl SweepArgs {
             rtol: self.rtol.unwrap_or(defaults.rtol),
             atol: self.atol.unwrap_or(defaults.atol),
         }
+    }
+}
+
+impl SweepArgs {
+    /// The model's default settings overridden by the options that were given.
+    pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
+        self.integration.settings(defaults)
     }
 }
 
@@ -332,34 +351,9 @@ pub struct SimulateArgs {
     #[arg(long = "param", value_name = "NAME=VALUE", allow_hyphen_values = true)]
     pub params: Vec<String>,
 
-    /// End time in seconds [default: the model's, see `camchain list`]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
-    pub t_end: Option<f64>,
-
-    /// Output interval in seconds: one CSV row and one plotted point per interval
-    /// [default: the model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
-    pub dt_out: Option<f64>,
-
-    /// Integrator, in any letter case as in model files: rk4 (fixed step --dt), dopri5 or
-    /// dop853 (adaptive, --rtol/--atol, first step --dt; dop853 is the fastest at tight
-    /// tolerances) [default: the model's]
-    #[arg(long, value_enum, value_name = "NAME", ignore_case = true)]
-    pub integrator: Option<IntegratorArg>,
-
-    /// Step in seconds: fixed step of rk4, first step of dopri5 and dop853 [default: the
-    /// model's]
-    #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
-    pub dt: Option<f64>,
-
-    /// Relative tolerance of dopri5 and dop853, in [1e-14, 0.1] [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = relative_tolerance, allow_hyphen_values = true)]
-    pub rtol: Option<f64>,
-
-    /// Absolute tolerance of dopri5 and dop853 (rad, m, rad/s, m/s), in [1e-18, 1]
-    /// [default: the model's]
-    #[arg(long, value_name = "TOL", value_parser = absolute_tolerance, allow_hyphen_values = true)]
-    pub atol: Option<f64>,
+    /// End time, output interval, integrator, step and tolerances.
+    #[command(flatten)]
+    pub integration: IntegrationArgs,
 
     /// One-sided contact: the follower lifts off where the normal force reaches zero and
     /// lands with this coefficient of restitution (0 plastic … 1 elastic); needs an adaptive
@@ -416,16 +410,7 @@ impl SimulateArgs {
 
     /// The model's default settings overridden by the options that were given.
     pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
-        SimSettings {
-            t_end: self.t_end.unwrap_or(defaults.t_end),
-            dt_out: self.dt_out.unwrap_or(defaults.dt_out),
-            integrator: self
-                .integrator
-                .map_or(defaults.integrator, IntegratorArg::kind),
-            dt: self.dt.unwrap_or(defaults.dt),
-            rtol: self.rtol.unwrap_or(defaults.rtol),
-            atol: self.atol.unwrap_or(defaults.atol),
-        }
+        self.integration.settings(defaults)
     }
 
     /// True when the CSV goes to standard output (`--csv -`).

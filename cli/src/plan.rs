@@ -93,7 +93,7 @@ fn checked_settings(model: &LoadedModel, args: &SimulateArgs) -> Result<SimSetti
                 "--restitution needs an adaptive integrator (dopri5 or dop853), which locates \
                  lift-off and landing on its dense output; {} would run rk4{}",
                 model.label,
-                if args.integrator.is_some() {
+                if args.integration.integrator.is_some() {
                     " (--integrator rk4)"
                 } else {
                     ", its default: add --integrator dop853"
@@ -114,11 +114,11 @@ fn checked_settings(model: &LoadedModel, args: &SimulateArgs) -> Result<SimSetti
 /// A setting out of range, attributed to the options that set it or to the model file.
 fn setting_error(e: &InvalidSetting, args: &SimulateArgs, model: &LoadedModel) -> CliError {
     let given = |flag: &str| match flag {
-        "--t-end" => args.t_end.is_some(),
-        "--dt-out" => args.dt_out.is_some(),
-        "--dt" => args.dt.is_some(),
-        "--rtol" => args.rtol.is_some(),
-        "--atol" => args.atol.is_some(),
+        "--t-end" => args.integration.t_end.is_some(),
+        "--dt-out" => args.integration.dt_out.is_some(),
+        "--dt" => args.integration.dt.is_some(),
+        "--rtol" => args.integration.rtol.is_some(),
+        "--atol" => args.integration.atol.is_some(),
         _ => false,
     };
     let flags: &[&str] = match e.field {

@@ -320,28 +320,8 @@ fn draw_lines<DB: DrawingBackend>(
 ) -> Result<(), PlotError> {
     let area = caption(area, &p.title)?;
     let (x0, x1) = p.x_range;
-    let (power, y_label) = scaled_axis(p.y_range, &p.y_label);
-    let scale = 10f64.powi(-power);
+    let (mut chart, scale) = axes(&area, (&p.x_label, &p.y_label), p.x_range, p.y_range)?;
     let (y0, y1) = (p.y_range.0 * scale, p.y_range.1 * scale);
-    let mut chart = ChartBuilder::on(&area)
-        .margin(MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    let (x_format, y_format) = (tick_format(p.x_range), tick_format((y0, y1)));
-    chart
-        .configure_mesh()
-        .x_desc(p.x_label.as_str())
-        .y_desc(y_label.as_str())
-        .x_label_formatter(&x_format)
-        .y_label_formatter(&y_format)
-        .x_labels(10)
-        .y_labels(7)
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_SIZE))
-        .bold_line_style(GRID_BOLD)
-        .light_line_style(GRID_LIGHT)
-        .draw()?;
     if p.zero_line && y0 < 0.0 && y1 > 0.0 {
         chart.draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], NEUTRAL))?;
     }
@@ -385,6 +365,47 @@ fn draw_lines<DB: DrawingBackend>(
             .draw()?;
     }
     Ok(())
+}
+
+/// A chart on f64 axes.
+type Chart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// A chart of line or point plots: labelled axes with a grid, y plotted in a power of ten
+/// when its values are too small or too large for plain tick labels; returns the chart and
+/// the factor the y values are to be multiplied by.
+fn axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    (x_label, y_label): (&str, &str),
+    (x0, x1): (f64, f64),
+    y_range: (f64, f64),
+) -> Result<(Chart<'a, DB>, f64), PlotError> {
+    let (power, y_label) = scaled_axis(y_range, y_label);
+    let scale = 10f64.powi(-power);
+    let (y0, y1) = (y_range.0 * scale, y_range.1 * scale);
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    let (x_format, y_format) = (tick_format((x0, x1)), tick_format((y0, y1)));
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label.as_str())
+        .x_label_formatter(&x_format)
+        .y_label_formatter(&y_format)
+        .x_labels(10)
+        .y_labels(7)
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_SIZE))
+        .bold_line_style(GRID_BOLD)
+        .light_line_style(GRID_LIGHT)
+        .draw()?;
+    Ok((chart, scale))
 }
 
 /// The cell edges around increasing grid values: midway between neighbours, half a gap
@@ -513,27 +534,8 @@ fn draw_points<DB: DrawingBackend>(
     p: &PointsPanel,
 ) -> Result<(), PlotError> {
     let area = caption(area, &p.title)?;
-    let (x0, x1) = p.x_range;
-    let (power, y_label) = scaled_axis(p.y_range, &p.y_label);
-    let scale = 10f64.powi(-power);
-    let (y0, y1) = (p.y_range.0 * scale, p.y_range.1 * scale);
-    let mut chart = ChartBuilder::on(&area)
-        .margin(MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    let (x_format, y_format) = (tick_format(p.x_range), tick_format((y0, y1)));
-    chart
-        .configure_mesh()
-        .x_desc(p.x_label.as_str())
-        .y_desc(y_label.as_str())
-        .x_label_formatter(&x_format)
-        .y_label_formatter(&y_format)
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_SIZE))
-        .bold_line_style(GRID_BOLD)
-        .light_line_style(GRID_LIGHT)
-        .draw()?;
+    let (mut chart, scale) = axes(&area, (&p.x_label, &p.y_label), p.x_range, p.y_range)?;
+    let y0 = p.y_range.0 * scale;
     let color = RGBColor(31, 119, 180);
     chart.draw_series(
         p.points

@@ -19,14 +19,83 @@ const LINE_EVERY: Duration = Duration::from_secs(10);
 /// Resolution of the bar (positions per run).
 const STEPS: u64 = 1000;
 
-/// How progress is shown.
-enum Display {
+/// How progress is shown: shared by a run's progress (in simulated time) and a sweep's (in
+/// runs).
+pub enum Display {
     /// Nothing (`--quiet`).
     None,
-    /// A bar on a terminal, drawn once the run has lasted [`SHOW_AFTER`].
-    Bar { bar: ProgressBar, shown: bool },
+    /// A bar on a terminal, drawn once the work has lasted [`SHOW_AFTER`].
+    Bar {
+        /// The bar (hidden until shown).
+        bar: ProgressBar,
+        /// Drawn yet.
+        shown: bool,
+    },
     /// A line now and then on standard error; `next` is when the next one is due.
-    Lines { next: Duration },
+    Lines {
+        /// When the next line is due.
+        next: Duration,
+    },
+}
+
+impl Display {
+    /// Nothing unless `enabled`; a bar of `length` positions in the `template` style when
+    /// `terminal`, else occasional lines.
+    pub fn new(enabled: bool, terminal: bool, template: &str, length: u64, prefix: &str) -> Self {
+        if !enabled {
+            return Display::None;
+        }
+        if !terminal {
+            return Display::Lines { next: LINE_EVERY };
+        }
+        let style = ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> ");
+        let bar = ProgressBar::with_draw_target(Some(length), ProgressDrawTarget::hidden())
+            .with_style(style)
+            .with_prefix(prefix.to_string());
+        Display::Bar { bar, shown: false }
+    }
+
+    /// Reports progress `elapsed` into the work: the bar at `position` with `message`, or,
+    /// when one is due, the line `line()`.
+    pub fn tick(
+        &mut self,
+        elapsed: Duration,
+        position: u64,
+        message: impl FnOnce() -> String,
+        line: impl FnOnce() -> String,
+    ) {
+        match self {
+            Display::None => {}
+            Display::Bar { bar, shown } => {
+                if !*shown {
+                    if elapsed < SHOW_AFTER {
+                        return;
+                    }
+                    bar.set_draw_target(ProgressDrawTarget::stderr());
+                    *shown = true;
+                }
+                bar.set_position(position);
+                bar.set_message(message());
+            }
+            Display::Lines { next } => {
+                if elapsed < *next {
+                    return;
+                }
+                *next = elapsed + LINE_EVERY;
+                // A closed standard error is no reason to stop the work.
+                let _ = writeln!(std::io::stderr(), "{}", line());
+            }
+        }
+    }
+
+    /// Removes the bar from the terminal.
+    pub fn finish(&self) {
+        if let Display::Bar { bar, .. } = self {
+            bar.finish_and_clear();
+        }
+    }
 }
 
 /// Progress of one run in simulated time.
@@ -42,21 +111,13 @@ impl Progress {
     /// Progress of a run from `t0` to `t_end`, shown only if `enabled`: as a bar when
     /// standard output is a terminal, else as occasional lines.
     pub fn new(label: &str, t0: f64, t_end: f64, enabled: bool) -> Self {
-        let display = if !enabled {
-            Display::None
-        } else if std::io::stdout().is_terminal() {
-            let style = ProgressStyle::with_template(
-                "{prefix} [{bar:40.cyan/blue}] {msg} ({elapsed}, about {eta} left)",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> ");
-            let bar = ProgressBar::with_draw_target(Some(STEPS), ProgressDrawTarget::hidden())
-                .with_style(style)
-                .with_prefix(label.to_string());
-            Display::Bar { bar, shown: false }
-        } else {
-            Display::Lines { next: LINE_EVERY }
-        };
+        let display = Display::new(
+            enabled,
+            std::io::stdout().is_terminal(),
+            "{prefix} [{bar:40.cyan/blue}] {msg} ({elapsed}, about {eta} left)",
+            STEPS,
+            label,
+        );
         Progress {
             display,
             label: label.to_string(),
@@ -80,36 +141,19 @@ impl Progress {
     pub fn update(&mut self, t: f64) {
         let elapsed = self.start.elapsed();
         let fraction = self.fraction(t);
-        match &mut self.display {
-            Display::None => {}
-            Display::Bar { bar, shown } => {
-                if !*shown {
-                    if elapsed < SHOW_AFTER {
-                        return;
-                    }
-                    bar.set_draw_target(ProgressDrawTarget::stderr());
-                    *shown = true;
-                }
-                bar.set_position((fraction * STEPS as f64).round() as u64);
-                bar.set_message(format!("t = {t:.3} of {} s", self.t_end));
-            }
-            Display::Lines { next } => {
-                if elapsed < *next {
-                    return;
-                }
-                *next = elapsed + LINE_EVERY;
-                let line = progress_line(&self.label, t, self.t_end, fraction, elapsed);
-                // A closed standard error is no reason to stop a run.
-                let _ = writeln!(std::io::stderr(), "{line}");
-            }
-        }
+        let t_end = self.t_end;
+        let label = &self.label;
+        self.display.tick(
+            elapsed,
+            (fraction * STEPS as f64).round() as u64,
+            || format!("t = {t:.3} of {t_end} s"),
+            || progress_line(label, t, t_end, fraction, elapsed),
+        );
     }
 
     /// Removes the bar from the terminal.
     pub fn finish(&self) {
-        if let Display::Bar { bar, .. } = &self.display {
-            bar.finish_and_clear();
-        }
+        self.display.finish();
     }
 }
 

@@ -760,14 +760,9 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
     let mut half: HashMap<Vec<u32>, (Option<Id>, Option<Id>)> = HashMap::new();
     for (i, &needed) in in_position.iter().enumerate() {
         let id = id_at(g, i);
-        let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+        let Some((f, _, vars)) = angle_trig(g, id).filter(|_| needed) else {
             continue;
         };
-        let mut vars = Vec::new();
-        if !needed || !angle_vars(g, arg, &mut vars) {
-            continue;
-        }
-        vars.sort_unstable();
         let entry = half.entry(vars).or_default();
         if f == Func::Sin {
             entry.0 = Some(id);
@@ -785,14 +780,10 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
     let mut replacements = Vec::new();
     for (i, (&velocity_needs, &position_has)) in in_velocity.iter().zip(&in_position).enumerate() {
         let id = id_at(g, i);
-        let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+        let Some((f, arg, vars)) = angle_trig(g, id).filter(|_| velocity_needs && !position_has)
+        else {
             continue;
         };
-        let mut vars = Vec::new();
-        if !velocity_needs || position_has || !angle_vars(g, arg, &mut vars) {
-            continue;
-        }
-        vars.sort_unstable();
         let rebuilt = g.rebuild_as(id, |g| trig_from_known(g, f, &vars, &known).unwrap_or(id));
         if rebuilt != id {
             // Named like the call it replaces (`c_q2` for cos q2).
@@ -896,6 +887,20 @@ fn multiset_sum(p: &[u32], r: &[u32]) -> Vec<u32> {
     all
 }
 
+/// For a sine or cosine of a joint angle (a coordinate or a sum of them): the function,
+/// the angle and its variables, sorted.
+fn angle_trig(g: &Graph, id: Id) -> Option<(Func, Id, Vec<u32>)> {
+    let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+        return None;
+    };
+    let mut vars = Vec::new();
+    if !angle_vars(g, arg, &mut vars) {
+        return None;
+    }
+    vars.sort_unstable();
+    Some((f, arg, vars))
+}
+
 /// The sine–cosine pairs of joint angles (a coordinate or a sum of them) among the
 /// `reachable` nodes, each given three cache entries in creation order.
 fn trig_pairs(g: &Graph, reachable: &[bool], params: &[Id]) -> Vec<TrigMemo> {
@@ -903,13 +908,9 @@ fn trig_pairs(g: &Graph, reachable: &[bool], params: &[Id]) -> Vec<TrigMemo> {
     let mut cosines: HashMap<Id, Id> = HashMap::new();
     for (i, &needed) in reachable.iter().enumerate() {
         let id = id_at(g, i);
-        let Node::Call(f @ (Func::Sin | Func::Cos), arg) = g.node(id) else {
+        let Some((f, arg, vars)) = angle_trig(g, id).filter(|_| needed) else {
             continue;
         };
-        let mut vars = Vec::new();
-        if !needed || !angle_vars(g, arg, &mut vars) {
-            continue;
-        }
         if vars.iter().any(|&k| params.contains(&g.var_id(k))) {
             continue;
         }
@@ -1469,17 +1470,32 @@ fn emit_function_full(
     }
     text.push_str(prelude);
     text.push_str(&bindings);
+    let mut fields = String::new();
     for (target, id) in &spec.outputs {
         if target == RETURN {
             let _ = writeln!(text, "{}", body.print(*id, 0));
+        } else if let Some(field) = target.strip_prefix(FIELD) {
+            let value = body.print(*id, 0);
+            if value == field {
+                let _ = writeln!(fields, "{field},");
+            } else {
+                let _ = writeln!(fields, "{field}: {value},");
+            }
         } else {
             let _ = writeln!(text, "{target} = {};", body.print(*id, 0));
         }
     }
-    text.push_str(&spec.tail);
+    text.push_str(&spec.tail.replace(FIELDS, &fields));
     text.push_str("\n}\n");
     (text, count)
 }
+
+/// Output target prefix `field:name`: the value becomes `name: value,` in the place of
+/// [`FIELDS`] in the function's tail (a struct built in one literal).
+pub(crate) const FIELD: &str = "field:";
+
+/// Where the fields of [`FIELD`] targets go in a function's tail.
+pub(crate) const FIELDS: &str = "__fields__";
 
 /// `let q1 = q[0];` lines for the variables the function uses, with the parameter they read.
 fn input_bindings(d: &Derivation, used: &HashSet<Id>) -> Vec<(&'static str, String)> {

@@ -409,13 +409,7 @@ impl NumericModel {
         overrides: &[(String, f64)],
         mode: ParameterMode,
     ) -> Result<Self, ModelError> {
-        let source = std::fs::read_to_string(path).map_err(|e| ModelError {
-            file: path.to_path_buf(),
-            line: 0,
-            column: 0,
-            field: String::new(),
-            message: format!("cannot read the file: {e}"),
-        })?;
+        let source = camchain_codegen::read_model_file(path, path)?;
         Self::from_source_with(&source, path, overrides, mode)
     }
 

@@ -284,7 +284,7 @@ const FOLDED: &[(&str, rt::parameters::Location)] = &[
     ("g", rt::parameters::Location::at(FILE, 37, 69, "parameters[17].constant")),
 ];
 /// The quantities that depend on the run-time parameters alone, computed once per parameter set by [`derive`].
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Derived {
     k2: f64,
     k3: f64,
@@ -305,21 +305,21 @@ fn derive(p: &Parameters) -> Derived {
     let c2 = p.c2;
     let c3 = p.c3;
     let c4 = p.c4;
-    let mut derived = Derived::default();
     // energy
     let half_stiffness_q2 = 0.5 * k2;
     let half_stiffness_q3 = 0.5 * k3;
     let half_stiffness_q4 = 0.5 * k4;
-    derived.k2 = k2;
-    derived.k3 = k3;
-    derived.k4 = k4;
-    derived.c2 = c2;
-    derived.c3 = c3;
-    derived.c4 = c4;
-    derived.half_stiffness_q2 = half_stiffness_q2;
-    derived.half_stiffness_q3 = half_stiffness_q3;
-    derived.half_stiffness_q4 = half_stiffness_q4;
-    derived
+    Derived {
+        k2,
+        k3,
+        k4,
+        c2,
+        c3,
+        c4,
+        half_stiffness_q2,
+        half_stiffness_q3,
+        half_stiffness_q4,
+    }
 }
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
 /// The build's checks of every value that depends on the run-time parameters, with its messages and locations in the model file.

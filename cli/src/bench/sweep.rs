@@ -163,8 +163,11 @@ fn sweep_args(n: usize, tolerance: f64, jobs: usize, csv: &std::path::Path) -> S
         model: "paper_concave".into(),
         params: vec![format!("swing=0.05:0.15:{n}"), format!("k3=30:50:{n}")],
         jobs: Some(jobs),
-        rtol: Some(tolerance),
-        atol: Some(tolerance),
+        integration: crate::args::IntegrationArgs {
+            rtol: Some(tolerance),
+            atol: Some(tolerance),
+            ..Default::default()
+        },
         csv: Some(csv.to_path_buf()),
         no_plots: true,
         quiet: true,

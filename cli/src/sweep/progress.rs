@@ -1,22 +1,10 @@
 //! Progress of a sweep, in runs: on a terminal a bar with the runs done, the failures and
 //! the time left (shown after a second); without one (a batch job's log) a line every 10 s;
-//! neither with `--quiet`. The same conventions as a single run's progress.
+//! neither with `--quiet`. The display is a single run's ([`crate::progress::Display`]).
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::{IsTerminal, Write};
+use crate::progress::Display;
+use std::io::IsTerminal;
 use std::time::{Duration, Instant};
-
-/// How long a sweep goes before its bar appears.
-const SHOW_AFTER: Duration = Duration::from_secs(1);
-
-/// Without a terminal: one line per this interval.
-const LINE_EVERY: Duration = Duration::from_secs(10);
-
-enum Display {
-    None,
-    Bar { bar: ProgressBar, shown: bool },
-    Lines { next: Duration },
-}
 
 /// Progress of a sweep of `total` runs.
 pub struct Progress {
@@ -29,22 +17,13 @@ pub struct Progress {
 impl Progress {
     /// Progress shown only if `enabled`; a bar when standard error is a terminal.
     pub fn new(label: &str, total: usize, enabled: bool) -> Self {
-        let display = if !enabled {
-            Display::None
-        } else if std::io::stderr().is_terminal() {
-            let style = ProgressStyle::with_template(
-                "{prefix} [{bar:40.cyan/blue}] {pos}/{len} runs, {msg} ({elapsed}, about {eta} left)",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> ");
-            let bar =
-                ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::hidden())
-                    .with_style(style)
-                    .with_prefix(label.to_string());
-            Display::Bar { bar, shown: false }
-        } else {
-            Display::Lines { next: LINE_EVERY }
-        };
+        let display = Display::new(
+            enabled,
+            std::io::stderr().is_terminal(),
+            "{prefix} [{bar:40.cyan/blue}] {pos}/{len} runs, {msg} ({elapsed}, about {eta} left)",
+            total as u64,
+            label,
+        );
         Progress {
             display,
             label: label.to_string(),
@@ -56,35 +35,18 @@ impl Progress {
     /// `done` runs written, `failed` of them failed.
     pub fn update(&mut self, done: usize, failed: usize) {
         let elapsed = self.start.elapsed();
-        match &mut self.display {
-            Display::None => {}
-            Display::Bar { bar, shown } => {
-                if !*shown {
-                    if elapsed < SHOW_AFTER {
-                        return;
-                    }
-                    bar.set_draw_target(ProgressDrawTarget::stderr());
-                    *shown = true;
-                }
-                bar.set_position(done as u64);
-                bar.set_message(format!("{failed} failed"));
-            }
-            Display::Lines { next } => {
-                if elapsed < *next {
-                    return;
-                }
-                *next = elapsed + LINE_EVERY;
-                let line = line(&self.label, done, self.total, failed, elapsed);
-                let _ = writeln!(std::io::stderr(), "{line}");
-            }
-        }
+        let (label, total) = (&self.label, self.total);
+        self.display.tick(
+            elapsed,
+            done as u64,
+            || format!("{failed} failed"),
+            || line(label, done, total, failed, elapsed),
+        );
     }
 
     /// Removes the bar.
     pub fn finish(&self) {
-        if let Display::Bar { bar, .. } = &self.display {
-            bar.finish_and_clear();
-        }
+        self.display.finish();
     }
 }
 

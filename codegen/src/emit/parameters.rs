@@ -5,7 +5,8 @@
 //! right-hand side calls read a stored number wherever the folded code had a constant.
 
 use super::{
-    ALLOW_LITERALS, ALLOW_UNUSED, FunctionSpec, Param, emit_function_given, lit, sanitize,
+    ALLOW_LITERALS, ALLOW_UNUSED, FIELD, FIELDS, FunctionSpec, Param, emit_function_given, lit,
+    sanitize,
 };
 use crate::derive::Derivation;
 use crate::expr::{Graph, Id, OpCount};
@@ -95,7 +96,7 @@ impl RuntimeParameters {
         format!(
             "/// The quantities that depend on the run-time parameters alone, computed once per \
              parameter set by [`derive`].\n\
-             #[derive(Debug, Clone, Copy, Default, PartialEq)]\n\
+             #[derive(Debug, Clone, Copy, PartialEq)]\n\
              struct Derived {{\n{fields}}}\n"
         )
     }
@@ -115,17 +116,11 @@ impl RuntimeParameters {
             outputs: self
                 .derived
                 .iter()
-                .map(|(id, name)| (format!("derived.{name}"), *id))
+                .map(|(id, name)| (format!("{FIELD}{name}"), *id))
                 .collect(),
-            tail: "derived".into(),
+            tail: format!("Derived {{ {FIELDS} }}"),
         };
-        let (text, count) = emit_function_given(
-            d,
-            &spec,
-            "let mut derived = Derived::default();\n",
-            false,
-            &[],
-        );
+        let (text, count) = emit_function_given(d, &spec, "", false, &[]);
         (format!("{ALLOW_LITERALS}\n{text}"), count)
     }
 }

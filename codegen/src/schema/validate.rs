@@ -386,12 +386,7 @@ impl Context<'_> {
         key: Field,
         what: &'static str,
     ) -> Checked<f64> {
-        let value = self.raw_number(field, n, Some(key), false)?;
-        if self.table.is_runtime(key) {
-            self.table
-                .check(RuntimeCheck::Positive(key, what, location(self.at, field)));
-        }
-        positive(self.at, field, what, value)
+        self.signed(field, n, key, what, true)
     }
 
     /// A numeric field that must be non-negative (a stiffness, a damping).
@@ -402,15 +397,32 @@ impl Context<'_> {
         key: Field,
         what: &'static str,
     ) -> Checked<f64> {
+        self.signed(field, n, key, what, false)
+    }
+
+    /// [`Context::positive`] (`strict`) or [`Context::non_negative`].
+    fn signed(
+        &self,
+        field: &str,
+        n: &raw::Number,
+        key: Field,
+        what: &'static str,
+        strict: bool,
+    ) -> Checked<f64> {
         let value = self.raw_number(field, n, Some(key), false)?;
         if self.table.is_runtime(key) {
-            self.table.check(RuntimeCheck::NonNegative(
-                key,
-                what,
-                location(self.at, field),
-            ));
+            let at = location(self.at, field);
+            self.table.check(if strict {
+                RuntimeCheck::Positive(key, what, at)
+            } else {
+                RuntimeCheck::NonNegative(key, what, at)
+            });
         }
-        non_negative(self.at, field, what, value)
+        if strict {
+            positive(self.at, field, what, value)
+        } else {
+            non_negative(self.at, field, what, value)
+        }
     }
 
     /// Three numeric fields `field[0..3]`, keyed by component.
