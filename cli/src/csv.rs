@@ -19,7 +19,7 @@ pub fn header(info: &ModelInfo) -> Vec<String> {
     let mut columns = vec!["t".to_string()];
     columns.extend(info.coordinates.iter().map(|c| c.name.clone()));
     columns.extend(info.coordinates.iter().map(|c| format!("{}_dot", c.name)));
-    for contact in &info.contacts {
+    for contact in info.contacts.iter().map(|c| &c.name) {
         let axes: &[&str] = if info.spatial {
             &["x", "y", "z"]
         } else {

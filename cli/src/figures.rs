@@ -122,7 +122,7 @@ fn coordinate_panel(
 }
 
 fn position_axis(run: &RunView, k: usize) -> String {
-    let name = &run.info.contacts[k];
+    let name = &run.info.contacts[k].name;
     let ground = run.geometry.is_some_and(|g| g.plane.is_ground());
     if ground && k == 0 {
         format!("{name}_x [m]")
@@ -142,7 +142,7 @@ fn position_panel(
     LinePanel {
         title: format!(
             "{prefix}{}: position of the contact point along the cam",
-            run.info.contacts[k]
+            run.info.contacts[k].name
         ),
         x_label: TIME_AXIS.into(),
         y_label: position_axis(run, k),
@@ -199,7 +199,7 @@ pub fn contact(run: &RunView) -> Option<Figure> {
         return None;
     }
     let mut panels = Vec::new();
-    for (k, name) in run.info.contacts.iter().enumerate() {
+    for (k, name) in run.info.contacts.iter().map(|c| &c.name).enumerate() {
         let force: Vec<(f64, f64)> = run
             .samples
             .iter()
@@ -402,8 +402,8 @@ pub fn comparison(a: &RunView, b: &RunView, coords: &[String]) -> Figure {
             ],
         });
     }
-    for (k, name) in a.info.contacts.iter().enumerate() {
-        let Some(l) = b.info.contacts.iter().position(|c| c == name) else {
+    for (k, name) in a.info.contacts.iter().map(|c| &c.name).enumerate() {
+        let Some(l) = b.info.contact_index(name) else {
             continue;
         };
         let range = padded(union(

@@ -7,7 +7,7 @@
 //! body's frame. Everything is projected on the plane of the first cam (the ground x–y
 //! plane when there is no cam), where the profile y = f(x) is drawn.
 
-use camchain_codegen::model::{JointKind, Model};
+use camchain_codegen::model::{JointKind, Model, Profile};
 use camchain_codegen::profile::Scalar;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
@@ -105,7 +105,10 @@ impl Geometry {
                     x_axis: Vec3::from(c.x_axis),
                     y_axis: Vec3::from(c.y_axis),
                 },
-                Some((c.profile.clone(), c.profile_source.clone())),
+                match &c.profile {
+                    Profile::Explicit { f, source } => Some((f.clone(), source.clone())),
+                    _ => None,
+                },
             ),
             None => (Plane::ground(), None),
         };
@@ -211,7 +214,7 @@ mod tests {
             let info = model.info();
             let q: Vec<f64> = (0..info.n()).map(|i| 0.3 - 0.17 * i as f64).collect();
             let mut contacts = vec![ContactGeometry::default(); info.n_contacts()];
-            model.contact_geometry(&q, &mut contacts);
+            model.contact_geometry(&q, &vec![0.0; q.len()], &mut contacts);
             let pose = geometry.pose(&q);
             for (k, c) in contacts.iter().enumerate() {
                 for axis in 0..3 {

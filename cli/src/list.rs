@@ -37,7 +37,11 @@ fn describe(name: &str, info: &ModelInfo) -> String {
     let contacts = if info.contacts.is_empty() {
         "none".to_string()
     } else {
-        info.contacts.join(", ")
+        info.contacts
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     };
     let kind = if info.spatial { "spatial" } else { "planar" };
     let _ = writeln!(text, "  contacts:    {contacts} ({kind})");

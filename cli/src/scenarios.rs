@@ -9,7 +9,7 @@
 //! generated code ([`camchain_models::by_name`]).
 
 use camchain_codegen::model::Field;
-use camchain_codegen::model::{Model, Prescribed};
+use camchain_codegen::model::{Model, Prescribed, Profile};
 use camchain_codegen::schema::parse_model;
 use camchain_reference::NumericModel;
 use camchain_runtime::{
@@ -183,8 +183,10 @@ pub fn with_profile(mut model: Model, k: usize, source: &str) -> Result<Model, S
         .contacts
         .get_mut(k)
         .ok_or_else(|| format!("the model has no contact {k}"))?;
-    contact.profile_source = source.to_string();
-    contact.profile = profile;
+    contact.profile = Profile::Explicit {
+        source: source.to_string(),
+        f: profile,
+    };
     Ok(model)
 }
 

@@ -828,7 +828,12 @@ fn non_finite(_ctx: &Context) -> Result<Section, CliError> {
     let source = convex
         .contacts
         .first()
-        .map(|c| format!("{} + 0.0*x.sqrt()", c.profile_source))
+        .and_then(|c| match &c.profile {
+            camchain_codegen::model::Profile::Explicit { source, .. } => {
+                Some(format!("{source} + 0.0*x.sqrt()"))
+            }
+            _ => None,
+        })
         .unwrap_or_default();
     let model = stress::with_profile(convex.clone(), 0, &source).map_err(failed)?;
     let sweep = stress::sweep(1.0, 0.01, &[1e-2, 1e-3], &[1e-6, 1e-8, 1e-10]);

@@ -133,7 +133,7 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
     } else {
         &["x", "y"]
     };
-    for (k, name) in info.contacts.iter().enumerate() {
+    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
         for (a, axis) in axes.iter().enumerate() {
             let (lo, hi) = range(samples, |s| s.contacts[k].position[a]);
             rows.push((format!("{name}_{axis} [m]"), lo, hi));
@@ -210,7 +210,7 @@ pub fn render(report: &RunReport) -> String {
             );
         }
         let mut checks = Vec::new();
-        for (k, name) in info.contacts.iter().enumerate() {
+        for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
             // In flight (one-sided contact, no dependent coordinate) h is the gap, not a
             // residual.
             let max_h = samples
@@ -249,7 +249,7 @@ pub fn render(report: &RunReport) -> String {
         return text;
     }
     // RK4 runs locate no events: the sign change is interpolated between outputs.
-    for (k, name) in info.contacts.iter().enumerate() {
+    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
         match lift_off(samples, k) {
             Some(l) if l.from_start => {
                 let _ = writeln!(
@@ -279,7 +279,10 @@ const LISTED_EVENTS: usize = 8;
 fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
     let mut text = String::new();
     for event in events.iter().take(LISTED_EVENTS) {
-        let name = info.contacts.get(event.contact).map_or("?", String::as_str);
+        let name = info
+            .contacts
+            .get(event.contact)
+            .map_or("?", |c| c.name.as_str());
         let what = match event.kind {
             EventKind::ForceBecameNegative => format!(
                 "warning: the normal force on {name} becomes negative: a one-sided follower \
@@ -419,7 +422,7 @@ pub fn result_warnings(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
     let Some(first) = samples.first() else {
         return out;
     };
-    for (k, name) in info.contacts.iter().enumerate() {
+    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
         let in_contact: Vec<&Sample> = samples.iter().filter(|s| !s.dependent.is_empty()).collect();
         let negative = in_contact
             .iter()

@@ -60,7 +60,7 @@ fn expected(info: &camchain_runtime::ModelInfo, sample: &Sample, column: &str) -
             return sample.drive[i];
         }
     }
-    for (k, name) in info.contacts.iter().enumerate() {
+    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
         let position = &sample.contacts[k].position;
         match column.strip_prefix(name.as_str()) {
             Some("_x") => return position[0],

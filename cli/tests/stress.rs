@@ -247,7 +247,8 @@ fn steep_flat_and_wavy_profiles_conserve_energy() {
         let slopes: Vec<f64> = trajectory
             .samples
             .iter()
-            .map(|s| s.contacts[0].slope)
+            // The normal (−f′, 1)/√(1 + f′²): its x has the sign of −f′.
+            .map(|s| -s.contacts[0].normal[0])
             .collect();
         let curvatures: Vec<f64> = trajectory
             .samples
@@ -309,7 +310,11 @@ fn non_finite_values_stop_the_run_and_name_the_quantity() {
     // A profile undefined for x < 0 (the convex cam plus 0·√x): the tip slides left and
     // reaches x = 0 near t = 0.39 s.
     let convex = paper("paper_convex");
-    let profile = format!("{} + 0.0*x.sqrt()", convex.contacts[0].profile_source);
+    let camchain_codegen::model::Profile::Explicit { source, .. } = &convex.contacts[0].profile
+    else {
+        panic!("the paper's cam is explicit");
+    };
+    let profile = format!("{source} + 0.0*x.sqrt()");
     let model = stress::numeric(stress::with_profile(convex.clone(), 0, &profile).expect("parses"));
     for integration in stress::sweep(1.0, 0.01, &[1e-3], &[1e-8]) {
         let record = run(&model, &integration);

@@ -1,7 +1,7 @@
 //! The whole symbolic derivation of a model: kinematics, cam constraints, dynamics, energy
 //! and prescribed motions, all in one expression graph.
 
-use crate::constraint::{ContactTerms, contact_terms, scalar_to_expr, value_and_derivatives};
+use crate::contact::{ContactTerms, contact_terms, scalar_to_expr, value_and_derivatives};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{Symbols, forward};
@@ -78,7 +78,12 @@ impl Derivation {
         let fields = model
             .symbolic
             .iter()
-            .filter(|(f, _)| !matches!(f, Field::Profile(_) | Field::Drive(_)))
+            .filter(|(f, _)| {
+                !matches!(
+                    f,
+                    Field::Profile(_) | Field::ProfileY(_) | Field::Drive(_) | Field::Load(_)
+                )
+            })
             .map(|(&f, expr)| (f, scalar_to_expr(&mut g, expr, zero, &symbols.params)))
             .collect();
         Derivation {
@@ -143,33 +148,50 @@ impl Derivation {
             &mut e.gravity,
             &mut e.spring,
             &mut e.damper_power,
+            &mut e.load_power,
         ] {
             f(3, id);
         }
         let mut group = 4;
         for c in &mut self.contacts {
-            c.position.iter_mut().for_each(|id| f(group, id));
-            for id in [
-                &mut c.f1,
-                &mut c.f2,
-                &mut c.conv1,
-                &mut c.conv2,
-                &mut c.slope,
-                &mut c.curvature,
-                &mut c.h,
-            ] {
+            let r = &mut c.relative;
+            for id in r.point.iter_mut().chain(&mut r.xy).chain(&mut r.convective) {
                 f(group, id);
             }
-            c.j1.iter_mut().for_each(|id| f(group, id));
-            c.j2.iter_mut().for_each(|id| f(group, id));
+            for column in &mut r.columns {
+                column.iter_mut().for_each(|id| f(group, id));
+            }
+            for id in c
+                .position
+                .iter_mut()
+                .chain(&mut c.cam_point)
+                .chain(&mut c.normal)
+                .chain([
+                    &mut c.force_scale,
+                    &mut c.parameter,
+                    &mut c.curvature,
+                    &mut c.h,
+                ])
+            {
+                f(group, id);
+            }
             c.jacobian.iter_mut().for_each(|id| f(group + 1, id));
             f(group + 1, &mut c.bias);
+            f(group + 1, &mut c.sliding);
             group += 2;
         }
         for d in &mut self.drives {
             d.motion.iter_mut().for_each(|id| f(group, id));
             group += 1;
         }
+    }
+
+    /// True when the model reads parameters at run time (the generated code has `Derived`).
+    pub fn has_runtime_parameters(&self) -> bool {
+        self.symbols
+            .params
+            .iter()
+            .any(|&p| matches!(self.graph.node(p), crate::expr::Node::Var(_)))
     }
 
     /// Values of the graph's variables for a state (q, q̇, t), for [`Graph::eval`].

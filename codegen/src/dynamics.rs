@@ -49,7 +49,11 @@ pub fn backward(
         .enumerate()
         .map(|(i, &grav)| {
             let spring = spring_damper_load(g, model, s, i);
-            g.add(grav, spring)
+            let passive = g.add(grav, spring);
+            match joint_load(g, model, s, i) {
+                Some(load) => g.sub(passive, load),
+                None => passive,
+            }
         })
         .collect();
     DynamicsTerms {
@@ -481,6 +485,19 @@ fn spring_damper_load(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Id
     g.add(ks, cv)
 }
 
+/// The applied load τ(t, q, q̇) of joint i, if it has one: it enters Q as −τ (a torque in
+/// the direction of the coordinate drives it forward).
+pub fn joint_load(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Option<Id> {
+    let load = model.bodies[i].joint.load.as_ref()?;
+    let expr = s.expression(model, Field::Load(i), &load.expr);
+    // Parameter indices past the model's parameters are the coordinates, then their rates
+    // (`JointLoad::expr`).
+    let variables: Vec<Id> = s.params.iter().chain(&s.q).chain(&s.qd).copied().collect();
+    let tau = crate::contact::scalar_to_expr(g, expr, s.t, &variables);
+    g.label(tau, format!("load_{}", model.bodies[i].joint.coordinate));
+    Some(tau)
+}
+
 /// Energy expressions: kinetic (from body velocities), gravity and spring potentials.
 #[derive(Debug, Clone, Copy)]
 pub struct EnergyTerms {
@@ -492,6 +509,8 @@ pub struct EnergyTerms {
     pub spring: Id,
     /// Σ c q̇², the power the dampers dissipate.
     pub damper_power: Id,
+    /// Σ τ q̇, the power of the applied joint loads.
+    pub load_power: Id,
 }
 
 /// Derives the energy expressions.
@@ -502,6 +521,7 @@ pub fn energy(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics])
     let mut gravity = Vec::new();
     let mut spring = Vec::new();
     let mut damper = Vec::new();
+    let mut load_power = Vec::new();
     let gvec = s.field3(g, model, Field::Gravity, model.gravity);
     for (i, body) in model.bodies.iter().enumerate() {
         let m = s.field(g, model, Field::Mass(i), body.mass);
@@ -538,11 +558,15 @@ pub fn energy(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics])
             let v2 = g.powi(s.qd[i], 2);
             damper.push(g.mul(c, v2));
         }
+        if let Some(tau) = joint_load(g, model, s, i) {
+            load_power.push(g.mul(tau, s.qd[i]));
+        }
     }
     EnergyTerms {
         kinetic: g.sum(kinetic),
         gravity: g.sum(gravity),
         spring: g.sum(spring),
         damper_power: g.sum(damper),
+        load_power: g.sum(load_power),
     }
 }

@@ -7,8 +7,9 @@
 //! the body and term they belong to. The text is formatted by `prettyplease`; the same
 //! model always gives the same bytes.
 
+use crate::contact::ContactTerms;
 use crate::derive::Derivation;
-use crate::expr::{Graph, Id, Node, OpCount, method_name};
+use crate::expr::{Graph, Guess, Id, Node, OpCount, method_name};
 use crate::model::{IntegratorChoice, JointKind, Model};
 use crate::profile::Func;
 use std::collections::{HashMap, HashSet};
@@ -18,6 +19,7 @@ mod parameters;
 use parameters::RuntimeParameters;
 
 /// One parameter of a generated function.
+#[derive(Debug, Clone, Copy)]
 struct Param {
     name: &'static str,
     ty: &'static str,
@@ -128,7 +130,9 @@ pub fn generate_with(
     options: &EmitOptions,
 ) -> Result<Generated, String> {
     let mut d = Derivation::new(model);
-    let specs = function_specs(model, &d);
+    let specs = function_specs(model, &mut d);
+    let parametric = model.runtime_parameters().next().is_some();
+    let kinematics_specs = contact_kinematics_specs(model, &mut d, parametric);
     let mut fused = FusedTerms::new(&mut d);
     let runtime = RuntimeParameters::new(model, &d, &all_roots(&d, &specs, &fused));
     if let Some(rp) = &runtime {
@@ -153,10 +157,22 @@ pub fn generate_with(
     };
     let mut functions = String::new();
     let mut op_counts = Vec::new();
+    let geometry_warm: Vec<(Id, String)> = d
+        .contacts
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| d.graph.implicit_of(c.parameter).is_some())
+        .map(|(k, c)| (c.parameter, format!("out[{k}].parameter")))
+        .collect();
     for spec in &specs {
+        let warm: &[(Id, String)] = if spec.name == "contact_geometry" {
+            &geometry_warm
+        } else {
+            &[]
+        };
         let (text, count) = match wrapper(model, &fused, &spec.name).filter(|_| wrap) {
             Some(text) => (text, function_count(&d, spec, &derived("self."))),
-            None => emit_function_given(&d, spec, "", true, &derived("self.")),
+            None => emit_function_full(&d, spec, "", true, &derived("self."), &[], warm),
         };
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
@@ -168,7 +184,17 @@ pub fn generate_with(
         } else {
             &[]
         };
-        let (text, count) = emit_function_full(&d, spec, "", true, &given, memo);
+        let warm: Vec<(Id, String)> = if spec.name == "position_terms" {
+            fused
+                .plain_cached()
+                .into_iter()
+                .filter(|&(_, id)| d.graph.implicit_of(id).is_some())
+                .map(|(k, id)| (id, format!("cache[{k}]")))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let (text, count) = emit_function_full(&d, spec, "", true, &given, memo, &warm);
         functions.push_str(&text);
         op_counts.push((spec.name.clone(), count));
     }
@@ -178,8 +204,9 @@ pub fn generate_with(
          fn cache_len(&self) -> usize {{ {} }}",
         fused.cache_len()
     );
-    let helpers =
-        contact_kinematics_helpers(model, &d, &mut op_counts, runtime.is_some(), &derived(""));
+    let mut helpers =
+        contact_kinematics_helpers(&d, &kinematics_specs, &mut op_counts, &derived(""));
+    helpers.push_str(&implicit_helpers(&d, &mut op_counts, &derived("")));
     if let Some(rp) = &runtime {
         op_counts.push(("derive".to_string(), rp.derive_count(&d)));
     }
@@ -502,7 +529,29 @@ fn info_static(model: &Model) -> String {
     let contacts: Vec<String> = model
         .contacts
         .iter()
-        .map(|c| format!("{:?}.to_string()", c.name))
+        .map(|c| {
+            let follower = match c.follower {
+                crate::model::Follower::Knife => "Knife",
+                crate::model::Follower::Roller { .. } => "Roller",
+                crate::model::Follower::Flat { .. } => "Flat",
+            };
+            let profile = match c.profile {
+                crate::model::Profile::Explicit { .. } => "Explicit",
+                crate::model::Profile::Polar { .. } => "Polar",
+                crate::model::Profile::Parametric { .. } => "Parametric",
+            };
+            let cam_coordinate = match c.cam_body {
+                Some(b) if model.bodies[b].joint.kind == JointKind::Revolute => {
+                    format!("Some({b})")
+                }
+                _ => "None".to_string(),
+            };
+            format!(
+                "rt::ContactInfo {{ name: {:?}.to_string(), follower: rt::FollowerKind::{follower}, \
+                 profile: rt::ProfileKind::{profile}, cam_coordinate: {cam_coordinate} }}",
+                c.name
+            )
+        })
         .collect();
     let s = &model.simulation;
     let integrator = match s.integrator {
@@ -585,9 +634,8 @@ fn param(name: &'static str, ty: &'static str) -> Param {
     }
 }
 
-fn function_specs(model: &Model, d: &Derivation) -> Vec<FunctionSpec> {
+fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionSpec> {
     let n = model.n();
-    let nc = model.contacts.len();
     let dy = &d.dynamics;
     let mass_outputs: Vec<(String, Id)> = (0..n)
         .flat_map(|i| (0..n).map(move |j| (i, j)))
@@ -720,9 +768,23 @@ fn function_specs(model: &Model, d: &Derivation) -> Vec<FunctionSpec> {
             tail: String::new(),
         },
     ];
-    specs.push(geometry_spec(d, nc));
+    specs.push(geometry_spec(d));
     specs.push(prescribed_spec(d));
     specs.push(energy_spec(d));
+    if model.bodies.iter().any(|b| b.joint.load.is_some()) {
+        specs.push(FunctionSpec {
+            doc: "Σ τ q̇, the power of the applied joint loads.".into(),
+            name: "load_power".into(),
+            params: vec![
+                param("t", "f64"),
+                param("q", "&[f64]"),
+                param("qd", "&[f64]"),
+            ],
+            ret: Some("f64"),
+            outputs: vec![(RETURN.into(), d.energy.load_power)],
+            tail: String::new(),
+        });
+    }
     specs.push(FunctionSpec {
         doc: "Σ c q̇², the power the joint dampers dissipate.".into(),
         name: "damper_power".into(),
@@ -995,7 +1057,10 @@ impl FusedTerms {
         let cached = (0..g.len())
             .filter(|&i| in_position[i] && in_velocity[i])
             .map(|i| id_at(g, i))
-            .filter(|&id| matches!(g.node(id), Node::Call(..) | Node::Powf(..) | Node::Div(..)))
+            .filter(|&id| {
+                matches!(g.node(id), Node::Call(..) | Node::Powf(..) | Node::Div(..))
+                    || g.implicit_of(id).is_some()
+            })
             .collect();
         let memo = trig_pairs(g, &in_position, &d.symbols.params);
         FusedTerms {
@@ -1111,9 +1176,10 @@ fn all_roots(d: &Derivation, specs: &[FunctionSpec], fused: &FusedTerms) -> Vec<
         .chain(fused.velocity.iter().map(|(_, id)| *id))
         .collect();
     for c in &d.contacts {
-        roots.extend(c.position);
-        roots.extend([c.f1, c.f2, c.slope, c.curvature, c.conv1, c.conv2]);
-        roots.extend(c.j1.iter().chain(&c.j2));
+        roots.extend(contact_output_roots(c));
+    }
+    for (_, def) in d.graph.implicits() {
+        roots.extend([def.residual, def.derivative, def.objective]);
     }
     roots
 }
@@ -1241,22 +1307,82 @@ fn wrapper(model: &Model, fused: &FusedTerms, name: &str) -> Option<String> {
     ))
 }
 
-fn geometry_spec(d: &Derivation, _nc: usize) -> FunctionSpec {
+/// Every node a contact's outputs read (geometry and kinematics), for the run-time
+/// parameters' `derive`.
+fn contact_output_roots(c: &ContactTerms) -> Vec<Id> {
+    let r = &c.relative;
+    let mut roots: Vec<Id> = c
+        .position
+        .iter()
+        .chain(&c.cam_point)
+        .chain(&c.normal)
+        .chain(&r.point)
+        .chain(&r.axis)
+        .chain(&r.direction)
+        .chain(&r.xy)
+        .chain(&r.convective)
+        .copied()
+        .collect();
+    roots.extend([c.force_scale, c.parameter, c.curvature, c.sliding]);
+    roots.extend(r.columns.iter().flatten());
+    roots
+}
+
+/// `out.<field>` targets of a contact's geometry (`prefix` = `out[k].` or `out.geometry.`).
+fn geometry_outputs(g: &mut Graph, c: &ContactTerms, prefix: &str) -> Vec<(String, Id)> {
     let mut outputs = Vec::new();
-    for (k, c) in d.contacts.iter().enumerate() {
-        for (a, &p) in c.position.iter().enumerate() {
-            outputs.push((format!("out[{k}].position[{a}]"), p));
+    let r = &c.relative;
+    let vectors = [
+        ("position", c.position),
+        ("follower", r.point),
+        ("normal", c.normal),
+        ("axis", r.axis),
+    ];
+    for (field, v) in vectors {
+        for (a, &p) in v.iter().enumerate() {
+            outputs.push((format!("{prefix}{field}[{a}]"), p));
         }
-        outputs.push((format!("out[{k}].x"), c.f1));
-        outputs.push((format!("out[{k}].y"), c.f2));
-        outputs.push((format!("out[{k}].slope"), c.slope));
-        outputs.push((format!("out[{k}].curvature"), c.curvature));
+    }
+    let direction = unit_vector(g, r.direction);
+    for (a, &p) in direction.iter().enumerate() {
+        outputs.push((format!("{prefix}direction[{a}]"), p));
+    }
+    outputs.extend([
+        (format!("{prefix}x"), c.cam_point[0]),
+        (format!("{prefix}y"), c.cam_point[1]),
+        (format!("{prefix}force_scale"), c.force_scale),
+        (format!("{prefix}parameter"), c.parameter),
+        (format!("{prefix}curvature"), c.curvature),
+        (format!("{prefix}sliding_speed"), c.sliding),
+    ]);
+    outputs
+}
+
+/// v/|v| (the direction of a follower's motion).
+fn unit_vector(g: &mut Graph, v: [Id; 3]) -> [Id; 3] {
+    g.set_section("outputs: the follower's direction of motion");
+    let squares: Vec<Id> = v.iter().map(|&c| g.mul(c, c)).collect();
+    let norm2 = g.sum(squares);
+    let norm = g.sqrt(norm2);
+    v.map(|c| g.div(c, norm))
+}
+
+fn geometry_spec(d: &mut Derivation) -> FunctionSpec {
+    let mut outputs = Vec::new();
+    let contacts = d.contacts.clone();
+    for (k, c) in contacts.iter().enumerate() {
+        outputs.extend(geometry_outputs(&mut d.graph, c, &format!("out[{k}].")));
     }
     FunctionSpec {
-        doc: "Contact points in ground and cam coordinates, with f3' and f3'' under them.".into(),
+        doc: "Where and how every contact touches: the contact point in ground and cam \
+              coordinates, the follower point, the normal, the force scale, the profile's \
+              parameter and curvature there, the follower's direction of motion, the sliding \
+              speed."
+            .into(),
         name: "contact_geometry".into(),
         params: vec![
             param("q", "&[f64]"),
+            param("qd", "&[f64]"),
             param("out", "&mut [rt::ContactGeometry]"),
         ],
         ret: None,
@@ -1327,66 +1453,153 @@ fn contact_kinematics_dispatch(model: &Model, parametric: bool) -> String {
     )
 }
 
-fn contact_kinematics_helpers(
+/// The specifications of `contact_kinematics_<k>`: every contact's geometry and its
+/// follower point's cam-frame kinematics.
+fn contact_kinematics_specs(
     model: &Model,
-    d: &Derivation,
-    counts: &mut Vec<(String, OpCount)>,
+    d: &mut Derivation,
     parametric: bool,
+) -> Vec<FunctionSpec> {
+    let n = model.n();
+    let contacts = d.contacts.clone();
+    contacts
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let mut outputs = geometry_outputs(&mut d.graph, c, "out.geometry.");
+            let r = &c.relative;
+            outputs.push(("out.x".to_string(), r.xy[0]));
+            outputs.push(("out.y".to_string(), r.xy[1]));
+            for i in 0..n {
+                outputs.push((format!("out.j1[{i}]"), r.columns[i][0]));
+            }
+            for i in 0..n {
+                outputs.push((format!("out.j2[{i}]"), r.columns[i][1]));
+            }
+            outputs.push(("out.conv1".to_string(), r.convective[0]));
+            outputs.push(("out.conv2".to_string(), r.convective[1]));
+            FunctionSpec {
+                doc: format!(
+                    "Geometry of contact `{}` and its follower point's cam-frame kinematics, \
+                     into `out` (J1 and J2 of length {n}).",
+                    c_name(model, k)
+                ),
+                name: format!("contact_kinematics_{k}"),
+                params: [
+                    parametric.then_some(Param {
+                        name: "derived",
+                        ty: "&Derived",
+                        always_used: false,
+                    }),
+                    Some(param("q", "&[f64]")),
+                    Some(param("qd", "&[f64]")),
+                    Some(Param {
+                        name: "out",
+                        ty: "&mut rt::ContactKinematics",
+                        always_used: true,
+                    }),
+                ]
+                .into_iter()
+                .flatten()
+                .collect(),
+                ret: None,
+                outputs,
+                tail: String::new(),
+            }
+        })
+        .collect()
+}
+
+/// Emits the `contact_kinematics_<k>` functions.
+fn contact_kinematics_helpers(
+    d: &Derivation,
+    specs: &[FunctionSpec],
+    counts: &mut Vec<(String, OpCount)>,
     derived: &[(Id, String)],
 ) -> String {
-    let n = model.n();
     let mut out = String::new();
-    for (k, c) in d.contacts.iter().enumerate() {
-        let mut outputs = Vec::new();
-        for a in 0..3 {
-            outputs.push((format!("out.geometry.position[{a}]"), c.position[a]));
-        }
-        outputs.extend([
-            ("out.geometry.x".to_string(), c.f1),
-            ("out.geometry.y".to_string(), c.f2),
-            ("out.geometry.slope".to_string(), c.slope),
-            ("out.geometry.curvature".to_string(), c.curvature),
-        ]);
-        for i in 0..n {
-            outputs.push((format!("out.j1[{i}]"), c.j1[i]));
-        }
-        for i in 0..n {
-            outputs.push((format!("out.j2[{i}]"), c.j2[i]));
-        }
-        outputs.push(("out.conv1".to_string(), c.conv1));
-        outputs.push(("out.conv2".to_string(), c.conv2));
-        let spec = FunctionSpec {
-            doc: format!(
-                "Kinematics of contact `{}` into `out` (J1 and J2 of length {n}).",
-                c_name(model, k)
-            ),
-            name: format!("contact_kinematics_{k}"),
-            params: [
-                parametric.then_some(Param {
-                    name: "derived",
-                    ty: "&Derived",
-                    always_used: false,
-                }),
-                Some(param("q", "&[f64]")),
-                Some(param("qd", "&[f64]")),
-                Some(Param {
-                    name: "out",
-                    ty: "&mut rt::ContactKinematics",
-                    always_used: true,
-                }),
-            ]
-            .into_iter()
-            .flatten()
-            .collect(),
-            ret: None,
-            outputs,
-            tail: String::new(),
-        };
-        let (text, count) = emit_function_given(d, &spec, "", false, derived);
+    for spec in specs {
+        let (text, count) = emit_function_given(d, spec, "", false, derived);
         out.push_str(ALLOW_LITERALS);
         out.push('\n');
         out.push_str(&text);
         counts.push((spec.name.clone(), count));
+    }
+    out
+}
+
+/// The residual ψ(s; p) with ψ′(s), and the objective, of every implicit variable (a contact
+/// parameter), as free functions `<name>_residual` and `<name>_objective` that the solves
+/// call (`rt::contact::solve`).
+fn implicit_helpers(
+    d: &Derivation,
+    counts: &mut Vec<(String, OpCount)>,
+    derived: &[(Id, String)],
+) -> String {
+    let g = &d.graph;
+    let names = Names::of_vars(g);
+    let parametric = d.has_runtime_parameters();
+    let mut out = String::new();
+    for (id, def) in g.implicits() {
+        let base = names.var(g, id);
+        let mut params: Vec<Param> = Vec::new();
+        if parametric {
+            params.push(Param {
+                name: "derived",
+                ty: "&Derived",
+                always_used: false,
+            });
+        }
+        let input_names = &def.input_names;
+        for &name in input_names {
+            params.push(Param {
+                name,
+                ty: "f64",
+                always_used: false,
+            });
+        }
+        params.push(Param {
+            name: "s",
+            ty: "f64",
+            always_used: false,
+        });
+        let mut given: Vec<(Id, String)> = derived.to_vec();
+        given.push((def.unknown, "s".to_string()));
+        for (&p, name) in def.placeholders.iter().zip(input_names) {
+            given.push((p, name.to_string()));
+        }
+        let residual = FunctionSpec {
+            doc: format!(
+                "{}: ψ(s) and ψ′(s), whose root with ψ′ < 0 Newton finds.",
+                def.description
+            ),
+            name: format!("{base}_residual"),
+            params: params.clone(),
+            ret: Some("[f64; 2]"),
+            outputs: vec![
+                ("let value".to_string(), def.residual),
+                ("let slope".to_string(), def.derivative),
+            ],
+            tail: "[value, slope]".to_string(),
+        };
+        let objective = FunctionSpec {
+            doc: format!(
+                "{}: the objective the root minimises (what a scan of the range compares).",
+                def.description
+            ),
+            name: format!("{base}_objective"),
+            params,
+            ret: Some("f64"),
+            outputs: vec![(RETURN.to_string(), def.objective)],
+            tail: String::new(),
+        };
+        for spec in [residual, objective] {
+            let (text, count) = emit_function_given(d, &spec, "", false, &given);
+            out.push_str(ALLOW_LITERALS);
+            out.push('\n');
+            out.push_str(&text);
+            counts.push((spec.name.clone(), count));
+        }
     }
     out
 }
@@ -1404,11 +1617,12 @@ fn emit_function_given(
     method: bool,
     given: &[(Id, String)],
 ) -> (String, OpCount) {
-    emit_function_full(d, spec, prelude, method, given, &[])
+    emit_function_full(d, spec, prelude, method, given, &[], &[])
 }
 
 /// [`emit_function_given`], the sine–cosine pairs of `memo` computed through the cache
-/// (`rt::sin_cos_memo`).
+/// (`rt::sin_cos_memo`), and the Newton solves of the implicit variables of `warm` started
+/// from the solutions kept where it says.
 fn emit_function_full(
     d: &Derivation,
     spec: &FunctionSpec,
@@ -1416,6 +1630,7 @@ fn emit_function_full(
     method: bool,
     given: &[(Id, String)],
     memo: &[TrigMemo],
+    warm: &[(Id, String)],
 ) -> (String, OpCount) {
     let g = &d.graph;
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
@@ -1425,6 +1640,15 @@ fn emit_function_full(
     for m in memo {
         body.memo.insert(m.sin, *m);
         body.memo.insert(m.cos, *m);
+    }
+    body.warm = warm.iter().cloned().collect();
+    if d.has_runtime_parameters() {
+        body.derived_arg = if method {
+            "&self.derived, "
+        } else {
+            "derived, "
+        }
+        .to_string();
     }
     let (bindings, used_vars) = body.bindings();
     let inputs = input_bindings(d, &used_vars);
@@ -1670,6 +1894,15 @@ fn is_reserved(name: &str) -> bool {
         || name.starts_with("__")
 }
 
+/// True for a plain Rust identifier (a function's scalar argument).
+fn is_identifier(source: &str) -> bool {
+    !source.is_empty()
+        && source
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !source.starts_with(|c: char| c.is_ascii_digit())
+}
+
 /// Lower-case ASCII identifier fragment from arbitrary text.
 fn sanitize(name: &str) -> String {
     let s: String = name
@@ -1703,6 +1936,14 @@ struct Emitter<'g> {
     parameters: HashSet<Id>,
     /// Sines and cosines computed together through the cache (by either node of a pair).
     memo: HashMap<Id, TrigMemo>,
+    /// Where an implicit variable's last solution is kept (`cache[4]`, `out[0].parameter`):
+    /// its Newton solve starts there.
+    warm: HashMap<Id, String>,
+    /// The argument that passes the derived parameter values to a residual (`&self.derived, `
+    /// in a method, `derived, ` in a free function, nothing without run-time parameters).
+    derived_arg: String,
+    /// The inputs of implicit variables: always bound (the solve's call reads them twice).
+    solve_inputs: HashSet<Id>,
 }
 
 impl<'g> Emitter<'g> {
@@ -1734,6 +1975,11 @@ impl<'g> Emitter<'g> {
                 .entry(*id)
                 .or_insert_with(|| output_name(target));
         }
+        let solve_inputs = (0..g.len())
+            .filter(|&i| reachable[i])
+            .filter_map(|i| g.implicit_of(id_at(g, i)))
+            .flat_map(|def| def.inputs.iter().copied())
+            .collect();
         Emitter {
             g,
             given,
@@ -1745,11 +1991,17 @@ impl<'g> Emitter<'g> {
             vars: Names::of_vars(g),
             parameters: params.iter().copied().collect(),
             memo: HashMap::new(),
+            warm: HashMap::new(),
+            derived_arg: String::new(),
+            solve_inputs,
         }
     }
 
     fn wants_binding(&self, id: Id) -> bool {
-        if self.given.contains_key(&id) {
+        if self.given.contains_key(&id) || self.solve_inputs.contains(&id) {
+            return true;
+        }
+        if self.g.implicit_of(id).is_some() {
             return true;
         }
         match self.g.node(id) {
@@ -1795,6 +2047,9 @@ impl<'g> Emitter<'g> {
         for word in ["conv1", "conv2", "p0", "p1", "p2", "j1", "j2", "k"] {
             taken.insert(word.to_string());
         }
+        for source in self.given.values().filter(|s| is_identifier(s)) {
+            taken.insert(source.clone());
+        }
         let mut section: Option<String> = None;
         for i in self.emission_order() {
             let id = id_at(self.g, i);
@@ -1815,6 +2070,17 @@ impl<'g> Emitter<'g> {
             if let Some(m) = self.memo.get(&id).copied() {
                 let line = self.memo_binding(m, &mut taken);
                 text.push_str(&line);
+                continue;
+            }
+            if let Some(source) = self.given.get(&id).filter(|s| is_identifier(s)) {
+                // A scalar argument of the function, read under its own name.
+                self.names.insert(id, source.clone());
+                continue;
+            }
+            if self.g.implicit_of(id).is_some() && !self.given.contains_key(&id) {
+                let name = self.vars.var(self.g, id);
+                let _ = writeln!(text, "let {name} = {};", self.solve_call(id));
+                self.names.insert(id, name);
                 continue;
             }
             let expr = match self.given.get(&id) {
@@ -1892,6 +2158,33 @@ impl<'g> Emitter<'g> {
             }
             k += 1;
         }
+    }
+
+    /// The Newton solve of an implicit variable (a contact parameter):
+    /// `rt::contact::solve(guess, range, |s_try| <residual>(…), |s_try| <objective>(…))`,
+    /// starting from the kept solution where the function has one.
+    fn solve_call(&self, id: Id) -> String {
+        let Some(def) = self.g.implicit_of(id) else {
+            return "f64::NAN".to_string();
+        };
+        let base = self.vars.var(self.g, id);
+        let inputs: Vec<String> = def.inputs.iter().map(|&i| self.print(i, 0)).collect();
+        let cold = match def.guess {
+            Guess::Input(i) => inputs[i].clone(),
+            Guess::Angle { x, y } => format!("{}.atan2({})", inputs[y], inputs[x]),
+            Guess::Scan => "f64::NAN".to_string(),
+        };
+        let guess = match self.warm.get(&id) {
+            Some(slot) => format!("rt::contact::warm_or({slot}, || {cold})"),
+            None => cold,
+        };
+        let args = format!("{}{}, s_try", self.derived_arg, inputs.join(", "));
+        format!(
+            "rt::contact::solve({guess}, ({}, {}), |s_try| {base}_residual({args}), \
+             |s_try| {base}_objective({args}))",
+            lit(def.range.0),
+            lit(def.range.1)
+        )
     }
 
     /// `let (s_a, c_a) = rt::sin_cos_memo(a, &mut cache[k..k + 3]);`, naming both nodes.
@@ -2056,6 +2349,9 @@ fn output_name(target: &str) -> String {
     let name = name.trim_matches('_').replace("__", "_");
     if name.is_empty() {
         "value".to_string()
+    } else if name.starts_with(|c: char| c.is_ascii_digit()) {
+        // `out[0].direction[1]`: the contact's index first.
+        format!("contact{name}")
     } else {
         name
     }

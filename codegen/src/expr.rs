@@ -111,6 +111,58 @@ pub struct Graph {
     /// While set, new nodes go into this section instead of the latest one (rewriting
     /// passes keep a rebuilt node under its original heading).
     section_override: Option<u32>,
+    /// The variables defined implicitly (contact parameters), by variable index.
+    implicits: HashMap<u32, Implicit>,
+}
+
+/// Where Newton starts on an [`Implicit`] variable when no earlier solution is at hand.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Guess {
+    /// The value of input `i`.
+    Input(usize),
+    /// The polar angle `atan2(input y, input x)`.
+    Angle {
+        /// Index of the input that is the point's x.
+        x: usize,
+        /// Index of the input that is the point's y.
+        y: usize,
+    },
+    /// None: the best sample of the range by the objective.
+    Scan,
+}
+
+/// A variable defined implicitly: the root s of ψ(s; p) = 0 with ψ'(s) < 0 (a minimum of
+/// the objective) near a guess, p standing for the values of `inputs`. A contact parameter
+/// (the profile point touched by a roller or a flat face) is one.
+///
+/// The emitted code and the interpreter find it by Newton's method
+/// (`camchain_runtime::contact::solve`). Its derivatives follow from the implicit-function
+/// theorem, ds/dx = −(∂ψ/∂p · dp/dx) / ψ'(s) ([`Graph::diff`]), although the contact
+/// equations avoid them (the envelope theorem: docs/method.md §9).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Implicit {
+    /// What the variable is, for comments (`contact R: the profile point nearest the
+    /// roller's centre`).
+    pub description: String,
+    /// The placeholder variable standing for s in `residual`, `derivative` and `objective`.
+    pub unknown: Id,
+    /// The placeholder variables standing for the inputs.
+    pub placeholders: Vec<Id>,
+    /// The inputs' names in the emitted residual (`x`, `y`).
+    pub input_names: Vec<&'static str>,
+    /// The inputs: expressions of the outer variables.
+    pub inputs: Vec<Id>,
+    /// ψ(s; p).
+    pub residual: Id,
+    /// ∂ψ/∂s.
+    pub derivative: Id,
+    /// A function of (s; p) that the wanted root minimises (ψ = −objective′ up to a
+    /// positive factor): what a scan of the range compares.
+    pub objective: Id,
+    /// Where Newton starts.
+    pub guess: Guess,
+    /// The interval of s scanned when Newton from the guess fails.
+    pub range: (f64, f64),
 }
 
 fn const_bits(value: f64) -> u64 {
@@ -188,6 +240,35 @@ impl Graph {
         let id = self.intern(Node::Var(index));
         self.var_ids.insert(name.to_string(), id);
         id
+    }
+
+    /// Declares the implicitly defined variable `name` (see [`Implicit`]); its node comes
+    /// after its inputs.
+    pub fn implicit(&mut self, name: &str, definition: Implicit) -> Id {
+        let id = self.var(name);
+        if let Node::Var(k) = self.node(id) {
+            self.implicits.insert(k, definition);
+        }
+        id
+    }
+
+    /// The definition of an implicitly defined variable.
+    pub fn implicit_of(&self, id: Id) -> Option<&Implicit> {
+        match self.node(id) {
+            Node::Var(k) => self.implicits.get(&k),
+            _ => None,
+        }
+    }
+
+    /// Every implicitly defined variable with its definition, in variable order.
+    pub fn implicits(&self) -> Vec<(Id, &Implicit)> {
+        let mut out: Vec<(Id, &Implicit)> = self
+            .implicits
+            .iter()
+            .map(|(&k, d)| (self.var_id(k), d))
+            .collect();
+        out.sort_by_key(|(id, _)| *id);
+        out
     }
 
     /// Names of the variables, by variable index.
@@ -389,7 +470,7 @@ impl Graph {
 
     /// c · b for a constant c; constant factors are kept positive (the sign goes to a
     /// negation, which the printer turns into a subtraction).
-    fn scale(&mut self, c: f64, b: Id) -> Id {
+    pub fn scale(&mut self, c: f64, b: Id) -> Id {
         if c == 0.0 {
             return self.zero();
         }
@@ -528,6 +609,8 @@ impl Graph {
             Node::Var(_) => {
                 if e == x {
                     self.one()
+                } else if let Some(def) = self.implicit_of(e).cloned() {
+                    self.diff_implicit(e, &def, x, memo)
                 } else {
                     self.zero()
                 }
@@ -577,6 +660,38 @@ impl Graph {
                 self.mul(outer, da)
             }
         }
+    }
+
+    /// ds/dx of the implicit variable `s` = −(Σ ∂ψ/∂p_i · dp_i/dx) / ψ'(s), the partial
+    /// derivatives taken at (s; inputs).
+    fn diff_implicit(&mut self, s: Id, def: &Implicit, x: Id, memo: &mut HashMap<Id, Id>) -> Id {
+        let mut numerator = self.zero();
+        for (&p, &input) in def.placeholders.iter().zip(&def.inputs) {
+            let d_input = self.diff_memo(input, x, memo);
+            if self.is_zero(d_input) {
+                continue;
+            }
+            let partial = self.diff(def.residual, p);
+            let partial = self.at_solution(partial, def, s);
+            let term = self.mul(partial, d_input);
+            numerator = self.add(numerator, term);
+        }
+        if self.is_zero(numerator) {
+            return numerator;
+        }
+        let slope = self.at_solution(def.derivative, def, s);
+        let ratio = self.div(numerator, slope);
+        self.neg(ratio)
+    }
+
+    /// An expression of (s; p) with the placeholders replaced by the inputs and s by the
+    /// implicit variable itself.
+    pub fn at_solution(&mut self, e: Id, def: &Implicit, s: Id) -> Id {
+        let mut e = self.substitute(e, def.unknown, s);
+        for (&p, &input) in def.placeholders.iter().zip(&def.inputs) {
+            e = self.substitute(e, p, input);
+        }
+        e
     }
 
     /// f'(a) for the node e = f(a).
@@ -664,6 +779,7 @@ impl Graph {
             return r;
         }
         let r = match self.node(e) {
+            Node::Var(_) if self.implicit_of(e).is_some() => self.subst_implicit(e, x, by, memo),
             Node::Const(_) | Node::Var(_) => e,
             Node::Add(a, b) => {
                 let (a, b) = (
@@ -710,6 +826,32 @@ impl Graph {
         r
     }
 
+    /// An implicit variable whose inputs contain `x`: the same definition on the substituted
+    /// inputs (a new variable), or the variable itself when nothing changes.
+    fn subst_implicit(&mut self, e: Id, x: Id, by: Id, memo: &mut HashMap<Id, Id>) -> Id {
+        let Some(mut def) = self.implicit_of(e).cloned() else {
+            return e;
+        };
+        let inputs: Vec<Id> = def
+            .inputs
+            .iter()
+            .map(|&i| self.subst_memo(i, x, by, memo))
+            .collect();
+        if inputs == def.inputs {
+            return e;
+        }
+        def.inputs = inputs;
+        let name = format!("{}_{}", self.vars[self.var_index_of(e)], self.len());
+        self.implicit(&name, def)
+    }
+
+    fn var_index_of(&self, id: Id) -> usize {
+        match self.node(id) {
+            Node::Var(k) => k as usize,
+            _ => 0,
+        }
+    }
+
     /// Evaluates the given roots with `vars[i]` the value of variable i (the interpreter).
     ///
     /// Only nodes up to the largest root are computed, in id (= topological) order.
@@ -720,7 +862,10 @@ impl Graph {
             let v = |id: &Id| values[id.index()];
             let value: f64 = match node {
                 Node::Const(bits) => f64::from_bits(*bits),
-                Node::Var(i) => vars.get(*i as usize).copied().unwrap_or(f64::NAN),
+                Node::Var(i) => match self.implicits.get(i) {
+                    Some(def) => self.solve_implicit(def, vars, &values),
+                    None => vars.get(*i as usize).copied().unwrap_or(f64::NAN),
+                },
                 Node::Add(a, b) => v(a) + v(b),
                 Node::Mul(a, b) => v(a) * v(b),
                 Node::Neg(a) => -v(a),
@@ -734,10 +879,53 @@ impl Graph {
         roots.iter().map(|r| values[r.index()]).collect()
     }
 
+    /// The interpreter's value of an implicit variable: the same Newton solve as the
+    /// emitted code's, on the interpreted residual.
+    fn solve_implicit(&self, def: &Implicit, vars: &[f64], values: &[f64]) -> f64 {
+        let mut local = vars.to_vec();
+        let set = |local: &mut Vec<f64>, id: Id, value: f64| {
+            if let Node::Var(k) = self.node(id) {
+                if local.len() <= k as usize {
+                    local.resize(k as usize + 1, f64::NAN);
+                }
+                local[k as usize] = value;
+            }
+        };
+        let inputs: Vec<f64> = def.inputs.iter().map(|i| values[i.index()]).collect();
+        for (&p, &value) in def.placeholders.iter().zip(&inputs) {
+            set(&mut local, p, value);
+        }
+        let guess = match def.guess {
+            Guess::Input(i) => inputs[i],
+            Guess::Angle { x, y } => inputs[y].atan2(inputs[x]),
+            Guess::Scan => f64::NAN,
+        };
+        let local = std::cell::RefCell::new(local);
+        let eval_at = |s: f64, roots: &[Id]| {
+            let mut l = local.borrow_mut();
+            set(&mut l, def.unknown, s);
+            self.eval(roots, &l)
+        };
+        camchain_runtime::contact::solve(
+            guess,
+            def.range,
+            |s| {
+                let r = eval_at(s, &[def.residual, def.derivative]);
+                [r[0], r[1]]
+            },
+            |s| eval_at(s, &[def.objective])[0],
+        )
+    }
+
     /// Direct children of a node.
     pub fn children(&self, id: Id) -> Vec<Id> {
         match self.node(id) {
-            Node::Const(_) | Node::Var(_) => vec![],
+            Node::Var(k) => self
+                .implicits
+                .get(&k)
+                .map(|d| d.inputs.clone())
+                .unwrap_or_default(),
+            Node::Const(_) => vec![],
             Node::Add(a, b) | Node::Mul(a, b) | Node::Div(a, b) | Node::Powf(a, b) => vec![a, b],
             Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) => vec![a],
         }
@@ -775,6 +963,9 @@ impl Graph {
                 continue;
             }
             match node {
+                // A contact parameter's Newton solve counts as one operation here; its
+                // residual is counted as a function of its own.
+                Node::Var(k) if self.implicits.contains_key(k) => count.other += 1,
                 Node::Const(_) | Node::Var(_) => {}
                 Node::Add(..) => count.add_sub += 1,
                 Node::Neg(_) => {

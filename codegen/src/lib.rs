@@ -10,13 +10,14 @@
 //! - [`linear`]: the pass that collects nested sums into linear combinations.
 //! - [`lint`]: warnings for valid models that look mistaken (degrees for radians, …).
 //! - [`kinematics`]: forward recursion of rotations, positions, velocities, accelerations (9).
-//! - [`constraint`]: contact point f1, f2, J1, J2, convective terms and h, J, c (1–8).
+//! - [`contact`]: the contact family: the follower seen from the cam on any body, profiles
+//!   (explicit, polar, parametric), knife edges, rollers and flat faces: h, J, c (1–8).
 //! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (10–13), and energies.
 //! - [`derive`](mod@derive): the whole derivation of a model in one graph.
 //! - [`emit`]: the generated Rust module.
 
 pub mod assembly;
-pub mod constraint;
+pub mod contact;
 pub mod derive;
 pub mod dynamics;
 pub mod emit;

@@ -36,6 +36,20 @@ pub struct Prescribed {
     pub expr: Scalar,
 }
 
+/// A generalised force applied in a joint (a motor torque, a force on a slider), positive in
+/// the direction of the joint's coordinate: an expression of the time `t`, the coordinates
+/// and their rates (`q1`, `q1_dot`) and the parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointLoad {
+    /// The expression as written in the model file.
+    pub source: String,
+    /// The parsed expression: its variable is t; [`Scalar::Param`] `i` is the model's
+    /// parameter i for `i < np` (every one resolved to its value here, the run-time ones kept
+    /// in [`Model::symbolic`] under [`Field::Load`]), coordinate `k` for `i = np + k` and its
+    /// rate for `i = np + n + k` (np parameters, n coordinates).
+    pub expr: Scalar,
+}
+
 /// The joint that connects a body to its parent.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Joint {
@@ -52,6 +66,8 @@ pub struct Joint {
     pub spring: Option<SpringDamper>,
     /// Optional prescribed motion; the coordinate is then known and its drive load reported.
     pub prescribed: Option<Prescribed>,
+    /// Optional applied load (not on a prescribed joint).
+    pub load: Option<JointLoad>,
 }
 
 /// A rigid body. Body `i` carries joint `i` and generalised coordinate `i`.
@@ -82,28 +98,144 @@ pub struct Marker {
     pub position: [f64; 3],
 }
 
-/// A fixed cam y = f(x) in a plane fixed to the ground, touched by a marker (eq. 1–3).
+/// The shape a follower presents to its cam (docs/model-format.md, "Contacts").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Follower {
+    /// The marker itself touches the profile: the paper's knife edge (eq. 1–3).
+    Knife,
+    /// A circle of radius `radius` (m, > 0) centred on the marker: its centre stays on the
+    /// profile's offset (pitch) curve. A cylinder whose axis is parallel to the cam's, or a
+    /// ball: both touch the cam at the in-plane distance `radius`. Massless, rolling without
+    /// slip: its spin does not enter the dynamics.
+    Roller {
+        /// Radius (m).
+        radius: f64,
+    },
+    /// A flat face through the marker, tangent to the profile; the contact point slides
+    /// along it. `normal` is the face's unit normal in the follower body's frame, pointing
+    /// from the face towards the cam; it must lie in the cam plane and the follower may turn
+    /// relative to the cam only about the cam's axis.
+    Flat {
+        /// Unit normal, follower body frame.
+        normal: [f64; 3],
+    },
+}
+
+impl Follower {
+    /// `knife`, `roller` or `flat`: the kind's name in messages and output.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Follower::Knife => "knife",
+            Follower::Roller { .. } => "roller",
+            Follower::Flat { .. } => "flat",
+        }
+    }
+}
+
+/// A cam profile: a curve in the cam plane, given by expressions with symbolic derivatives.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Profile {
+    /// y = f(x) (the paper's form, eq. 3); the cam's material is below the curve (y < f(x)).
+    Explicit {
+        /// f as written (variable `x`).
+        source: String,
+        /// Parsed f.
+        f: Scalar,
+    },
+    /// The points r(θ)·(cos θ, sin θ), θ the angle from the cam frame's x axis: a disc cam,
+    /// its material inside the curve. r must be positive.
+    Polar {
+        /// r as written (variable `theta`).
+        source: String,
+        /// Parsed r.
+        r: Scalar,
+    },
+    /// The points (x(s), y(s)); the cam's material is on the left of the direction of
+    /// increasing s (inside a curve traced counterclockwise), the follower on the right.
+    Parametric {
+        /// x(s) as written.
+        x_source: String,
+        /// y(s) as written.
+        y_source: String,
+        /// Parsed x(s).
+        x: Scalar,
+        /// Parsed y(s).
+        y: Scalar,
+    },
+}
+
+impl Profile {
+    /// `explicit`, `polar` or `parametric`.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Profile::Explicit { .. } => "explicit",
+            Profile::Polar { .. } => "polar",
+            Profile::Parametric { .. } => "parametric",
+        }
+    }
+
+    /// The name of the profile's variable in its expressions.
+    pub fn variable(&self) -> &'static str {
+        match self {
+            Profile::Explicit { .. } => "x",
+            Profile::Polar { .. } => "theta",
+            Profile::Parametric { .. } => "s",
+        }
+    }
+}
+
+/// A follower on a body touching a cam profile on another body (or the ground), eqs. (1)–(8)
+/// generalised: the contact family of docs/method.md §9.
 ///
-/// The cam coordinates of a ground point p are `x = x_axis·(p − origin)`,
-/// `y = y_axis·(p − origin)`; the constraint is `h = y − f(x) = 0`. The cam is the
-/// cylinder swept by the profile along `x_axis × y_axis`, its material on the side y < f(x),
-/// so the normal force is positive when the cam pushes the marker towards +y.
+/// The cam plane is fixed to the cam body: its origin and axes are given in that body's
+/// frame. The cam coordinates of a point p are `x = x̂·(p − o)`, `y = ŷ·(p − o)` with o, x̂,
+/// ŷ carried by the cam body; the cam is the cylinder swept by the profile along `x̂ × ŷ`.
+/// The constraint h is positive when the follower is clear of the cam and the normal force
+/// positive when the cam pushes the follower.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Contact {
-    /// Name of the contact = name of its marker (e.g. `A`).
+    /// Name of the contact (the marker's name unless the file gives one), e.g. `A`.
     pub name: String,
-    /// Index into [`Model::markers`].
+    /// Index into [`Model::markers`]: the knife edge, the roller's centre, or a point of the
+    /// flat face.
     pub marker: usize,
-    /// The profile as written (Rust syntax, variable `x`).
-    pub profile_source: String,
-    /// Parsed profile, variable = x.
-    pub profile: Scalar,
-    /// Origin of the cam frame in ground coordinates.
+    /// The follower's shape.
+    pub follower: Follower,
+    /// The cam profile.
+    pub profile: Profile,
+    /// The body carrying the cam (sorted index), `None` for the ground.
+    pub cam_body: Option<usize>,
+    /// Origin of the cam frame in the cam body's frame.
     pub origin: [f64; 3],
-    /// Unit x axis of the cam plane, in ground coordinates.
+    /// Unit x axis of the cam plane, in the cam body's frame.
     pub x_axis: [f64; 3],
     /// Unit y axis of the cam plane, orthogonal to `x_axis`.
     pub y_axis: [f64; 3],
+    /// The interval of the profile's variable the follower may touch: where undercutting is
+    /// checked, and where a contact point is first searched for a parametric profile.
+    /// `[0, 2π]` for a polar profile unless given.
+    pub range: Option<(f64, f64)>,
+}
+
+impl Contact {
+    /// The profile's expression of the one-variable field `Field::Profile(c)` (f, r or x(s)).
+    pub fn profile_expression(&self) -> &Scalar {
+        match &self.profile {
+            Profile::Explicit { f, .. } => f,
+            Profile::Polar { r, .. } => r,
+            Profile::Parametric { x, .. } => x,
+        }
+    }
+
+    /// The cam plane's normal x̂ × ŷ, cam body frame.
+    pub fn axis(&self) -> [f64; 3] {
+        let (a, b) = (self.x_axis, self.y_axis);
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    }
 }
 
 /// Integrator named in the model's default settings.
@@ -248,8 +380,14 @@ pub enum Field {
     Marker(usize, usize),
     /// Component k of contact c's cam-frame origin.
     Origin(usize, usize),
-    /// The profile of contact c (an expression of x).
+    /// The profile of contact c: f(x), r(θ), or x(s) of a parametric one.
     Profile(usize),
+    /// y(s) of contact c's parametric profile.
+    ProfileY(usize),
+    /// The roller radius of contact c.
+    Radius(usize),
+    /// The applied load of joint i (an expression of t, the coordinates and their rates).
+    Load(usize),
     /// The initial guess of coordinate i.
     InitialQ(usize),
     /// The initial guess of velocity i.

@@ -1053,7 +1053,7 @@ mod tests {
 
     #[test]
     fn profiles_are_the_papers() {
-        let at = |file: &str, x: f64| load(file).contacts[0].profile.eval(x);
+        let at = |file: &str, x: f64| load(file).contacts[0].profile_expression().eval(x);
         // The profiles are cubic polynomials evaluated in a different association order from
         // the closed forms below: agreement to 1e-15 at |x| ≤ 1 (a few ulps of values ≤ 1).
         let close = |a: f64, b: f64| (a - b).abs() < 1e-15;
@@ -1136,7 +1136,7 @@ mod tests {
         let d = marker_position(m, q, c.marker) - nalgebra::Vector3::from(c.origin);
         let x = d.dot(&nalgebra::Vector3::from(c.x_axis));
         let y = d.dot(&nalgebra::Vector3::from(c.y_axis));
-        y - c.profile.eval(x)
+        y - c.profile_expression().eval(x)
     }
 
     /// Newton on the one unheld coordinate from the file's guess (drives evaluated at t = 0):

@@ -55,7 +55,7 @@ fn paper_contact_point_matches_the_closed_form_of_section_6() {
     for _ in 0..100 {
         let q = rng.vec(4, -3.0, 3.0);
         let qd = vec![0.0; 4];
-        let v = d.eval(&[c.f1, c.f2], 0.0, &q, &qd);
+        let v = d.eval(&c.relative.xy, 0.0, &q, &qd);
         let l = 0.1 + q[2] + 0.3;
         let x =
             0.38 + 0.3 * q[0].cos() + l * (q[0] + q[1]).cos() + 0.3 * (q[0] + q[1] + q[3]).cos();
@@ -93,7 +93,10 @@ fn check_contacts(d: &Derivation, q: &[f64], qd: &[f64]) {
         let at = |ids: &[camchain_codegen::expr::Id], q: &[f64]| d.eval(ids, 0.0, q, qd);
         for k in 0..n {
             let e = unit(n, k);
-            for (ids, f) in [(&c.j1, c.f1), (&c.j2, c.f2), (&c.jacobian, c.h)] {
+            let r = &c.relative;
+            let j1: Vec<_> = r.columns.iter().map(|c| c[0]).collect();
+            let j2: Vec<_> = r.columns.iter().map(|c| c[1]).collect();
+            for (ids, f) in [(&j1, r.xy[0]), (&j2, r.xy[1]), (&c.jacobian, c.h)] {
                 let fd = d1(|s| at(&[f], &shifted(q, &e, s))[0], h);
                 let sym = at(&[ids[k]], q)[0];
                 assert!(
@@ -103,7 +106,12 @@ fn check_contacts(d: &Derivation, q: &[f64], qd: &[f64]) {
             }
         }
         // Along the straight path q + s q̇ (q̈ = 0): d²f/ds² is the convective term.
-        for (conv, f) in [(c.conv1, c.f1), (c.conv2, c.f2), (c.bias, c.h)] {
+        let r = &c.relative;
+        for (conv, f) in [
+            (r.convective[0], r.xy[0]),
+            (r.convective[1], r.xy[1]),
+            (c.bias, c.h),
+        ] {
             let fd = d2(|s| at(&[f], &shifted(q, qd, s))[0], 1e-4);
             let sym = at(&[conv], q)[0];
             assert!(

@@ -226,10 +226,16 @@ impl Div for Jet2 {
 
 /// Evaluates `expr` as a jet at `x`: the jet of the variable is `(x, 1, 0)`.
 pub fn eval_jet2(expr: &Scalar, x: f64) -> Jet2 {
-    let ev = |e: &Scalar| eval_jet2(e, x);
+    eval_on(expr, Jet2::variable(x))
+}
+
+/// Evaluates `expr` with its variable given as the jet `x` (the chain rule through an inner
+/// function: a profile at a point that itself moves).
+pub fn eval_on(expr: &Scalar, x: Jet2) -> Jet2 {
+    let ev = |e: &Scalar| eval_on(e, x);
     match expr {
         Scalar::Const(c) => Jet2::constant(*c),
-        Scalar::Var => Jet2::variable(x),
+        Scalar::Var => x,
         // Validated models hand the reference their expressions with every parameter
         // resolved to its value; an unresolved one has no value here.
         Scalar::Param(_) => Jet2::constant(f64::NAN),
@@ -241,6 +247,26 @@ pub fn eval_jet2(expr: &Scalar, x: f64) -> Jet2 {
         Scalar::Powi(a, n) => ev(a).powi(*n),
         Scalar::Powf(a, b) => ev(a).powf(ev(b)),
         Scalar::Call(func, a) => ev(a).apply(*func),
+    }
+}
+
+/// The value of `expr` at `x` with [`Scalar::Param`] `i` given by `values[i]` (an applied
+/// joint load: its extra parameters are the coordinates and their rates), NaN for an index
+/// past them.
+pub fn eval_with(expr: &Scalar, x: f64, values: &[f64]) -> f64 {
+    let ev = |e: &Scalar| eval_with(e, x, values);
+    match expr {
+        Scalar::Const(c) => *c,
+        Scalar::Var => x,
+        Scalar::Param(i) => values.get(*i).copied().unwrap_or(f64::NAN),
+        Scalar::Neg(a) => -ev(a),
+        Scalar::Add(a, b) => ev(a) + ev(b),
+        Scalar::Sub(a, b) => ev(a) - ev(b),
+        Scalar::Mul(a, b) => ev(a) * ev(b),
+        Scalar::Div(a, b) => ev(a) / ev(b),
+        Scalar::Powi(a, n) => ev(a).powi(*n),
+        Scalar::Powf(a, b) => ev(a).powf(ev(b)),
+        Scalar::Call(func, a) => Jet2::constant(ev(a)).apply(*func).v,
     }
 }
 

@@ -23,7 +23,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod contact;
 pub mod jet;
 mod numeric;
 
-pub use numeric::{NumericModel, model_info};
+pub use numeric::{NumericModel, contact_info, model_info};

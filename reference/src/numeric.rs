@@ -17,13 +17,17 @@
 //!   the joint axes, convective acceleration from the acceleration recursion with q̈ = 0,
 //!   profile derivatives from [`crate::jet`].
 
-use crate::jet::eval_jet;
+use crate::contact::{ContactConst, Evaluated};
+use crate::jet::{eval_jet, eval_with};
 use camchain_codegen::ModelError;
-use camchain_codegen::model::{Body, Contact, IntegratorChoice, JointKind, Model, ParameterMode};
+use camchain_codegen::model::{
+    Body, Contact, Follower, IntegratorChoice, JointKind, Model, ParameterMode, Profile,
+};
 use camchain_codegen::schema::{load_model, parse_model_with};
 use camchain_runtime::{
-    ContactGeometry, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics, Energy,
-    InitialGuess, IntegratorKind, ModelInfo, ParameterInfo, SimSettings,
+    ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
+    Energy, FollowerKind, InitialGuess, IntegratorKind, ModelInfo, ParameterInfo, ProfileKind,
+    SimSettings,
 };
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use std::path::Path;
@@ -38,7 +42,11 @@ pub fn model_info(model: &Model) -> ModelInfo {
         name: model.name.clone(),
         description: model.description.clone(),
         coordinates: model.bodies.iter().map(coordinate_info).collect(),
-        contacts: model.contacts.iter().map(|c| c.name.clone()).collect(),
+        contacts: model
+            .contacts
+            .iter()
+            .map(|c| contact_info(model, c))
+            .collect(),
         spatial: !model.is_planar(),
         initial: InitialGuess {
             q: model.initial.q.clone(),
@@ -69,6 +77,26 @@ pub fn model_info(model: &Model) -> ModelInfo {
     }
 }
 
+/// The runtime's description of a contact.
+pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
+    ContactInfo {
+        name: c.name.clone(),
+        follower: match c.follower {
+            Follower::Knife => FollowerKind::Knife,
+            Follower::Roller { .. } => FollowerKind::Roller,
+            Follower::Flat { .. } => FollowerKind::Flat,
+        },
+        profile: match c.profile {
+            Profile::Explicit { .. } => ProfileKind::Explicit,
+            Profile::Polar { .. } => ProfileKind::Polar,
+            Profile::Parametric { .. } => ProfileKind::Parametric,
+        },
+        cam_coordinate: c
+            .cam_body
+            .filter(|&b| model.bodies[b].joint.kind == JointKind::Revolute),
+    }
+}
+
 fn coordinate_info(body: &Body) -> CoordinateInfo {
     CoordinateInfo {
         name: body.joint.coordinate.clone(),
@@ -88,7 +116,7 @@ fn integrator_kind(choice: IntegratorChoice) -> IntegratorKind {
     }
 }
 
-fn vec3(a: &[f64; 3]) -> Vec3 {
+pub(crate) fn vec3(a: &[f64; 3]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
 }
 
@@ -193,11 +221,11 @@ impl BodyConst {
 
 /// Position and orientation of a body, in ground coordinates.
 #[derive(Debug, Clone, Copy)]
-struct Pose {
+pub(crate) struct Pose {
     /// Rotation ground ← body.
-    rot: Mat3,
+    pub(crate) rot: Mat3,
     /// Origin of the body frame (on the joint axis of a revolute joint).
-    origin: Vec3,
+    pub(crate) origin: Vec3,
     /// Joint axis.
     axis: Vec3,
     /// Vector from the parent's origin to this body's origin.
@@ -225,16 +253,16 @@ impl Pose {
 /// Velocity state of a body: angular velocity and acceleration, velocity and acceleration
 /// of the body origin, all in ground coordinates.
 #[derive(Debug, Clone, Copy)]
-struct Motion {
-    omega: Vec3,
-    alpha: Vec3,
-    vel: Vec3,
-    acc: Vec3,
+pub(crate) struct Motion {
+    pub(crate) omega: Vec3,
+    pub(crate) alpha: Vec3,
+    pub(crate) vel: Vec3,
+    pub(crate) acc: Vec3,
 }
 
 impl Motion {
     /// The ground is at rest.
-    fn rest() -> Self {
+    pub(crate) fn rest() -> Self {
         Self {
             omega: Vec3::zeros(),
             alpha: Vec3::zeros(),
@@ -244,12 +272,12 @@ impl Motion {
     }
 
     /// Velocity of the body point at offset `r` from the origin.
-    fn point_velocity(&self, r: &Vec3) -> Vec3 {
+    pub(crate) fn point_velocity(&self, r: &Vec3) -> Vec3 {
         self.vel + self.omega.cross(r)
     }
 
     /// Acceleration of the body point at offset `r` from the origin.
-    fn point_acceleration(&self, r: &Vec3) -> Vec3 {
+    pub(crate) fn point_acceleration(&self, r: &Vec3) -> Vec3 {
         self.acc + self.alpha.cross(r) + self.omega.cross(&self.omega.cross(r))
     }
 }
@@ -259,100 +287,6 @@ impl Motion {
 struct Load {
     force: Vec3,
     moment: Vec3,
-}
-
-/// The constant data of one cam contact.
-#[derive(Debug, Clone)]
-struct ContactConst {
-    /// Body carrying the marker.
-    body: usize,
-    /// Marker position in the body frame.
-    marker: Vec3,
-    /// Joints between the ground and the marker's body, root first, with their kinds.
-    path: Vec<(usize, JointKind)>,
-    origin: Vec3,
-    x_axis: Vec3,
-    y_axis: Vec3,
-}
-
-impl ContactConst {
-    fn new(model: &Model, contact: &Contact) -> Self {
-        let marker = &model.markers[contact.marker];
-        Self {
-            body: marker.body,
-            marker: vec3(&marker.position),
-            path: path_from_root(model, marker.body),
-            origin: vec3(&contact.origin),
-            x_axis: vec3(&contact.x_axis),
-            y_axis: vec3(&contact.y_axis),
-        }
-    }
-
-    /// Offset of the marker from its body's origin, ground axes.
-    fn marker_offset(&self, poses: &[Pose]) -> Vec3 {
-        poses[self.body].rot * self.marker
-    }
-
-    /// Column j of the marker's geometric Jacobian ∂p_A/∂q_j: `e_j × (p_A − o_j)` for a
-    /// revolute joint on the path from the root, `e_j` for a prismatic one, zero elsewhere.
-    fn jacobian_column(&self, poses: &[Pose], point: &Vec3, j: usize) -> Vec3 {
-        let on_path = self.path.iter().find(|(i, _)| *i == j);
-        match on_path {
-            None => Vec3::zeros(),
-            Some((_, JointKind::Revolute)) => poses[j].axis.cross(&(point - poses[j].origin)),
-            Some((_, JointKind::Prismatic)) => poses[j].axis,
-        }
-    }
-}
-
-/// Joints from the root down to `body` (root first), with their kinds.
-fn path_from_root(model: &Model, body: usize) -> Vec<(usize, JointKind)> {
-    let mut path = Vec::new();
-    let mut current = Some(body);
-    while let Some(i) = current {
-        path.push((i, model.bodies[i].joint.kind));
-        current = model.bodies[i].parent;
-    }
-    path.reverse();
-    path
-}
-
-/// A contact point located in the cam plane, with the profile under it (eq. 1).
-#[derive(Debug, Clone, Copy)]
-struct CamPoint {
-    /// The marker in ground coordinates.
-    point: Vec3,
-    /// f1: cam-plane x.
-    x: f64,
-    /// f2: cam-plane y.
-    y: f64,
-    /// f3, f3', f3'' at x.
-    profile: [f64; 3],
-}
-
-impl CamPoint {
-    /// h = f2 − f3(f1), eq. (3).
-    fn gap(&self) -> f64 {
-        self.y - self.profile[0]
-    }
-
-    fn slope(&self) -> f64 {
-        self.profile[1]
-    }
-
-    fn curvature(&self) -> f64 {
-        self.profile[2]
-    }
-
-    fn geometry(&self) -> ContactGeometry {
-        ContactGeometry {
-            position: [self.point.x, self.point.y, self.point.z],
-            x: self.x,
-            y: self.y,
-            slope: self.slope(),
-            curvature: self.curvature(),
-        }
-    }
 }
 
 /// A model evaluated numerically by recursive Newton–Euler: the reference implementation of
@@ -517,32 +451,33 @@ impl NumericModel {
             .sum()
     }
 
-    /// Locates contact `k` in the cam plane and evaluates the profile there (eq. 1).
-    fn cam_point(&self, poses: &[Pose], k: usize) -> CamPoint {
-        let contact = &self.contacts[k];
-        let point = poses[contact.body].origin + contact.marker_offset(poses);
-        let relative = point - contact.origin;
-        let x = contact.x_axis.dot(&relative);
-        CamPoint {
-            point,
-            x,
-            y: contact.y_axis.dot(&relative),
-            profile: eval_jet(&self.model.contacts[k].profile, x),
-        }
+    /// Every contact evaluated at (q, q̇): h, J, c and the outputs ([`crate::contact`]).
+    fn contacts_at(&self, q: &[f64], qd: &[f64]) -> Vec<Evaluated> {
+        let poses = self.poses(q);
+        let motions = self.motions(&poses, |i| qd[i], |_| 0.0);
+        let unit = |j: usize| self.motions(&poses, |i| f64::from(u8::from(i == j)), |_| 0.0);
+        self.contacts
+            .iter()
+            .map(|c| c.evaluate(&poses, &motions, &unit, self.n()))
+            .collect()
     }
 
-    /// Velocity and convective acceleration (q̈ = 0 in `motions`) of the marker of
-    /// contact `k`, ground coordinates.
-    fn marker_velocity_acceleration(
-        &self,
-        poses: &[Pose],
-        motions: &[Motion],
-        k: usize,
-    ) -> (Vec3, Vec3) {
-        let contact = &self.contacts[k];
-        let r = contact.marker_offset(poses);
-        let motion = &motions[contact.body];
-        (motion.point_velocity(&r), motion.point_acceleration(&r))
+    /// The applied joint loads τ(t, q, q̇) (zero where a joint has none).
+    fn joint_loads_applied(&self, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+        let np = self.model.parameters.len();
+        let mut values = vec![f64::NAN; np];
+        values.extend(q);
+        values.extend(qd);
+        self.model
+            .bodies
+            .iter()
+            .map(|b| {
+                b.joint
+                    .load
+                    .as_ref()
+                    .map_or(0.0, |load| eval_with(&load.expr, t, &values))
+            })
+            .collect()
     }
 }
 
@@ -577,51 +512,42 @@ impl Dynamics for NumericModel {
         self.joint_loads(&poses, &motions, &Vec3::zeros(), f);
     }
 
-    /// Inverse dynamics with q̇ = q̈ = 0 under gravity, plus `k (q − rest) + c q̇`.
-    fn applied_forces(&self, _t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+    /// Inverse dynamics with q̇ = q̈ = 0 under gravity, plus `k (q − rest) + c q̇`, minus the
+    /// applied joint loads.
+    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
         let poses = self.poses(q);
         let motions = self.motions(&poses, |_| 0.0, |_| 0.0);
         self.joint_loads(&poses, &motions, &self.gravity(), out);
         self.add_spring_dampers(q, qd, out);
+        for (o, tau) in out.iter_mut().zip(self.joint_loads_applied(t, q, qd)) {
+            *o -= tau;
+        }
     }
 
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
-        let poses = self.poses(q);
-        for (k, hk) in h.iter_mut().enumerate().take(self.contacts.len()) {
-            *hk = self.cam_point(&poses, k).gap();
+        let zero = vec![0.0; self.n()];
+        for (hk, e) in h.iter_mut().zip(self.contacts_at(q, &zero)) {
+            *hk = e.h;
         }
     }
 
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
         let n = self.n();
-        let poses = self.poses(q);
-        for (k, contact) in self.contacts.iter().enumerate() {
-            let cam = self.cam_point(&poses, k);
-            let direction = contact.y_axis - contact.x_axis * cam.slope();
-            for col in 0..n {
-                let column = contact.jacobian_column(&poses, &cam.point, col);
-                j[k * n + col] = direction.dot(&column);
-            }
+        let zero = vec![0.0; n];
+        for (k, e) in self.contacts_at(q, &zero).iter().enumerate() {
+            j[k * n..(k + 1) * n].copy_from_slice(&e.jacobian);
         }
     }
 
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
-        let poses = self.poses(q);
-        let motions = self.motions(&poses, |i| qd[i], |_| 0.0);
-        for (k, contact) in self.contacts.iter().enumerate() {
-            let cam = self.cam_point(&poses, k);
-            let (vel, acc) = self.marker_velocity_acceleration(&poses, &motions, k);
-            let x_rate = contact.x_axis.dot(&vel);
-            c[k] = contact.y_axis.dot(&acc)
-                - cam.slope() * contact.x_axis.dot(&acc)
-                - cam.curvature() * x_rate * x_rate;
+        for (ck, e) in c.iter_mut().zip(self.contacts_at(q, qd)) {
+            *ck = e.bias;
         }
     }
 
-    fn contact_geometry(&self, q: &[f64], out: &mut [ContactGeometry]) {
-        let poses = self.poses(q);
-        for (k, g) in out.iter_mut().enumerate().take(self.contacts.len()) {
-            *g = self.cam_point(&poses, k).geometry();
+    fn contact_geometry(&self, q: &[f64], qd: &[f64], out: &mut [ContactGeometry]) {
+        for (g, e) in out.iter_mut().zip(self.contacts_at(q, qd)) {
+            *g = e.geometry;
         }
     }
 
@@ -632,23 +558,11 @@ impl Dynamics for NumericModel {
         k: usize,
         out: &mut ContactKinematics,
     ) {
-        let Some(contact) = self.contacts.get(k) else {
-            return;
-        };
-        let poses = self.poses(q);
-        let motions = self.motions(&poses, |i| qd[i], |_| 0.0);
-        let cam = self.cam_point(&poses, k);
-        let columns: Vec<Vec3> = (0..self.n())
-            .map(|j| contact.jacobian_column(&poses, &cam.point, j))
-            .collect();
-        let (_, acc) = self.marker_velocity_acceleration(&poses, &motions, k);
-        *out = ContactKinematics {
-            geometry: cam.geometry(),
-            j1: columns.iter().map(|c| contact.x_axis.dot(c)).collect(),
-            j2: columns.iter().map(|c| contact.y_axis.dot(c)).collect(),
-            conv1: contact.x_axis.dot(&acc),
-            conv2: contact.y_axis.dot(&acc),
-        };
+        if k < self.contacts.len() {
+            if let Some(e) = self.contacts_at(q, qd).into_iter().nth(k) {
+                *out = e.kinematics;
+            }
+        }
     }
 
     fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
@@ -670,6 +584,14 @@ impl Dynamics for NumericModel {
         }
         energy.spring = self.spring_energy(q);
         energy
+    }
+
+    fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+        self.joint_loads_applied(t, q, qd)
+            .iter()
+            .zip(qd)
+            .map(|(tau, v)| tau * v)
+            .sum()
     }
 
     fn damper_power(&self, qd: &[f64]) -> f64 {
@@ -701,6 +623,7 @@ mod tests {
             coordinate: name.to_string(),
             spring: None,
             prescribed: None,
+            load: None,
         }
     }
 
@@ -767,11 +690,16 @@ mod tests {
         Contact {
             name: name.into(),
             marker,
-            profile_source: String::new(),
-            profile,
+            follower: Follower::Knife,
+            profile: Profile::Explicit {
+                source: String::new(),
+                f: profile,
+            },
+            cam_body: None,
             origin: [0.0; 3],
             x_axis: [x_axis.x, x_axis.y, x_axis.z],
             y_axis: [y_axis.x, y_axis.y, y_axis.z],
+            range: None,
         }
     }
 
@@ -984,8 +912,8 @@ mod tests {
         for k in 0..m.info().n_contacts() {
             let kin = m.contact_kinematics(q, qd, k);
             let f12 = |x: &[f64]| {
-                let g = m.contact_kinematics(x, qd, k).geometry;
-                vec![g.x, g.y]
+                let kin = m.contact_kinematics(x, qd, k);
+                vec![kin.x, kin.y]
             };
             let (fd_j1, fd_j2): (Vec<f64>, Vec<f64>) = (0..n)
                 .map(|i| {
@@ -1196,12 +1124,20 @@ mod tests {
         assert_relative_eq!(g.x, x, max_relative = EXACT_TOL);
         assert_relative_eq!(g.y, y, max_relative = EXACT_TOL);
         assert_eq!(g.position[2], 0.0);
-        assert_relative_eq!(g.slope, -0.595 + x + 1.5 * x * x, max_relative = EXACT_TOL);
-        assert_relative_eq!(g.curvature, 1.0 + 3.0 * x, max_relative = EXACT_TOL);
+        let (slope, second) = (-0.595 + x + 1.5 * x * x, 1.0 + 3.0 * x);
+        let stretch = (1.0 + slope * slope).sqrt();
+        assert_relative_eq!(g.force_scale, stretch, max_relative = EXACT_TOL);
+        assert_relative_eq!(g.normal[0], -slope / stretch, max_relative = EXACT_TOL);
+        assert_relative_eq!(g.normal[1], 1.0 / stretch, max_relative = EXACT_TOL);
+        assert_relative_eq!(
+            g.curvature,
+            second / stretch.powi(3),
+            max_relative = EXACT_TOL
+        );
         let f3 = -0.595 * x + 0.5 * x * x + 0.5 * x.powi(3);
         assert_relative_eq!(gaps(&nm, &q)[0], y - f3, max_relative = EXACT_TOL);
         let mut geometry = [ContactGeometry::default()];
-        nm.contact_geometry(&q, &mut geometry);
+        nm.contact_geometry(&q, &PAPER_QD, &mut geometry);
         assert_eq!(geometry[0], g);
     }
 
@@ -1223,7 +1159,7 @@ mod tests {
         let nm = paper_chain();
         let info = nm.info();
         assert_eq!(info.n(), 4);
-        assert_eq!(info.contacts, vec!["A".to_string()]);
+        assert_eq!(info.contacts, vec![ContactInfo::knife("A")]);
         assert!(!info.spatial);
         assert_eq!(info.coordinate_index("q3"), Some(2));
         assert_eq!(info.coordinates[2].kind, CoordinateKind::Prismatic);

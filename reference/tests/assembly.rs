@@ -157,8 +157,11 @@ fn paper_scaled(length: f64) -> NumericModel {
     let profile = format!(
         "{length:?}*(-0.595*(x/{length:?}) + 0.5*(x/{length:?}).powi(2) + 0.5*(x/{length:?}).powi(3))"
     );
-    model.contacts[0].profile = camchain_codegen::profile::parse_expression(&profile, "x")
-        .expect("the scaled profile parses");
+    model.contacts[0].profile = camchain_codegen::model::Profile::Explicit {
+        f: camchain_codegen::profile::parse_expression(&profile, "x")
+            .expect("the scaled profile parses"),
+        source: profile,
+    };
     NumericModel::new(model)
 }
 

@@ -219,35 +219,61 @@ fn check_model(spec: &ModelSpec, ron: &str, states: &[StateSpec]) -> Result<(), 
             check.group("h", &hs, &h[k..=k], g.y.abs().max((g.y - h[k]).abs()));
             // J = J2 − f3' J1.
             let js = d.eval(&terms.jacobian, t, q, qd);
-            let j_terms = max_abs(&ck.j2).max(g.slope.abs() * max_abs(&ck.j1));
+            // |f3'| ≤ √(1 + f3'²) = the force scale of a knife edge on y = f3(x).
+            let j_terms = max_abs(&ck.j2).max(g.force_scale * max_abs(&ck.j1));
             check.group("J", &js, &j[k * n..(k + 1) * n], j_terms);
             // c = conv2 − f3' conv1 − f3'' (J1 q̇)².
             let cs = d.eval(&[terms.bias], t, q, qd);
+            // f3'' = κ (1 + f3'²)^(3/2).
+            let second = g.curvature * g.force_scale.powi(3);
             let c_terms = ck
                 .conv2
                 .abs()
-                .max((g.slope * ck.conv1).abs())
-                .max((g.curvature * j1_qd * j1_qd).abs());
+                .max((g.force_scale * ck.conv1).abs())
+                .max((second * j1_qd * j1_qd).abs());
             check.group("c (convective term)", &cs, &c[k..=k], c_terms);
+            let r = &terms.relative;
             let ids = [
-                terms.f1,
-                terms.f2,
+                r.xy[0],
+                r.xy[1],
                 terms.position[0],
                 terms.position[1],
                 terms.position[2],
             ];
-            let want = [g.x, g.y, g.position[0], g.position[1], g.position[2]];
+            let want = [ck.x, ck.y, g.position[0], g.position[1], g.position[2]];
             check.group(
                 "contact position f1, f2, p",
                 &d.eval(&ids, t, q, qd),
                 &want,
                 0.0,
             );
-            let profile = d.eval(&[terms.slope, terms.curvature], t, q, qd);
-            check.group("f3', f3''", &profile, &[g.slope, g.curvature], 0.0);
-            check.group("J1", &d.eval(&terms.j1, t, q, qd), &ck.j1, 0.0);
-            check.group("J2", &d.eval(&terms.j2, t, q, qd), &ck.j2, 0.0);
-            let conv = d.eval(&[terms.conv1, terms.conv2], t, q, qd);
+            let ids = [
+                terms.force_scale,
+                terms.curvature,
+                terms.normal[0],
+                terms.normal[1],
+                terms.normal[2],
+                terms.sliding,
+            ];
+            let want = [
+                g.force_scale,
+                g.curvature,
+                g.normal[0],
+                g.normal[1],
+                g.normal[2],
+                g.sliding_speed,
+            ];
+            check.group(
+                "force scale, curvature, normal, sliding speed",
+                &d.eval(&ids, t, q, qd),
+                &want,
+                0.0,
+            );
+            let j1: Vec<_> = r.columns.iter().map(|c| c[0]).collect();
+            let j2: Vec<_> = r.columns.iter().map(|c| c[1]).collect();
+            check.group("J1", &d.eval(&j1, t, q, qd), &ck.j1, 0.0);
+            check.group("J2", &d.eval(&j2, t, q, qd), &ck.j2, 0.0);
+            let conv = d.eval(&r.convective, t, q, qd);
             check.group(
                 "convective (J1 q̇)_q q̇, (J2 q̇)_q q̇",
                 &conv,

@@ -51,22 +51,40 @@ fn compare(model: Model) {
         }
         for (k, c) in d.contacts.iter().enumerate() {
             let r = numeric.contact_kinematics(&q, &qd, k);
-            let ids = [c.f1, c.f2, c.conv1, c.conv2, c.slope, c.curvature];
+            let rel = &c.relative;
+            let ids = [
+                rel.xy[0],
+                rel.xy[1],
+                rel.convective[0],
+                rel.convective[1],
+                c.force_scale,
+                c.curvature,
+                c.h,
+                c.bias,
+            ];
+            let mut h = vec![0.0; d.contacts.len()];
+            numeric.constraint(&q, &mut h);
+            let mut bias = vec![0.0; d.contacts.len()];
+            numeric.constraint_bias(&q, &qd, &mut bias);
             let want = [
-                r.geometry.x,
-                r.geometry.y,
+                r.x,
+                r.y,
                 r.conv1,
                 r.conv2,
-                r.geometry.slope,
+                r.geometry.force_scale,
                 r.geometry.curvature,
+                h[k],
+                bias[k],
             ];
             for (a, b) in d.eval(&ids, 0.0, &q, &qd).iter().zip(want) {
                 close(*a, b, "contact");
             }
-            for (a, b) in d.eval(&c.j1, 0.0, &q, &qd).iter().zip(&r.j1) {
+            let j1: Vec<_> = rel.columns.iter().map(|c| c[0]).collect();
+            let j2: Vec<_> = rel.columns.iter().map(|c| c[1]).collect();
+            for (a, b) in d.eval(&j1, 0.0, &q, &qd).iter().zip(&r.j1) {
                 close(*a, *b, "J1");
             }
-            for (a, b) in d.eval(&c.j2, 0.0, &q, &qd).iter().zip(&r.j2) {
+            for (a, b) in d.eval(&j2, 0.0, &q, &qd).iter().zip(&r.j2) {
                 close(*a, *b, "J2");
             }
         }

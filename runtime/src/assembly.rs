@@ -167,7 +167,7 @@ fn changes<D: Dynamics + ?Sized>(
 /// point (ground frame) at q.
 fn length_scale<D: Dynamics + ?Sized>(model: &D, q: &[f64]) -> f64 {
     let mut contacts = vec![ContactGeometry::default(); model.info().n_contacts()];
-    model.contact_geometry(q, &mut contacts);
+    model.contact_geometry(q, &vec![0.0; q.len()], &mut contacts);
     contacts
         .iter()
         .flat_map(|c| c.position)

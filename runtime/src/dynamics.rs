@@ -1,10 +1,13 @@
 //! The contract between a model (generated, or the numeric reference) and the runtime.
 //!
 //! Everything is expressed in the paper's form (13)–(14):
-//! `M(q) q̈ + F(q, q̇) + Q(q, q̇, t) + Jᵀ λ = 0`, with one scalar constraint
-//! `h(q) = f2(q) − f3(f1(q)) = 0` per cam contact (3) and its acceleration form
-//! `J q̈ + c(q, q̇) = 0` (7, 8). Matrices are dense row-major slices so that generated code
-//! can write them without allocation.
+//! `M(q) q̈ + F(q, q̇) + Q(q, q̇, t) + Jᵀ λ = 0`: the tree dynamics M, F, Q, and one scalar
+//! constraint `h(q) = 0` per contact with its acceleration form `J q̈ + c(q, q̇) = 0` (7, 8).
+//! Every contact kind (a knife edge, a roller or a flat face on a cam profile carried by the
+//! ground or by any body) supplies its h, J and c and describes itself through
+//! [`ContactGeometry`]: the runtime sees constraints and normals, never a profile.
+//! Matrices are dense row-major slices so that generated code can write them without
+//! allocation.
 
 /// Kind of a generalised coordinate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -79,6 +82,54 @@ pub struct InitialGuess {
     pub given_qd: Vec<bool>,
 }
 
+/// The shape of a contact's follower.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FollowerKind {
+    /// A point of the follower (the paper's knife edge).
+    Knife,
+    /// A roller (a circle centred on the follower point).
+    Roller,
+    /// A flat face through the follower point.
+    Flat,
+}
+
+/// The form of a contact's cam profile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ProfileKind {
+    /// y = f(x).
+    Explicit,
+    /// r(θ): a disc cam.
+    Polar,
+    /// (x(s), y(s)).
+    Parametric,
+}
+
+/// Static description of one contact.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactInfo {
+    /// Name (its marker's, unless the model file names it).
+    pub name: String,
+    /// The follower's shape.
+    pub follower: FollowerKind,
+    /// The profile's form.
+    pub profile: ProfileKind,
+    /// The coordinate of the cam body's own joint when it is revolute (the cam's angle is
+    /// that coordinate); `None` for a cam on the ground or on a sliding body.
+    pub cam_coordinate: Option<usize>,
+}
+
+impl ContactInfo {
+    /// A knife edge on an explicit profile fixed to the ground: the paper's contact.
+    pub fn knife(name: &str) -> Self {
+        ContactInfo {
+            name: name.to_string(),
+            follower: FollowerKind::Knife,
+            profile: ProfileKind::Explicit,
+            cam_coordinate: None,
+        }
+    }
+}
+
 /// Static description of a model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelInfo {
@@ -88,8 +139,8 @@ pub struct ModelInfo {
     pub description: String,
     /// The generalised coordinates, in order.
     pub coordinates: Vec<CoordinateInfo>,
-    /// Contact names (the marker names), in order.
-    pub contacts: Vec<String>,
+    /// The contacts (one constraint each), in order.
+    pub contacts: Vec<ContactInfo>,
     /// False for a planar model (contact z coordinates are always 0 and not reported).
     pub spatial: bool,
     /// Initial guess.
@@ -117,39 +168,114 @@ impl ModelInfo {
         self.coordinates.iter().position(|c| c.name == name)
     }
 
+    /// Index of a contact by name.
+    pub fn contact_index(&self, name: &str) -> Option<usize> {
+        self.contacts.iter().position(|c| c.name == name)
+    }
+
     /// Index of a run-time parameter by name.
     pub fn parameter_index(&self, name: &str) -> Option<usize> {
         self.parameters.iter().position(|p| p.name == name)
     }
 }
 
-/// Where a contact point is, in ground and cam coordinates, and the profile there.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// Where and how a contact touches: what every contact kind reports, at (q, q̇).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactGeometry {
-    /// Contact point (the marker) in ground coordinates.
+    /// The contact point on the cam profile, ground coordinates.
     pub position: [f64; 3],
-    /// f1(q): the point's x in the cam plane (1).
+    /// The contact point's x in the cam frame (the cam plane, carried by the cam body).
     pub x: f64,
-    /// f2(q): the point's y in the cam plane (1).
+    /// The contact point's y in the cam frame.
     pub y: f64,
-    /// f3'(f1(q)): slope of the profile under the point.
-    pub slope: f64,
-    /// f3''(f1(q)).
+    /// The follower point (the knife edge, the roller's centre, the marker on the flat
+    /// face), ground coordinates.
+    pub follower: [f64; 3],
+    /// Unit normal at the contact, ground coordinates, pointing from the cam into the
+    /// follower: the direction of the force the cam exerts.
+    pub normal: [f64; 3],
+    /// The cam's axis (the normal of the cam plane), ground coordinates.
+    pub axis: [f64; 3],
+    /// |∂h/∂(displacement along the normal)|: the normal force is `−λ · force_scale`
+    /// ([`crate::partition::normal_force`]); √(1 + f′²) for a knife edge on y = f(x), 1 for
+    /// the kinds whose h is a distance.
+    pub force_scale: f64,
+    /// The profile's parameter at the contact point (x, θ or s). A caller that passes the
+    /// previous call's values back lets the solve start there.
+    pub parameter: f64,
+    /// Curvature of the profile at the contact point (1/m): positive where the profile is
+    /// hollow seen from the follower (a roller must be smaller than 1/curvature there).
     pub curvature: f64,
+    /// Unit direction in which the follower body's own joint moves the follower point,
+    /// ground coordinates: the slide of a translating follower, the arc's tangent of a rocker.
+    pub direction: [f64; 3],
+    /// Sliding speed (m/s): the tangential velocity, relative to the cam, of the follower
+    /// body's material at the contact point (a roller rolls: for it this is the rim speed
+    /// of its spin relative to the follower, the slip a seized roller would have).
+    pub sliding_speed: f64,
 }
 
-/// Full first- and second-order kinematics of one contact point (diagnostics and tests).
+impl Default for ContactGeometry {
+    fn default() -> Self {
+        ContactGeometry {
+            position: [0.0; 3],
+            x: 0.0,
+            y: 0.0,
+            follower: [0.0; 3],
+            normal: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            force_scale: 1.0,
+            // Not a solved parameter: a solve starts from its own guess.
+            parameter: f64::NAN,
+            curvature: 0.0,
+            direction: [0.0; 3],
+            sliding_speed: 0.0,
+        }
+    }
+}
+
+impl ContactGeometry {
+    /// The pressure angle (rad): the angle between the contact normal and the follower's
+    /// direction of motion, in [−π/2, π/2], positive when the normal is turned from the
+    /// direction counterclockwise about the cam's axis.
+    pub fn pressure_angle(&self) -> f64 {
+        let (n, a) = (self.normal, self.axis);
+        let mut d = self.direction;
+        if dot3(d, n) < 0.0 {
+            d = d.map(|c| -c);
+        }
+        let cross = [
+            d[1] * n[2] - d[2] * n[1],
+            d[2] * n[0] - d[0] * n[2],
+            d[0] * n[1] - d[1] * n[0],
+        ];
+        dot3(cross, a).atan2(dot3(d, n))
+    }
+}
+
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// First- and second-order kinematics of a contact's follower point in the cam frame
+/// (diagnostics and tests): X, Y its cam-frame coordinates, J1 = ∂X/∂q, J2 = ∂Y/∂q, and the
+/// velocity-product parts of Ẍ and Ÿ. For a cam on a moving body these are the relative
+/// kinematics the constraint is written with.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ContactKinematics {
-    /// Geometry at q.
+    /// Geometry at (q, q̇).
     pub geometry: ContactGeometry,
-    /// J1 = ∂f1/∂q.
+    /// X: the follower point's x in the cam frame.
+    pub x: f64,
+    /// Y: the follower point's y in the cam frame.
+    pub y: f64,
+    /// J1 = ∂X/∂q.
     pub j1: Vec<f64>,
-    /// J2 = ∂f2/∂q.
+    /// J2 = ∂Y/∂q.
     pub j2: Vec<f64>,
-    /// (J1 q̇)_q q̇: convective part of the point's cam-x acceleration.
+    /// (J1 q̇)_q q̇: convective part of Ẍ.
     pub conv1: f64,
-    /// (J2 q̇)_q q̇: convective part of the point's cam-y acceleration.
+    /// (J2 q̇)_q q̇: convective part of Ÿ.
     pub conv2: f64,
 }
 
@@ -209,22 +335,26 @@ pub trait Dynamics {
     /// `M q̈ + F + Q = joint drive loads` (so a spring contributes `+k (q − rest)`).
     fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
 
-    /// h(q), eq. (3), one entry per contact.
+    /// h(q), one entry per contact: positive when the follower is clear of the cam
+    /// (h = f2 − f3(f1) for a knife edge on y = f(x), eq. 3; a distance for the other kinds).
     fn constraint(&self, q: &[f64], h: &mut [f64]);
 
-    /// J(q) = J2 − f3'(f1) J1, eq. (5b): row-major nc×n into `j`.
+    /// J(q) = ∂h/∂q, eq. (5b): row-major nc×n into `j`.
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]);
 
-    /// c(q, q̇) = (J2 q̇)_q q̇ − f3' (J1 q̇)_q q̇ − f3'' (J1 q̇)², eqs. (7, 8), so that the
-    /// acceleration-level constraint reads `J q̈ + c = 0`. One entry per contact.
+    /// c(q, q̇) = (J q̇)_q q̇, eqs. (7, 8), so that the acceleration-level constraint reads
+    /// `J q̈ + c = 0`. One entry per contact.
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]);
 
-    /// Geometry of every contact point at q (length nc).
-    fn contact_geometry(&self, q: &[f64], out: &mut [ContactGeometry]);
+    /// Geometry of every contact at (q, q̇) (length nc). Entries of `out` hold the previous
+    /// call's values or defaults: a contact whose point is solved for starts from
+    /// `out[k].parameter` when it is finite.
+    fn contact_geometry(&self, q: &[f64], qd: &[f64], out: &mut [ContactGeometry]);
 
-    /// f1, f2, J1, J2 and the convective terms of contact `k` (diagnostics, tests), written
-    /// into `out` without allocating: `out.j1` and `out.j2` must have length n (as made by
-    /// [`ContactKinematics::new`]). For `k` ≥ nc, `out` is left unchanged.
+    /// The follower point's cam-frame kinematics and the geometry of contact `k`
+    /// (diagnostics, tests), written into `out` without allocating: `out.j1` and `out.j2`
+    /// must have length n (as made by [`ContactKinematics::new`]). For `k` ≥ nc, `out` is
+    /// left unchanged.
     fn contact_kinematics_into(&self, q: &[f64], qd: &[f64], k: usize, out: &mut ContactKinematics);
 
     /// [`Dynamics::contact_kinematics_into`] into a new value (allocates J1 and J2).
@@ -243,6 +373,13 @@ pub trait Dynamics {
 
     /// Power dissipated by the joint dampers, Σ c q̇² (W, >= 0).
     fn damper_power(&self, qd: &[f64]) -> f64;
+
+    /// Power of the applied joint loads (motor torques given as expressions of t, q, q̇),
+    /// Σ τ_i q̇_i (W): with the drives' power, the work done on the system from outside.
+    fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+        let _ = (t, q, qd);
+        0.0
+    }
 
     /// M, F and Q in one call. Generated models override it so that the kinematics shared by
     /// the three (sines, cosines, body velocities) are computed once.

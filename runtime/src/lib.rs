@@ -21,6 +21,7 @@
 //! - [`error`]: simulation errors with time and state.
 
 pub mod assembly;
+pub mod contact;
 pub mod dynamics;
 pub mod error;
 pub mod events;

@@ -198,13 +198,13 @@ fn point_from_workspace<D: Dynamics + ?Sized>(
     let nc = partition.dependent().len();
     ws.solve_multipliers(partition, t)?;
     point.geometry.resize(nc, ContactGeometry::default());
-    model.contact_geometry(ws.q(), &mut point.geometry);
+    model.contact_geometry(ws.q(), ws.qd(), &mut point.geometry);
     point.forces.clear();
     point.forces.extend(
         ws.lambda()
             .iter()
             .zip(&point.geometry)
-            .map(|(&l, g)| normal_force(l, g.slope)),
+            .map(|(&l, g)| normal_force(l, g.force_scale)),
     );
     point.residuals.resize(nc, 0.0);
     model.constraint(ws.q(), &mut point.residuals);

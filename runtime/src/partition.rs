@@ -179,16 +179,18 @@ fn gather_columns(j: &[f64], n: usize, columns: &[usize], out: &mut [f64]) {
     }
 }
 
-/// Contact normal force from the multiplier λ_k and the profile slope f3' under the point.
+/// Contact normal force from the multiplier λ_k and the contact's
+/// [`ContactGeometry::force_scale`](crate::ContactGeometry::force_scale) |∇_p h|.
 ///
 /// The constraint's generalised force enters (14) as +Jᵀλ on the left, i.e. the cam applies
-/// −Jᵀλ. With J = ∇_p h · J_A, where J_A = [J1; J2] is the point's Jacobian and
-/// ∇_p h = (−f3', 1) the gradient of h = y − f3(x) w.r.t. the point position, −Jᵀλ = J_Aᵀ P
-/// with the Cartesian contact force P = −λ ∇_p h = −λ √(1 + f3'²) n̂, where
-/// n̂ = (−f3', 1)/√(1 + f3'²) is the unit normal of the profile pointing to +y. Hence
-/// N = P·n̂ = −λ √(1 + f3'²), positive when the cam pushes the point towards +y.
-pub fn normal_force(lambda: f64, slope: f64) -> f64 {
-    -lambda * (1.0 + slope * slope).sqrt()
+/// −Jᵀλ. With J = ∇_p h · J_p, where J_p is the Jacobian of the follower's point relative to
+/// the cam and ∇_p h the gradient of h with respect to that point, −Jᵀλ = J_pᵀ P with the
+/// contact force P = −λ ∇_p h = −λ |∇_p h| n̂, n̂ the unit normal pointing from the cam into
+/// the follower. Hence N = P·n̂ = −λ |∇_p h|, positive when the cam pushes the follower. For
+/// a knife edge on y = f3(x), h = y − f3(x) and |∇_p h| = √(1 + f3'²); for the kinds whose h
+/// is a distance, 1.
+pub fn normal_force(lambda: f64, force_scale: f64) -> f64 {
+    -lambda * force_scale
 }
 
 /// The split of the coordinates into driven, independent and dependent sets.
@@ -666,7 +668,7 @@ impl Workspace {
     fn evaluate_position_terms<D: Dynamics + ?Sized>(&mut self, model: &D) {
         let len = model.cache_len();
         if self.cache.len() != len {
-            self.cache.resize(len, 0.0);
+            self.cache.resize(len, f64::NAN);
         }
         model.position_terms(&self.q, &mut self.h, &mut self.jacobian, &mut self.cache);
     }
@@ -1601,8 +1603,10 @@ mod tests {
 
     #[test]
     fn normal_force_points_along_the_upward_normal() {
-        // Flat cam, point pushed up by the cam: the y row of (14) has +λ, so λ < 0.
-        assert_eq!(normal_force(-2.0, 0.0), 2.0);
-        assert!((normal_force(-1.0, 1.0) - 2f64.sqrt()).abs() < 1e-15);
+        // Flat cam (force scale √(1 + 0²) = 1), point pushed up by the cam: the y row of
+        // (14) has +λ, so λ < 0.
+        assert_eq!(normal_force(-2.0, 1.0), 2.0);
+        // Slope 1: h = y − x has |∇h| = √2, the force √2 times −λ.
+        assert!((normal_force(-1.0, 2f64.sqrt()) - 2f64.sqrt()).abs() < 1e-15);
     }
 }

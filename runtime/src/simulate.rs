@@ -133,7 +133,8 @@ impl State {
         self.dissipated
     }
 
-    /// Work done by the drives since assembly, ∫ Σ τ_d q̇_d dt (J).
+    /// Work done by the drives and the applied joint loads since assembly,
+    /// ∫ (Σ τ_d q̇_d + Σ τ_i q̇_i) dt (J).
     pub fn driven_work(&self) -> f64 {
         self.driven_work
     }
@@ -242,7 +243,7 @@ pub struct Sample {
     pub energy: Energy,
     /// Energy dissipated by the dampers since assembly (J).
     pub dissipated: f64,
-    /// Work done by the drives since assembly (J).
+    /// Work done by the drives and the applied joint loads since assembly (J).
     pub driven_work: f64,
     /// Dependent coordinates at this instant (shared by the samples of one partition).
     pub dependent: std::sync::Arc<[usize]>,
@@ -838,12 +839,12 @@ impl Phase<'_, '_> {
                 ws.solve_accelerations(model, partition, t)?;
                 ws.solve_multipliers(partition, t)?;
                 let mut contacts = vec![ContactGeometry::default(); partition.dependent().len()];
-                model.contact_geometry(ws.q(), &mut contacts);
+                model.contact_geometry(ws.q(), ws.qd(), &mut contacts);
                 Ok(ws
                     .lambda()
                     .iter()
                     .zip(&contacts)
-                    .map(|(&l, g)| normal_force(l, g.slope))
+                    .map(|(&l, g)| normal_force(l, g.force_scale))
                     .collect())
             }
             Watch::Gap { gap } => Ok(vec![gap(ws.q())]),
@@ -1064,12 +1065,12 @@ fn complete_sample<D: Dynamics + ?Sized>(
     ws.solve_multipliers(partition, t)?;
     model.constraint(&ws.q, &mut ws.h);
     let mut contacts = vec![ContactGeometry::default(); partition.dependent().len()];
-    model.contact_geometry(ws.q(), &mut contacts);
+    model.contact_geometry(ws.q(), ws.qd(), &mut contacts);
     sample.normal_force = ws
         .lambda()
         .iter()
         .zip(&contacts)
-        .map(|(&l, g)| normal_force(l, g.slope))
+        .map(|(&l, g)| normal_force(l, g.force_scale))
         .collect();
     sample.qdd = ws.qdd().to_vec();
     sample.lambda = ws.lambda().to_vec();
@@ -1342,7 +1343,7 @@ fn evaluate_rhs<D: Dynamics + ?Sized>(
         dy[nu + a] = ws.qdd[u];
     }
     dy[2 * nu] = model.damper_power(ws.qd());
-    dy[2 * nu + 1] = drive_power;
+    dy[2 * nu + 1] = drive_power + model.load_power(t, ws.q(), ws.qd());
     let nc = partition.dependent().len();
     for (k, &v) in partition.dependent().iter().enumerate() {
         dy[2 * nu + 2 + k] = ws.qd[v];
@@ -1486,6 +1487,22 @@ mod tests {
         }
     }
 
+    /// A knife edge at `point` on a ground cam y = f(x) with f′ = `slope`, f″ = `second`.
+    fn on_ground_cam(point: [f64; 2], slope: f64, second: f64) -> ContactGeometry {
+        let stretch = (1.0 + slope * slope).sqrt();
+        ContactGeometry {
+            position: [point[0], point[1], 0.0],
+            x: point[0],
+            y: point[1],
+            follower: [point[0], point[1], 0.0],
+            normal: [-slope / stretch, 1.0 / stretch, 0.0],
+            force_scale: stretch,
+            parameter: point[0],
+            curvature: second / stretch.powi(3),
+            ..ContactGeometry::default()
+        }
+    }
+
     fn model_info(
         name: &str,
         coordinates: Vec<CoordinateInfo>,
@@ -1496,7 +1513,9 @@ mod tests {
             name: name.to_string(),
             description: String::new(),
             coordinates,
-            contacts: (0..contacts).map(|k| format!("tip{k}")).collect(),
+            contacts: (0..contacts)
+                .map(|k| crate::ContactInfo::knife(&format!("tip{k}")))
+                .collect(),
             spatial: false,
             initial,
             defaults: settings(IntegratorKind::Dopri5, 1.0, 0.1, 1e-3, 1e-9),
@@ -1607,15 +1626,9 @@ mod tests {
         fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
             c[0] = -self.curve.eval(q[0]).2 * qd[0] * qd[0];
         }
-        fn contact_geometry(&self, q: &[f64], out: &mut [ContactGeometry]) {
+        fn contact_geometry(&self, q: &[f64], _qd: &[f64], out: &mut [ContactGeometry]) {
             let (_, slope, curvature) = self.curve.eval(q[0]);
-            out[0] = ContactGeometry {
-                position: [q[0], q[1], 0.0],
-                x: q[0],
-                y: q[1],
-                slope,
-                curvature,
-            };
+            out[0] = on_ground_cam([q[0], q[1]], slope, curvature);
         }
         fn contact_kinematics_into(
             &self,
@@ -1625,9 +1638,11 @@ mod tests {
             out: &mut ContactKinematics,
         ) {
             let mut geometry = [ContactGeometry::default()];
-            self.contact_geometry(q, &mut geometry);
+            self.contact_geometry(q, _qd, &mut geometry);
             *out = ContactKinematics {
                 geometry: geometry[0],
+                x: q[0],
+                y: q[1],
                 j1: vec![1.0, 0.0],
                 j2: vec![0.0, 1.0],
                 conv1: 0.0,
@@ -1813,17 +1828,11 @@ mod tests {
                 *c = conv2 - slope * conv1 - curvature * x_rate * x_rate;
             }
         }
-        fn contact_geometry(&self, q: &[f64], out: &mut [ContactGeometry]) {
+        fn contact_geometry(&self, q: &[f64], _qd: &[f64], out: &mut [ContactGeometry]) {
             if let Some(out) = out.first_mut() {
                 let [x, y] = self.points(q, &[0.0; 3]).position[2];
                 let (_, slope, curvature) = self.cam_at(x);
-                *out = ContactGeometry {
-                    position: [x, y, 0.0],
-                    x,
-                    y,
-                    slope,
-                    curvature,
-                };
+                *out = on_ground_cam([x, y], slope, curvature);
             }
         }
         fn contact_kinematics_into(
@@ -1835,9 +1844,11 @@ mod tests {
         ) {
             let p = self.points(q, qd);
             let mut geometry = [ContactGeometry::default()];
-            self.contact_geometry(q, &mut geometry);
+            self.contact_geometry(q, qd, &mut geometry);
             *out = ContactKinematics {
                 geometry: geometry[0],
+                x: p.position[2][0],
+                y: p.position[2][1],
                 j1: p.jacobian[2][0].to_vec(),
                 j2: p.jacobian[2][1].to_vec(),
                 conv1: p.convective[2][0],

@@ -95,7 +95,7 @@ impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
     fn constraint(&self, _q: &[f64], _h: &mut [f64]) {}
     fn constraint_jacobian(&self, _q: &[f64], _j: &mut [f64]) {}
     fn constraint_bias(&self, _q: &[f64], _qd: &[f64], _c: &mut [f64]) {}
-    fn contact_geometry(&self, _q: &[f64], _out: &mut [ContactGeometry]) {}
+    fn contact_geometry(&self, _q: &[f64], _qd: &[f64], _out: &mut [ContactGeometry]) {}
     fn contact_kinematics_into(
         &self,
         q: &[f64],
@@ -113,6 +113,9 @@ impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
     }
     fn damper_power(&self, qd: &[f64]) -> f64 {
         self.inner.damper_power(qd)
+    }
+    fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+        self.inner.load_power(t, q, qd)
     }
     fn equations(
         &self,
@@ -225,7 +228,7 @@ fn complete_flight_sample<D: Dynamics + ?Sized>(model: &D, sample: &mut Sample) 
     let mut h = vec![0.0; nc];
     model.constraint(&sample.q, &mut h);
     let mut contacts = vec![ContactGeometry::default(); nc];
-    model.contact_geometry(&sample.q, &mut contacts);
+    model.contact_geometry(&sample.q, &sample.qd, &mut contacts);
     sample.h = h;
     sample.contacts = contacts;
     sample.normal_force = vec![0.0; nc];

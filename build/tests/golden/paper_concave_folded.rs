@@ -15,13 +15,13 @@
 // | `constraint_jacobian` | 14 | 12 | 0 | 6 | 0 | 0 | 32 |
 // | `constraint_bias` | 24 | 28 | 0 | 6 | 0 | 1 | 59 |
 // | `constraint_terms` | 28 | 32 | 0 | 6 | 0 | 1 | 67 |
-// | `contact_geometry` | 12 | 9 | 0 | 6 | 0 | 0 | 27 |
+// | `contact_geometry` | 32 | 26 | 6 | 6 | 2 | 0 | 72 |
 // | `prescribed` | 0 | 0 | 0 | 0 | 0 | 0 | 0 |
 // | `energy` | 30 | 35 | 0 | 7 | 0 | 3 | 75 |
 // | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
 // | `velocity_terms` | 68 | 80 | 0 | 0 | 0 | 1 | 149 |
-// | `contact_kinematics_0` | 24 | 22 | 0 | 6 | 0 | 0 | 52 |
+// | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -167,7 +167,14 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             driven: false,
         },
     ]),
-    contacts: Vec::from(["A".to_string()]),
+    contacts: Vec::from([
+        rt::ContactInfo {
+            name: "A".to_string(),
+            follower: rt::FollowerKind::Knife,
+            profile: rt::ProfileKind::Explicit,
+            cam_coordinate: None,
+        },
+    ]),
     spatial: false,
     initial: rt::InitialGuess {
         q: Vec::from([-1.6707963267948966, 0.0, 0.0, 0.0]),
@@ -474,7 +481,7 @@ impl rt::Dynamics for Model {
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
         let c_q4_q1_q2 = angle_q4_q1_q2.cos();
         let s_q4_q1_q2 = angle_q4_q1_q2.sin();
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        // contact A: the follower seen from the cam, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
         let a_segment_q2_x_t1 = q3 + 0.4;
@@ -507,7 +514,7 @@ impl rt::Dynamics for Model {
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
         let c_q4_q1_q2 = angle_q4_q1_q2.cos();
         let s_q4_q1_q2 = angle_q4_q1_q2.sin();
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        // contact A: the follower seen from the cam, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
         let a_segment_q2_x_t1 = q3 + 0.4;
@@ -552,7 +559,7 @@ impl rt::Dynamics for Model {
         let c_q4_q1_q2 = angle_q4_q1_q2.cos();
         let s_q4_q1_q2 = angle_q4_q1_q2.sin();
         let omega_body4_sq = omega_body4_z * omega_body4_z;
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        // contact A: the follower seen from the cam, h, J, c
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
         let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
@@ -577,11 +584,10 @@ impl rt::Dynamics for Model {
         let a_arm_q1_y = step_body2_y + a_arm_q2_y;
         let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
-        let a_curvature = 1.0 + 3.0 * a_x;
+        let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
-        c[0] = a_convective_y + neg_a_convective_x * a_slope
-            - a_curvature * a_x_rate.powi(2);
+        c[0] = a_convective_y + neg_a_convective_x * a_slope - a_fxx * a_x_rate.powi(2);
     }
     /// J and c sharing one evaluation of the contact kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
@@ -611,7 +617,7 @@ impl rt::Dynamics for Model {
         let c_q4_q1_q2 = angle_q4_q1_q2.cos();
         let s_q4_q1_q2 = angle_q4_q1_q2.sin();
         let omega_body4_sq = omega_body4_z * omega_body4_z;
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        // contact A: the follower seen from the cam, h, J, c
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
         let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
@@ -636,22 +642,25 @@ impl rt::Dynamics for Model {
         let a_arm_q1_y = step_body2_y + a_arm_q2_y;
         let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
-        let a_curvature = 1.0 + 3.0 * a_x;
+        let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
         j[0] = a_arm_q1_x + a_arm_q1_y * a_slope;
         j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
         j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
-        c[0] = a_convective_y + neg_a_convective_x * a_slope
-            - a_curvature * a_x_rate.powi(2);
+        c[0] = a_convective_y + neg_a_convective_x * a_slope - a_fxx * a_x_rate.powi(2);
     }
-    /// Contact points in ground and cam coordinates, with f3' and f3'' under them.
-    fn contact_geometry(&self, q: &[f64], out: &mut [rt::ContactGeometry]) {
+    /// Where and how every contact touches: the contact point in ground and cam coordinates, the follower point, the normal, the force scale, the profile's parameter and curvature there, the follower's direction of motion, the sliding speed.
+    fn contact_geometry(&self, q: &[f64], qd: &[f64], out: &mut [rt::ContactGeometry]) {
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
+        let q1_dot = qd[0];
+        let q2_dot = qd[1];
+        let q3_dot = qd[2];
+        let q4_dot = qd[3];
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = q1.cos();
         let s_q1 = q1.sin();
@@ -661,11 +670,23 @@ impl rt::Dynamics for Model {
         let s_q1_q2 = angle_q1_q2.sin();
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
+        let pos_body2_x = 0.38 + step_body2_x;
+        let pos_body2_y = 0.8 + step_body2_y;
+        // body3: joint q3, rotation, velocities and accelerations
+        let offset_body3_x = q3 + 0.1;
+        let step_body3_x = c_q1_q2 * offset_body3_x;
+        let step_body3_y = s_q1_q2 * offset_body3_x;
+        let pos_body3_x = pos_body2_x + step_body3_x;
+        let pos_body3_y = pos_body2_y + step_body3_y;
         // body4: joint q4, rotation, velocities and accelerations
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
         let c_q4_q1_q2 = angle_q4_q1_q2.cos();
         let s_q4_q1_q2 = angle_q4_q1_q2.sin();
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        let step_body4_x = 0.3 * c_q1_q2;
+        let step_body4_y = 0.3 * s_q1_q2;
+        let pos_body4_x = pos_body3_x + step_body4_x;
+        let pos_body4_y = pos_body3_y + step_body4_y;
+        // contact A: the follower seen from the cam, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
         let a_segment_q2_x_t1 = q3 + 0.4;
@@ -677,15 +698,41 @@ impl rt::Dynamics for Model {
         let a_arm_q1_y = step_body2_y + a_arm_q2_y;
         let a_x = 0.38 + a_arm_q1_x;
         let a_y = 0.8 + a_arm_q1_y;
+        let contact0_direction_1_t1 = a_x - pos_body4_x;
+        let contact0_direction_0_t1 = a_y - pos_body4_y;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
-        let a_curvature = 1.0 + 3.0 * a_x;
+        let a_fxx = 1.0 + 3.0 * a_x;
+        let a_stretch_t1 = 1.0 + a_slope * a_slope;
+        let a_stretch = a_stretch_t1.sqrt();
+        let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
+            - q4_dot * a_segment_q4_y;
+        // outputs: the follower's direction of motion
+        let contact0_direction_0_t2 = (contact0_direction_0_t1 * contact0_direction_0_t1
+            + contact0_direction_1_t1 * contact0_direction_1_t1)
+            .sqrt();
         out[0].position[0] = a_x;
         out[0].position[1] = a_y;
         out[0].position[2] = 0.0;
+        out[0].follower[0] = a_x;
+        out[0].follower[1] = a_y;
+        out[0].follower[2] = 0.0;
+        out[0].normal[0] = -a_slope / a_stretch;
+        out[0].normal[1] = 1.0 / a_stretch;
+        out[0].normal[2] = 0.0;
+        out[0].axis[0] = 0.0;
+        out[0].axis[1] = 0.0;
+        out[0].axis[2] = 1.0;
+        out[0].direction[0] = -contact0_direction_0_t1 / contact0_direction_0_t2;
+        out[0].direction[1] = contact0_direction_1_t1 / contact0_direction_0_t2;
+        out[0].direction[2] = 0.0;
         out[0].x = a_x;
         out[0].y = a_y;
-        out[0].slope = a_slope;
-        out[0].curvature = a_curvature;
+        out[0].force_scale = a_stretch;
+        out[0].parameter = a_x;
+        out[0].curvature = a_fxx / (a_stretch_t1 * a_stretch);
+        out[0].sliding_speed = ((q4_dot * a_segment_q4_x
+            + (q3_dot * s_q1_q2 + (q1_dot * a_arm_q1_x + q2_dot * a_arm_q2_x))) * a_slope
+            + a_x_rate) / a_stretch;
     }
     /// q, q̇, q̈ of the driven coordinates at time t.
     fn prescribed(&self, _t: f64, _q: &mut [f64], _qd: &mut [f64], _qdd: &mut [f64]) {}
@@ -784,7 +831,7 @@ impl rt::Dynamics for Model {
             angle_q4_q1_q2,
             &mut cache[6..9],
         );
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        // contact A: the follower seen from the cam, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
         let a_segment_q2_x_t1 = q3 + 0.4;
@@ -852,7 +899,7 @@ impl rt::Dynamics for Model {
         let neg_acc_body4_in_parent_x = neg_centripetal_body4_x + neg_acc_body3_x;
         let acc_body4_y = neg_rel_rot_body4_12 * neg_acc_body4_in_parent_x
             + rel_rot_body4_11 * acc_body3_y;
-        // contact A: position on the cam, J1, J2, convective terms, h, J, c
+        // contact A: the follower seen from the cam, h, J, c
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
         let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
@@ -877,7 +924,7 @@ impl rt::Dynamics for Model {
         let a_arm_q1_y = step_body2_y + a_arm_q2_y;
         let a_x = 0.38 + a_arm_q1_x;
         let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
-        let a_curvature = 1.0 + 3.0 * a_x;
+        let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
         // body4: composite inertia and column q4 of M
@@ -959,7 +1006,7 @@ impl rt::Dynamics for Model {
         out.applied[2] = weight_q3 + (q3_dot + 40.0 * q3);
         out.applied[3] = 18.0 * q4 + (q4_dot + weight_moment_body4_z);
         out.bias[0] = a_convective_y + neg_a_convective_x * a_slope
-            - a_curvature * a_x_rate.powi(2);
+            - a_fxx * a_x_rate.powi(2);
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
     fn cache_len(&self) -> usize {
@@ -979,7 +1026,7 @@ impl rt::Dynamics for Model {
     }
 }
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
-/// Kinematics of contact `A` into `out` (J1 and J2 of length 4).
+/// Geometry of contact `A` and its follower point's cam-frame kinematics, into `out` (J1 and J2 of length 4).
 fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) {
     let q1 = q[0];
     let q2 = q[1];
@@ -1000,14 +1047,26 @@ fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) 
     let s_q1_q2 = angle_q1_q2.sin();
     let step_body2_x = 0.3 * c_q1;
     let step_body2_y = 0.3 * s_q1;
+    let pos_body2_x = 0.38 + step_body2_x;
+    let pos_body2_y = 0.8 + step_body2_y;
     let omega_body2_sq = omega_body2_z * omega_body2_z;
+    // body3: joint q3, rotation, velocities and accelerations
+    let offset_body3_x = q3 + 0.1;
+    let step_body3_x = c_q1_q2 * offset_body3_x;
+    let step_body3_y = s_q1_q2 * offset_body3_x;
+    let pos_body3_x = pos_body2_x + step_body3_x;
+    let pos_body3_y = pos_body2_y + step_body3_y;
     // body4: joint q4, rotation, velocities and accelerations
     let omega_body4_z = q4_dot + omega_body2_z;
     let angle_q4_q1_q2 = q4 + angle_q1_q2;
     let c_q4_q1_q2 = angle_q4_q1_q2.cos();
     let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+    let step_body4_x = 0.3 * c_q1_q2;
+    let step_body4_y = 0.3 * s_q1_q2;
+    let pos_body4_x = pos_body3_x + step_body4_x;
+    let pos_body4_y = pos_body3_y + step_body4_y;
     let omega_body4_sq = omega_body4_z * omega_body4_z;
-    // contact A: position on the cam, J1, J2, convective terms, h, J, c
+    // contact A: the follower seen from the cam, h, J, c
     let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
     let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
     let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
@@ -1032,15 +1091,43 @@ fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) 
     let a_arm_q1_y = step_body2_y + a_arm_q2_y;
     let a_x = 0.38 + a_arm_q1_x;
     let a_y = 0.8 + a_arm_q1_y;
+    let geometry_direction_1_t1 = a_x - pos_body4_x;
+    let geometry_direction_0_t1 = a_y - pos_body4_y;
     let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
-    let a_curvature = 1.0 + 3.0 * a_x;
+    let a_fxx = 1.0 + 3.0 * a_x;
+    let a_stretch_t1 = 1.0 + a_slope * a_slope;
+    let a_stretch = a_stretch_t1.sqrt();
+    let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
+        - q4_dot * a_segment_q4_y;
+    // outputs: the follower's direction of motion
+    let geometry_direction_0_t2 = (geometry_direction_0_t1 * geometry_direction_0_t1
+        + geometry_direction_1_t1 * geometry_direction_1_t1)
+        .sqrt();
     out.geometry.position[0] = a_x;
     out.geometry.position[1] = a_y;
     out.geometry.position[2] = 0.0;
+    out.geometry.follower[0] = a_x;
+    out.geometry.follower[1] = a_y;
+    out.geometry.follower[2] = 0.0;
+    out.geometry.normal[0] = -a_slope / a_stretch;
+    out.geometry.normal[1] = 1.0 / a_stretch;
+    out.geometry.normal[2] = 0.0;
+    out.geometry.axis[0] = 0.0;
+    out.geometry.axis[1] = 0.0;
+    out.geometry.axis[2] = 1.0;
+    out.geometry.direction[0] = -geometry_direction_0_t1 / geometry_direction_0_t2;
+    out.geometry.direction[1] = geometry_direction_1_t1 / geometry_direction_0_t2;
+    out.geometry.direction[2] = 0.0;
     out.geometry.x = a_x;
     out.geometry.y = a_y;
-    out.geometry.slope = a_slope;
-    out.geometry.curvature = a_curvature;
+    out.geometry.force_scale = a_stretch;
+    out.geometry.parameter = a_x;
+    out.geometry.curvature = a_fxx / (a_stretch_t1 * a_stretch);
+    out.geometry.sliding_speed = ((q4_dot * a_segment_q4_x
+        + (q3_dot * s_q1_q2 + (q1_dot * a_arm_q1_x + q2_dot * a_arm_q2_x))) * a_slope
+        + a_x_rate) / a_stretch;
+    out.x = a_x;
+    out.y = a_y;
     out.j1[0] = -a_arm_q1_y;
     out.j1[1] = -a_arm_q2_y;
     out.j1[2] = c_q1_q2;
@@ -1063,11 +1150,11 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("constraint_jacobian", [14, 12, 0, 6, 0, 0]),
     ("constraint_bias", [24, 28, 0, 6, 0, 1]),
     ("constraint_terms", [28, 32, 0, 6, 0, 1]),
-    ("contact_geometry", [12, 9, 0, 6, 0, 0]),
+    ("contact_geometry", [32, 26, 6, 6, 2, 0]),
     ("prescribed", [0, 0, 0, 0, 0, 0]),
     ("energy", [30, 35, 0, 7, 0, 3]),
     ("damper_power", [2, 0, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
     ("velocity_terms", [68, 80, 0, 0, 0, 1]),
-    ("contact_kinematics_0", [24, 22, 0, 6, 0, 0]),
+    ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
 ];

@@ -457,7 +457,11 @@ fn constant_value(model: &Model, field: Field) -> f64 {
         Field::Origin(c, k) => model.contacts[c].origin[k],
         Field::InitialQ(i) => model.initial.q[i],
         Field::InitialQd(i) => model.initial.qd[i],
-        Field::Drive(_) | Field::Profile(_) => f64::NAN,
+        Field::Radius(c) => match model.contacts[c].follower {
+            crate::model::Follower::Roller { radius } => radius,
+            _ => f64::NAN,
+        },
+        Field::Drive(_) | Field::Profile(_) | Field::ProfileY(_) | Field::Load(_) => f64::NAN,
     }
 }
 

@@ -171,6 +171,8 @@ pub(super) struct Joint {
     pub spring: Option<Spring>,
     #[serde(default)]
     pub prescribed: Option<String>,
+    #[serde(default)]
+    pub load: Option<String>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -190,13 +192,52 @@ pub(super) struct Marker {
     pub position: Vec3,
 }
 
+/// A contact: a follower (a marker and its shape) on a cam profile carried by a body.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Contact {
+    #[serde(default)]
+    pub name: Option<String>,
     pub marker: String,
-    pub profile: String,
+    #[serde(default)]
+    pub follower: Follower,
+    #[serde(default)]
+    pub cam_body: Option<String>,
+    /// An explicit profile y = f(x).
+    #[serde(default)]
+    pub profile: Option<String>,
+    /// A polar profile r(θ).
+    #[serde(default)]
+    pub polar: Option<String>,
+    /// A parametric profile (x(s), y(s)).
+    #[serde(default)]
+    pub parametric: Option<Parametric>,
+    #[serde(default)]
+    pub range: Option<(f64, f64)>,
     #[serde(default)]
     pub frame: Frame,
+}
+
+/// The follower's shape.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) enum Follower {
+    #[default]
+    Knife,
+    Roller {
+        radius: Number,
+    },
+    Flat {
+        normal: Vec3,
+    },
+}
+
+/// `parametric: (x: "…", y: "…")`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Parametric {
+    pub x: String,
+    pub y: String,
 }
 
 /// The cam plane; every field defaults to the ground frame's.

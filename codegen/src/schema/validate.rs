@@ -6,8 +6,9 @@ use super::Locator;
 use super::raw;
 use crate::error::ModelError;
 use crate::model::{
-    Body, Contact, Field, FieldLocation, Initial, IntegratorChoice, Joint, JointKind, Marker,
-    Model, Parameter, ParameterMode, Prescribed, RuntimeCheck, Simulation, SpringDamper,
+    Body, Contact, Field, FieldLocation, Follower, Initial, IntegratorChoice, Joint, JointKind,
+    JointLoad, Marker, Model, Parameter, ParameterMode, Prescribed, Profile, RuntimeCheck,
+    Simulation, SpringDamper,
 };
 use crate::profile::{Scalar, parse_expression_with};
 use camchain_runtime::parameters::{Bound, checks};
@@ -53,10 +54,11 @@ pub(super) fn validate(
     let cx = Context { at, table: &table };
     let gravity = cx.vector("gravity", &file.gravity, Some(Field::Gravity))?;
     let tree = BodyTree::new(&file.bodies, at)?;
-    let bodies = tree.bodies(&file.bodies, &cx)?;
+    let mut bodies = tree.bodies(&file.bodies, &cx)?;
     parameter_names_free(&parameters, &bodies, at)?;
+    joint_loads(&file.bodies, &tree, &mut bodies, &cx)?;
     let markers = markers(&file.markers, &tree, &cx)?;
-    let contacts = contacts(&file.contacts, &markers, &cx)?;
+    let contacts = contacts(&file.contacts, &markers, &tree, &cx)?;
     let initial = initial(&file.initial, &bodies, &cx)?;
     let simulation = simulation(&file.simulation, at)?;
     Ok(Model {
@@ -86,9 +88,9 @@ fn location(at: &Locator, field: &str) -> FieldLocation {
 }
 
 /// Names that expressions already give a meaning to.
-const RESERVED_IN_EXPRESSIONS: [&str; 16] = [
-    "x", "t", "PI", "E", "sin", "cos", "tan", "exp", "ln", "sqrt", "sinh", "cosh", "tanh", "atan",
-    "powi", "powf",
+const RESERVED_IN_EXPRESSIONS: [&str; 18] = [
+    "x", "t", "theta", "s", "PI", "E", "sin", "cos", "tan", "exp", "ln", "sqrt", "sinh", "cosh",
+    "tanh", "atan", "powi", "powf",
 ];
 
 /// The parameters with their effective values (the file's, or an override) and whether the
@@ -109,9 +111,9 @@ fn parameters(file: &raw::Model, options: &Options, at: &Locator) -> Checked<Vec
             return Err(at.error(
                 &format!("{path}.name"),
                 format!(
-                    "`{}` already means something in expressions (the variables x and t, the \
-                     constants PI and E, the math functions; names starting with `__` are \
-                     reserved): choose another parameter name",
+                    "`{}` already means something in expressions (the variables x, theta, s \
+                     and t, the constants PI and E, the math functions; names starting with \
+                     `__` are reserved): choose another parameter name",
                     p.name
                 ),
             ));
@@ -179,11 +181,21 @@ fn parameters(file: &raw::Model, options: &Options, at: &Locator) -> Checked<Vec
 /// stay folded in [`ParameterMode::AllAtRunTime`].
 fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usize> {
     let names: Vec<&str> = parameters.iter().map(|p| p.name.as_str()).collect();
-    let axes = file.bodies.iter().flat_map(|b| b.joint.axis.iter()).chain(
-        file.contacts
+    let axes =
+        file.bodies
             .iter()
-            .flat_map(|c| c.frame.x_axis.iter().chain(c.frame.y_axis.iter())),
-    );
+            .flat_map(|b| b.joint.axis.iter())
+            .chain(file.contacts.iter().flat_map(|c| {
+                let face: &[raw::Number] = match &c.follower {
+                    raw::Follower::Flat { normal } => normal,
+                    _ => &[],
+                };
+                c.frame
+                    .x_axis
+                    .iter()
+                    .chain(c.frame.y_axis.iter())
+                    .chain(face)
+            }));
     let mut used: Vec<usize> = axes
         .filter_map(|n| match n {
             raw::Number::Expr(source) => parse_expression_with(source, None, &names).ok(),
@@ -286,6 +298,34 @@ impl<'a> Table<'a> {
         let folded = parsed.resolve(&self.values, &|i| self.constant[i]);
         let resolved = parsed.resolve_all(&self.values);
         Ok((folded, resolved))
+    }
+
+    /// An applied joint load: an expression of `t`, the parameters, the coordinates (named
+    /// `coordinates`) and their rates (`<name>_dot`), as [`JointLoad::expr`] describes it;
+    /// recorded under `key` when it uses run-time parameters.
+    fn load_expression(
+        &self,
+        field: &str,
+        source: &str,
+        coordinates: &[String],
+        key: Field,
+    ) -> Checked<Scalar> {
+        let np = self.names.len();
+        let rates: Vec<String> = coordinates.iter().map(|c| format!("{c}_dot")).collect();
+        let names: Vec<&str> = self
+            .names
+            .iter()
+            .chain(coordinates)
+            .chain(&rates)
+            .map(String::as_str)
+            .collect();
+        let parsed = parse_expression_with(source, Some("t"), &names)
+            .map_err(|e| self.at.error_in_string(field, e.offset, e.message))?;
+        let folded = parsed.resolve(&self.values, &|i| i < np && self.constant[i]);
+        if folded.parameters().iter().any(|&i| i < np) {
+            self.symbolic.borrow_mut().insert(key, folded);
+        }
+        Ok(parsed.resolve(&self.values, &|i| i < np))
     }
 
     /// Multiplies the recorded expression of `field`, if any, by `factor`.
@@ -820,7 +860,40 @@ fn joint(cx: &Context, path: &str, j: &raw::Joint, body: usize) -> Checked<Joint
             .as_ref()
             .map(|source| prescribed(cx, &format!("{path}.prescribed"), source, body))
             .transpose()?,
+        load: None,
     })
+}
+
+/// The applied loads of the joints: expressions of t, the coordinates (`q1`) and their rates
+/// (`q1_dot`), parsed once every coordinate's name is known.
+fn joint_loads(
+    file: &[raw::Body],
+    tree: &BodyTree,
+    bodies: &mut [Body],
+    cx: &Context,
+) -> Checked<()> {
+    let coordinates: Vec<String> = bodies.iter().map(|b| b.joint.coordinate.clone()).collect();
+    for (sorted, &i) in tree.order.iter().enumerate() {
+        let Some(source) = &file[i].joint.load else {
+            continue;
+        };
+        let field = format!("bodies[{i}].joint.load");
+        if bodies[sorted].joint.prescribed.is_some() {
+            return Err(cx.at.error(
+                &field,
+                "a prescribed joint cannot also have a load: its motion is given and the load \
+                 that drives it is computed (reported as its drive load)",
+            ));
+        }
+        let expr = cx
+            .table
+            .load_expression(&field, source, &coordinates, Field::Load(sorted))?;
+        bodies[sorted].joint.load = Some(JointLoad {
+            source: source.clone(),
+            expr,
+        });
+    }
+    Ok(())
 }
 
 fn spring(cx: &Context, path: &str, s: &raw::Spring, body: usize) -> Checked<SpringDamper> {
@@ -883,51 +956,230 @@ fn markers(list: &[raw::Marker], tree: &BodyTree, cx: &Context) -> Checked<Vec<M
         .collect()
 }
 
-fn contacts(list: &[raw::Contact], markers: &[Marker], cx: &Context) -> Checked<Vec<Contact>> {
+fn contacts(
+    list: &[raw::Contact],
+    markers: &[Marker],
+    tree: &BodyTree,
+    cx: &Context,
+) -> Checked<Vec<Contact>> {
     let at = cx.at;
     let by_name: HashMap<&str, usize> = markers
         .iter()
         .enumerate()
         .map(|(i, m)| (m.name.as_str(), i))
         .collect();
-    let mut used = HashMap::new();
+    let mut names: HashMap<&str, usize> = HashMap::new();
+    for (i, c) in list.iter().enumerate() {
+        let (field, name) = match &c.name {
+            Some(name) => (format!("contacts[{i}].name"), name.as_str()),
+            None => (format!("contacts[{i}].marker"), c.marker.as_str()),
+        };
+        identifier(at, &field, name, "contact name")?;
+        if let Some(first) = names.insert(name, i) {
+            let message = if c.name.is_some() {
+                format!("duplicate contact name `{name}` (contacts[{first}])")
+            } else {
+                format!(
+                    "marker `{name}` already has a contact (contacts[{first}]): a second contact \
+                     on it needs a `name` of its own"
+                )
+            };
+            return Err(at.error(&field, message));
+        }
+    }
     list.iter()
         .enumerate()
         .map(|(i, c)| {
             let field = format!("contacts[{i}].marker");
             let marker = lookup(at, &field, &by_name, &c.marker, "marker")?;
-            if let Some(first) = used.insert(marker, i) {
-                let message = format!(
-                    "marker `{}` already has a contact (contacts[{first}])",
-                    c.marker
-                );
-                return Err(at.error(&field, message));
-            }
-            contact(cx, i, c, marker)
+            contact(cx, tree, i, c, marker, markers[marker].body)
         })
         .collect()
 }
 
-fn contact(cx: &Context, i: usize, c: &raw::Contact, marker: usize) -> Checked<Contact> {
+fn contact(
+    cx: &Context,
+    tree: &BodyTree,
+    i: usize,
+    c: &raw::Contact,
+    marker: usize,
+    follower_body: usize,
+) -> Checked<Contact> {
+    let at = cx.at;
     let path = format!("contacts[{i}]");
+    let cam_body = match c.cam_body.as_deref() {
+        None | Some(GROUND) => None,
+        Some(name) => Some(tree.sorted_body(at, &format!("{path}.cam_body"), name)?),
+    };
+    if cam_body == Some(follower_body) {
+        return Err(at.error(
+            &format!("{path}.cam_body"),
+            format!(
+                "the cam is on the body that carries the marker `{}`: a contact needs two \
+                 bodies that move relative to each other",
+                c.marker
+            ),
+        ));
+    }
     let (x_axis, y_axis) = cam_axes(cx, &format!("{path}.frame"), &c.frame)?;
+    let profile = profile(cx, &path, c, i)?;
+    let follower = follower(cx, &path, &c.follower, i)?;
+    let range = contact_range(at, &path, c, &profile, &follower)?;
     Ok(Contact {
-        name: c.marker.clone(),
+        name: c.name.clone().unwrap_or_else(|| c.marker.clone()),
         marker,
-        profile_source: c.profile.clone(),
-        profile: expression(
-            cx,
-            &format!("{path}.profile"),
-            &c.profile,
-            "x",
-            Field::Profile(i),
-        )?,
+        follower,
+        profile,
+        cam_body,
         origin: cx.vector_of(&format!("{path}.frame.origin"), &c.frame.origin, |k| {
             Field::Origin(i, k)
         })?,
         x_axis,
         y_axis,
+        range,
     })
+}
+
+/// The profile: exactly one of `profile` (explicit), `polar` and `parametric`.
+fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Profile> {
+    let given = [
+        c.profile.is_some(),
+        c.polar.is_some(),
+        c.parametric.is_some(),
+    ];
+    if given.iter().filter(|g| **g).count() != 1 {
+        let message = if given.contains(&true) {
+            "give only one of `profile`, `polar` and `parametric`"
+        } else {
+            "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
+             `polar: \"r(theta)\"` or `parametric: (x: \"x(s)\", y: \"y(s)\")`"
+        };
+        let field = if c.polar.is_some() && given[0] {
+            format!("{path}.polar")
+        } else if c.parametric.is_some() && given.iter().filter(|g| **g).count() > 1 {
+            format!("{path}.parametric")
+        } else {
+            format!("{path}.marker")
+        };
+        return Err(cx.at.error(&field, message));
+    }
+    if let Some(source) = &c.profile {
+        let f = expression(
+            cx,
+            &format!("{path}.profile"),
+            source,
+            "x",
+            Field::Profile(i),
+        )?;
+        return Ok(Profile::Explicit {
+            source: source.clone(),
+            f,
+        });
+    }
+    if let Some(source) = &c.polar {
+        let r = expression(
+            cx,
+            &format!("{path}.polar"),
+            source,
+            "theta",
+            Field::Profile(i),
+        )?;
+        return Ok(Profile::Polar {
+            source: source.clone(),
+            r,
+        });
+    }
+    let p = c.parametric.as_ref().ok_or_else(|| {
+        cx.at
+            .error(&format!("{path}.parametric"), "missing parametric profile")
+    })?;
+    let x = expression(
+        cx,
+        &format!("{path}.parametric.x"),
+        &p.x,
+        "s",
+        Field::Profile(i),
+    )?;
+    let y = expression(
+        cx,
+        &format!("{path}.parametric.y"),
+        &p.y,
+        "s",
+        Field::ProfileY(i),
+    )?;
+    Ok(Profile::Parametric {
+        x_source: p.x.clone(),
+        y_source: p.y.clone(),
+        x,
+        y,
+    })
+}
+
+fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
+    Ok(match f {
+        raw::Follower::Knife => Follower::Knife,
+        raw::Follower::Roller { radius } => Follower::Roller {
+            radius: cx.positive(
+                &format!("{path}.follower.radius"),
+                radius,
+                Field::Radius(i),
+                "the roller radius",
+            )?,
+        },
+        raw::Follower::Flat { normal } => {
+            let field = format!("{path}.follower.normal");
+            let v = cx.vector(&field, normal, None)?;
+            Follower::Flat {
+                normal: unit_vector(cx.at, &field, "the face normal", v)?,
+            }
+        }
+    })
+}
+
+/// The profile interval a contact may touch: given (finite, increasing), or [0, 2π] for a
+/// polar profile; required where the contact point is searched for along the profile
+/// (a parametric profile) or undercutting is checked (a roller or a flat face).
+fn contact_range(
+    at: &Locator,
+    path: &str,
+    c: &raw::Contact,
+    profile: &Profile,
+    follower: &Follower,
+) -> Checked<Option<(f64, f64)>> {
+    let field = format!("{path}.range");
+    if let Some((a, b)) = c.range {
+        finite(at, &format!("{field}[0]"), a)?;
+        finite(at, &format!("{field}[1]"), b)?;
+        if a >= b {
+            return Err(at.error(
+                &field,
+                format!("the range must be increasing, got ({a}, {b})"),
+            ));
+        }
+        return Ok(Some((a, b)));
+    }
+    let needs = match (profile, follower) {
+        (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
+        (Profile::Parametric { .. }, _) => Some("a parametric profile"),
+        (Profile::Explicit { .. }, Follower::Knife) => None,
+        (Profile::Explicit { .. }, Follower::Roller { .. }) => {
+            Some("a roller on an explicit profile")
+        }
+        (Profile::Explicit { .. }, Follower::Flat { .. }) => {
+            Some("a flat face on an explicit profile")
+        }
+    };
+    match needs {
+        None => Ok(None),
+        Some(what) => Err(at.error(
+            &format!("{path}.marker"),
+            format!(
+                "{what} needs `range: (from, to)`: the interval of the profile's variable the \
+                 follower may touch, where undercutting is checked and the contact point is \
+                 first searched for"
+            ),
+        )),
+    }
 }
 
 /// Unit, orthogonal in-plane axes of the cam frame (constant: they fix the plane's

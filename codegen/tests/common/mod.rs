@@ -17,6 +17,7 @@ fn revolute_z(anchor: [f64; 3], name: &str, spring: Option<(f64, f64)>) -> Joint
             rest: 0.0,
         }),
         prescribed: None,
+        load: None,
     }
 }
 
@@ -66,6 +67,7 @@ pub fn paper_concave() -> Model {
             rest: 0.0,
         }),
         prescribed: None,
+        load: None,
     };
     Model {
         parameters: Vec::new(),
@@ -110,11 +112,16 @@ pub fn paper_concave() -> Model {
         contacts: vec![Contact {
             name: "A".into(),
             marker: 0,
-            profile_source: "-0.595*x + 0.5*x*x + 0.5*x.powi(3)".into(),
-            profile: concave_profile(),
+            follower: Follower::Knife,
+            profile: Profile::Explicit {
+                source: "-0.595*x + 0.5*x*x + 0.5*x.powi(3)".into(),
+                f: concave_profile(),
+            },
+            cam_body: None,
             origin: [0.0; 3],
             x_axis: [1.0, 0.0, 0.0],
             y_axis: [0.0, 1.0, 0.0],
+            range: None,
         }],
         initial: Initial {
             q: vec![-std::f64::consts::FRAC_PI_2 - 0.1, 0.0, 0.0, 0.0],
@@ -152,6 +159,7 @@ pub fn spatial_tree() -> Model {
             coordinate: name.into(),
             spring,
             prescribed: None,
+            load: None,
         }
     };
     let sd = Some(SpringDamper {
@@ -236,11 +244,16 @@ pub fn spatial_tree() -> Model {
         contacts: vec![Contact {
             name: "P".into(),
             marker: 0,
-            profile_source: "0.2*x.sin() - 0.1*x*x".into(),
-            profile,
+            follower: Follower::Knife,
+            profile: Profile::Explicit {
+                source: "0.2*x.sin() - 0.1*x*x".into(),
+                f: profile,
+            },
+            cam_body: None,
             origin: [0.1, -0.2, 0.3],
             x_axis: [1.0, 0.0, 0.0],
             y_axis: [0.0, s, c],
+            range: None,
         }],
         initial: Initial {
             q: vec![0.0; 5],

@@ -148,8 +148,8 @@ pub fn compare_dynamics(
             let (a, b) = both(&|m| {
                 let ck = m.contact_kinematics(&q, &qd, k);
                 let g = ck.geometry;
-                let mut v = vec![g.x, g.y, g.slope, g.curvature, ck.conv1, ck.conv2];
-                v.extend(g.position);
+                let mut v = geometry_values(&g);
+                v.extend([ck.x, ck.y, ck.conv1, ck.conv2]);
                 v.extend(ck.j1);
                 v.extend(ck.j2);
                 v
@@ -175,4 +175,21 @@ pub fn compare_dynamics(
         assert_close_recorded(&a, &b, tol, &format!("{name}: prescribed motion"), &worst);
     }
     worst.get()
+}
+
+/// Every number of a contact's geometry, for comparisons.
+pub fn geometry_values(g: &camchain::runtime::ContactGeometry) -> Vec<f64> {
+    let mut v = Vec::new();
+    for vector in [g.position, g.follower, g.normal, g.axis, g.direction] {
+        v.extend(vector);
+    }
+    v.extend([
+        g.x,
+        g.y,
+        g.force_scale,
+        g.parameter,
+        g.curvature,
+        g.sliding_speed,
+    ]);
+    v
 }

@@ -1,0 +1,150 @@
+//! A cam profile as a plane curve c(s) with c′(s) and c″(s), symbolic in s, for every
+//! profile form: explicit (s = x), polar (s = θ) and parametric.
+//!
+//! The follower's side of the curve is fixed per form: above an explicit profile (to the
+//! left of increasing x), outside a polar one (to the right of increasing θ), to the right
+//! of a parametric one. [`Frame`] gives the unit tangent, the unit normal towards the
+//! follower and the curvature signed so that it is positive where the profile is hollow seen
+//! from the follower.
+
+use super::expressions::value_and_derivatives;
+use crate::expr::{Graph, Id};
+use crate::kinematics::Symbols;
+use crate::model::{Field, Model, Profile};
+
+/// A point of the profile with its first two derivatives, cam-frame components.
+#[derive(Debug, Clone, Copy)]
+pub struct CurvePoint {
+    /// c(s).
+    pub point: [Id; 2],
+    /// c′(s).
+    pub d1: [Id; 2],
+    /// c″(s).
+    pub d2: [Id; 2],
+}
+
+/// c, c′, c″ of contact `index`'s profile at the expression `at`.
+pub fn curve_at(g: &mut Graph, model: &Model, s: &Symbols, index: usize, at: Id) -> CurvePoint {
+    let contact = &model.contacts[index];
+    let name = &contact.name;
+    let expr = s.expression(model, Field::Profile(index), contact.profile_expression());
+    match &contact.profile {
+        Profile::Explicit { .. } => {
+            let placeholder = format!("__cam_{name}");
+            let [f, d1, d2] = value_and_derivatives(g, expr, &placeholder, at, &s.params);
+            let (zero, one) = (g.zero(), g.one());
+            CurvePoint {
+                point: [at, f],
+                d1: [one, d1],
+                d2: [zero, d2],
+            }
+        }
+        Profile::Polar { .. } => {
+            let placeholder = format!("__cam_{name}_r");
+            let [r, r1, r2] = value_and_derivatives(g, expr, &placeholder, at, &s.params);
+            let (cos, sin) = (g.cos(at), g.sin(at));
+            let radial = [cos, sin];
+            let neg_sin = g.neg(sin);
+            let tangential = [neg_sin, cos];
+            // c = r e_r, c′ = r′ e_r + r e_θ, c″ = (r″ − r) e_r + 2 r′ e_θ.
+            let point = radial.map(|e| g.mul(r, e));
+            let d1 = combine(g, r1, radial, r, tangential);
+            let r2_minus_r = g.sub(r2, r);
+            let two_r1 = g.scale(2.0, r1);
+            let d2 = combine(g, r2_minus_r, radial, two_r1, tangential);
+            CurvePoint { point, d1, d2 }
+        }
+        Profile::Parametric { y, .. } => {
+            let y_expr = s.expression(model, Field::ProfileY(index), y);
+            let px = format!("__cam_{name}_x");
+            let py = format!("__cam_{name}_y");
+            let [x0, x1, x2] = value_and_derivatives(g, expr, &px, at, &s.params);
+            let [y0, y1, y2] = value_and_derivatives(g, y_expr, &py, at, &s.params);
+            CurvePoint {
+                point: [x0, y0],
+                d1: [x1, y1],
+                d2: [x2, y2],
+            }
+        }
+    }
+}
+
+/// a·u + b·v for scalars a, b and 2-vectors u, v.
+fn combine(g: &mut Graph, a: Id, u: [Id; 2], b: Id, v: [Id; 2]) -> [Id; 2] {
+    [0, 1].map(|k| {
+        let x = g.mul(a, u[k]);
+        let y = g.mul(b, v[k]);
+        g.add(x, y)
+    })
+}
+
+/// +1 when the follower is on the left of the direction of increasing s (explicit
+/// profiles), −1 on the right (polar and parametric ones).
+pub fn follower_side(profile: &Profile) -> f64 {
+    match profile {
+        Profile::Explicit { .. } => 1.0,
+        Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
+    }
+}
+
+/// The Frenet frame of the profile at a point, oriented towards the follower.
+#[derive(Debug, Clone, Copy)]
+pub struct Frame {
+    /// Unit tangent c′/|c′|.
+    pub tangent: [Id; 2],
+    /// Unit normal pointing to the follower's side.
+    pub normal: [Id; 2],
+    /// Curvature, positive where the profile bends towards the follower (hollow seen from
+    /// it): side · (c′ × c″)/|c′|³.
+    pub curvature: Id,
+}
+
+/// The frame of the profile at `c` for a follower on `side` ([`follower_side`]).
+pub fn frame(g: &mut Graph, c: &CurvePoint, side: f64) -> Frame {
+    let speed2 = {
+        let a = g.mul(c.d1[0], c.d1[0]);
+        let b = g.mul(c.d1[1], c.d1[1]);
+        g.add(a, b)
+    };
+    let speed = g.sqrt(speed2);
+    let tangent = c.d1.map(|d| g.div(d, speed));
+    // side · rot90(t): rot90(a, b) = (−b, a).
+    let normal = [g.scale(-side, tangent[1]), g.scale(side, tangent[0])];
+    let cross = {
+        let a = g.mul(c.d1[0], c.d2[1]);
+        let b = g.mul(c.d1[1], c.d2[0]);
+        g.sub(a, b)
+    };
+    let cube = g.mul(speed2, speed);
+    let kappa = g.div(cross, cube);
+    Frame {
+        tangent,
+        normal,
+        curvature: g.scale(side, kappa),
+    }
+}
+
+/// a·b for 2-vectors.
+pub fn dot2(g: &mut Graph, a: [Id; 2], b: [Id; 2]) -> Id {
+    let x = g.mul(a[0], b[0]);
+    let y = g.mul(a[1], b[1]);
+    g.add(x, y)
+}
+
+/// a − b for 2-vectors.
+pub fn sub2(g: &mut Graph, a: [Id; 2], b: [Id; 2]) -> [Id; 2] {
+    [g.sub(a[0], b[0]), g.sub(a[1], b[1])]
+}
+
+/// rot90(a) = (−a_y, a_x): a turned a quarter turn counterclockwise about the cam's axis.
+pub fn perp(g: &mut Graph, a: [Id; 2]) -> [Id; 2] {
+    [g.neg(a[1]), a[0]]
+}
+
+/// a + k·b for 2-vectors a, b and a scalar k.
+pub fn add_scaled(g: &mut Graph, a: [Id; 2], k: Id, b: [Id; 2]) -> [Id; 2] {
+    [0, 1].map(|i| {
+        let t = g.mul(k, b[i]);
+        g.add(a[i], t)
+    })
+}

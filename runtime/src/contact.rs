@@ -1,0 +1,146 @@
+//! Contact parameters: the point of a profile that a roller or a flat face touches.
+//!
+//! A knife edge on an explicit profile y = f(x) has its contact point in closed form (the
+//! edge itself, eq. 1). A roller touches the profile at the point nearest its centre, a flat
+//! face at the profile's extreme point along the face's normal: the profile's parameter s of
+//! that point is the root of a residual ψ(s) = 0 at which ψ'(s) < 0 (the minimum of an
+//! objective: the squared distance to the centre, or minus the extent along the normal).
+//! Generated code and the build's interpreter find it with [`solve`] on the residual the
+//! code generator derived symbolically; the contact equations then use the envelope theorem
+//! (docs/method.md §9), so no derivative of s is ever needed.
+
+/// Newton iterations from one start before it counts as failed.
+pub const MAX_ITERATIONS: usize = 40;
+
+/// Samples of the range a scan compares when Newton needs a new start.
+pub const SCAN_SAMPLES: usize = 96;
+
+/// Newton stops when a step is at most this fraction of the range: the error left after
+/// that step is of the order of its square (about 1e-18 of the range), below rounding.
+pub const STEP_TOLERANCE: f64 = 1e-9;
+
+/// Newton's steps are limited to this fraction of the range, so that a start far from the
+/// root does not jump across the profile.
+pub const MAX_STEP_FRACTION: f64 = 0.125;
+
+/// The root of `residual` (which returns ψ(s) and ψ'(s)) with ψ' < 0, by Newton's method
+/// from `guess`; when that fails (a non-finite value, ψ' ≥ 0 at the root, no convergence)
+/// or `guess` is not finite, from the best of [`SCAN_SAMPLES`] points of `range` by
+/// `objective`. NaN when both fail: the caller's constraint is then not finite and the
+/// simulation stops with the time and state.
+pub fn solve(
+    guess: f64,
+    range: (f64, f64),
+    residual: impl Fn(f64) -> [f64; 2],
+    objective: impl Fn(f64) -> f64,
+) -> f64 {
+    let length = (range.1 - range.0).abs().max(f64::MIN_POSITIVE);
+    if guess.is_finite() {
+        if let Some(s) = newton(guess, length, &residual) {
+            return s;
+        }
+    }
+    let start = scan(range, &objective);
+    newton(start, length, &residual).unwrap_or(f64::NAN)
+}
+
+/// `slot` when it holds a finite value (a contact parameter solved at a nearby state),
+/// otherwise `cold()`: generated code starts Newton from the last solution it kept.
+#[inline]
+pub fn warm_or(slot: f64, cold: impl FnOnce() -> f64) -> f64 {
+    if slot.is_finite() { slot } else { cold() }
+}
+
+/// Newton's method with steps limited to [`MAX_STEP_FRACTION`] of `length`.
+fn newton(mut s: f64, length: f64, residual: &impl Fn(f64) -> [f64; 2]) -> Option<f64> {
+    let max_step = MAX_STEP_FRACTION * length;
+    for _ in 0..MAX_ITERATIONS {
+        let [value, slope] = residual(s);
+        let step = value / slope;
+        if !step.is_finite() {
+            return None;
+        }
+        s -= step.clamp(-max_step, max_step);
+        if step.abs() <= STEP_TOLERANCE * length {
+            // The last step was taken at a point where ψ' had this sign; a root with
+            // ψ' > 0 is the wrong extremum (the farthest point, the other side of the cam).
+            return (slope < 0.0).then_some(s);
+        }
+    }
+    None
+}
+
+/// The sample of `range` with the smallest finite objective (its first point if none is).
+fn scan(range: (f64, f64), objective: &impl Fn(f64) -> f64) -> f64 {
+    let (a, b) = range;
+    let mut best = (f64::INFINITY, a);
+    for k in 0..SCAN_SAMPLES {
+        let s = a + (b - a) * (k as f64 + 0.5) / SCAN_SAMPLES as f64;
+        let value = objective(s);
+        if value < best.0 {
+            best = (value, s);
+        }
+    }
+    best.1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nearest point of the unit circle (x, y) = (cos s, sin s) to p: ψ = c'·(p − c),
+    /// objective |p − c|².
+    fn nearest_on_circle(p: [f64; 2], guess: f64) -> f64 {
+        solve(
+            guess,
+            (0.0, std::f64::consts::TAU),
+            |s| {
+                let (sn, cs) = s.sin_cos();
+                let d = [p[0] - cs, p[1] - sn];
+                let value = -sn * d[0] + cs * d[1];
+                // ψ' = c''·d − |c'|² with c'' = −c.
+                [value, -cs * d[0] - sn * d[1] - 1.0]
+            },
+            |s| {
+                let (sn, cs) = s.sin_cos();
+                (p[0] - cs).powi(2) + (p[1] - sn).powi(2)
+            },
+        )
+    }
+
+    #[test]
+    fn finds_the_nearest_point_from_a_near_guess_or_by_scanning() {
+        let p = [2.0 * 0.3f64.cos(), 2.0 * 0.3f64.sin()];
+        // The nearest point of the circle to p is along p: s = 0.3 exactly.
+        for guess in [0.25, 0.3, 0.9, f64::NAN] {
+            let s = nearest_on_circle(p, guess);
+            assert!((s - 0.3).abs() < 1e-15, "guess {guess}: {s}");
+        }
+    }
+
+    #[test]
+    fn a_guess_at_the_farthest_point_falls_back_to_the_scan() {
+        // From the antipode, Newton converges to the maximum of the distance (ψ' > 0):
+        // refused, and the scan finds the minimum.
+        let p = [2.0, 0.0];
+        let s = nearest_on_circle(p, std::f64::consts::PI);
+        assert!(
+            s.rem_euclid(std::f64::consts::TAU)
+                .min(std::f64::consts::TAU - s.rem_euclid(std::f64::consts::TAU))
+                < 1e-15,
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn no_root_gives_nan() {
+        let s = solve(0.0, (0.0, 1.0), |s| [1.0 + s * s, 2.0 * s], |s| s);
+        assert!(s.is_nan());
+    }
+
+    #[test]
+    fn warm_start_prefers_a_finite_slot() {
+        assert_eq!(warm_or(0.5, || 1.0), 0.5);
+        assert_eq!(warm_or(f64::NAN, || 1.0), 1.0);
+    }
+}
