@@ -357,9 +357,15 @@ pub struct SimulateArgs {
 
     /// One-sided contact: the follower lifts off where the normal force reaches zero and
     /// lands with this coefficient of restitution (0 plastic … 1 elastic); needs an adaptive
-    /// integrator and one contact [default: bilateral contact, as in the paper]
-    #[arg(long, value_name = "E", value_parser = restitution)]
+    /// integrator and one contact [default: the model file's `simulation.restitution`, or
+    /// bilateral contact, as in the paper]
+    #[arg(long, value_name = "E", value_parser = restitution, conflicts_with = "bilateral")]
     pub restitution: Option<f64>,
+
+    /// Bilateral contact (the follower held on its cam, a negative normal force reported)
+    /// even where the model file asks for one-sided contact
+    #[arg(long)]
+    pub bilateral: bool,
 
     /// Coordinates plotted in the time-history figure, comma-separated, e.g. q4,q3 (the
     /// paper's figures 3 and 5) [default: all, from the tip to the base]
@@ -411,6 +417,16 @@ impl SimulateArgs {
     /// The model's default settings overridden by the options that were given.
     pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
         self.integration.settings(defaults)
+    }
+
+    /// The contact law of the run: `--restitution`, else bilateral with `--bilateral`, else
+    /// the model file's.
+    pub fn restitution(&self, model_default: Option<f64>) -> Option<f64> {
+        match (self.restitution, self.bilateral) {
+            (Some(e), _) => Some(e),
+            (None, true) => None,
+            (None, false) => model_default,
+        }
     }
 
     /// True when the CSV goes to standard output (`--csv -`).

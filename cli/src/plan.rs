@@ -87,7 +87,7 @@ fn checked_settings(model: &LoadedModel, args: &SimulateArgs) -> Result<SimSetti
     settings
         .validate(0.0)
         .map_err(|e| setting_error(&e, args, model))?;
-    if args.restitution.is_some() {
+    if args.restitution(info.restitution).is_some() {
         if !settings.integrator.is_adaptive() {
             return Err(CliError::Usage(format!(
                 "--restitution needs an adaptive integrator (dopri5 or dop853), which locates \

@@ -161,7 +161,7 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
             Observed::Continue(())
         }
     };
-    let run = match args.restitution {
+    let run = match args.restitution(info.restitution) {
         Some(e) => dynamics.simulate_unilateral_observed(state, settings, e, &mut observe),
         None => dynamics.simulate_observed(state, settings, &mut observe),
     };

@@ -570,6 +570,7 @@ fn info_static(model: &Model) -> String {
          spatial: {spatial},\n\
          initial: rt::InitialGuess {{ q: Vec::from({q}), qd: Vec::from({qd}), hold: Vec::from({hold:?}), given_q: Vec::from({given_q:?}), given_qd: Vec::from({given_qd:?}) }},\n\
          defaults: rt::SimSettings {{ t_end: {t_end}, dt_out: {dt_out}, integrator: rt::IntegratorKind::{integrator}, dt: {dt}, rtol: {rtol}, atol: {atol} }},\n\
+         restitution: {restitution},\n\
          parameters: Vec::from([{parameters}]),\n\
          }});\n",
         name = model.name,
@@ -587,6 +588,9 @@ fn info_static(model: &Model) -> String {
         dt = lit(s.dt),
         rtol = lit(s.rtol),
         atol = lit(s.atol),
+        restitution = s
+            .restitution
+            .map_or("None".to_string(), |e| format!("Some({})", lit(e))),
         parameters = parameter_infos(model),
     )
 }
@@ -866,12 +870,17 @@ fn reuse_position_trigonometry(g: &mut Graph, position: &[Id], velocity: &mut [(
 /// Robotran's name of a sine or cosine of a coordinate or a sum of coordinates: `s_q1`,
 /// `c_q1_q2`.
 fn trig_name(g: &Graph, f: Func, angle: Id) -> Option<String> {
+    trig_name_of(f, &angle_name(g, angle)?)
+}
+
+/// `s_<angle>` for a sine, `c_<angle>` for a cosine.
+fn trig_name_of(f: Func, angle: &str) -> Option<String> {
     let prefix = match f {
         Func::Sin => "s",
         Func::Cos => "c",
         _ => return None,
     };
-    Some(format!("{prefix}_{}", angle_name(g, angle)?))
+    Some(format!("{prefix}_{angle}"))
 }
 
 /// `q1_q2` for the angle q1 + q2 (the coordinates summed, in the expression's order).
@@ -1653,6 +1662,17 @@ fn emit_function_full(
     let (bindings, used_vars) = body.bindings();
     let inputs = input_bindings(d, &used_vars);
     let mut used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
+    if body.solves_read_derived && !method {
+        used_params.insert("derived");
+    }
+    // A scalar argument read under its own name.
+    for (id, source) in given {
+        if is_identifier(source) && body.names.contains_key(id) {
+            if let Some(p) = spec.params.iter().find(|p| p.name == source) {
+                used_params.insert(p.name);
+            }
+        }
+    }
     // A parameter that a bound given expression reads (`derived.k1`, `cache[3]`).
     for p in &spec.params {
         let reads = |(id, source): &(Id, String)| {
@@ -1944,6 +1964,8 @@ struct Emitter<'g> {
     derived_arg: String,
     /// The inputs of implicit variables: always bound (the solve's call reads them twice).
     solve_inputs: HashSet<Id>,
+    /// Set when a solve's call passes the derived parameter values on.
+    solves_read_derived: bool,
 }
 
 impl<'g> Emitter<'g> {
@@ -1994,6 +2016,7 @@ impl<'g> Emitter<'g> {
             warm: HashMap::new(),
             derived_arg: String::new(),
             solve_inputs,
+            solves_read_derived: false,
         }
     }
 
@@ -2080,6 +2103,7 @@ impl<'g> Emitter<'g> {
             if self.g.implicit_of(id).is_some() && !self.given.contains_key(&id) {
                 let name = self.vars.var(self.g, id);
                 let _ = writeln!(text, "let {name} = {};", self.solve_call(id));
+                self.solves_read_derived |= !self.derived_arg.is_empty();
                 self.names.insert(id, name);
                 continue;
             }
@@ -2218,6 +2242,12 @@ impl<'g> Emitter<'g> {
 
     fn structural_name(&self, id: Id) -> Option<String> {
         if let Node::Call(f, a) = self.g.node(id) {
+            // The sine of a function's scalar argument `s`: `s_s`, as for a joint angle.
+            if let Some(argument) = self.given.get(&a).filter(|s| is_identifier(s)) {
+                if let Some(name) = trig_name_of(f, argument) {
+                    return Some(name);
+                }
+            }
             if let Some(name) = trig_name(self.g, f, a) {
                 return Some(name);
             }

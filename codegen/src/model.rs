@@ -264,6 +264,9 @@ pub struct Simulation {
     pub rtol: f64,
     /// Absolute tolerance of adaptive integrators.
     pub atol: f64,
+    /// One-sided contact with this coefficient of restitution (in [0, 1]), or `None` for
+    /// bilateral contact.
+    pub restitution: Option<f64>,
 }
 
 /// Initial guess and assembly instructions.

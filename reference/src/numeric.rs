@@ -63,6 +63,7 @@ pub fn model_info(model: &Model) -> ModelInfo {
             rtol: model.simulation.rtol,
             atol: model.simulation.atol,
         },
+        restitution: model.simulation.restitution,
         parameters: model
             .runtime_parameters()
             .map(|(_, p)| ParameterInfo {
@@ -682,6 +683,7 @@ mod tests {
                 dt: 1e-3,
                 rtol: 1e-8,
                 atol: 1e-10,
+                restitution: None,
             },
         }
     }

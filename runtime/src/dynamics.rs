@@ -147,6 +147,11 @@ pub struct ModelInfo {
     pub initial: InitialGuess,
     /// Default settings.
     pub defaults: SimSettings,
+    /// The model file's contact law: `None` for bilateral contact (the follower held on its
+    /// cam: a negative normal force is reported, not acted on), `Some(e)` for one-sided
+    /// contact with impacts of restitution e ([`crate::unilateral`]), what a run uses unless
+    /// told otherwise.
+    pub restitution: Option<f64>,
     /// The run-time parameters (those not folded at build time), in file order; their
     /// current values are [`Dynamics::parameter_values`].
     pub parameters: Vec<crate::parameters::ParameterInfo>,

@@ -1,7 +1,8 @@
 //! Assembly, stepping and simulation of a model under its cam constraints.
 //!
 //! Only the independent coordinates are integrated: the integrated state is
-//! y = (u, u̇, dissipated energy, driven work, v, v̇), of which (u, u̇) are error-controlled,
+//! y = (u, u̇, dissipated energy, driven work, v, v̇), of which (u, u̇) are error-controlled
+//! (everything, when the drives alone move the mechanism: no u),
 //! the two energies are quadratures, and (v, v̇) ride along uncontrolled as Newton's
 //! starting point (at a Runge–Kutta stage they are accurate to the stage's order, so
 //! Newton usually converges at its first evaluation). At every right-hand side evaluation the dependent
@@ -77,8 +78,8 @@ impl State {
         let engine = Engine {
             y: vec![0.0; dim],
             rk4: Rk4::new(dim),
-            dopri: Dopri5::new(dim, 2 * nu),
-            dop853: Dop853::new(dim, 2 * nu),
+            dopri: Dopri5::new(dim, controlled_len(nu, dim)),
+            dop853: Dop853::new(dim, controlled_len(nu, dim)),
             h_next: None,
             at_step_end: false,
             synced_t: t,
@@ -436,6 +437,14 @@ pub trait Simulate: Dynamics {
 }
 
 impl<D: Dynamics + ?Sized> Simulate for D {}
+
+/// How many leading components of y the adaptive integrators control: (u, u̇); when there
+/// is no independent coordinate (a mechanism moved only by its drives, y = (dissipated,
+/// driven work, v, v̇)), the two energy quadratures, which then set the step (nothing would
+/// bound it otherwise; v and v̇ are solved exactly at every evaluation).
+fn controlled_len(nu: usize, _dim: usize) -> usize {
+    if nu == 0 { 2 } else { 2 * nu }
+}
 
 /// Length of the integrated vector y = (u, u̇, dissipated, driven work, v, v̇).
 fn integrated_len(partition: &Partition) -> usize {
@@ -1519,6 +1528,7 @@ mod tests {
             spatial: false,
             initial,
             defaults: settings(IntegratorKind::Dopri5, 1.0, 0.1, 1e-3, 1e-9),
+            restitution: None,
             parameters: Vec::new(),
         }
     }

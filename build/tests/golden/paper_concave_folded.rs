@@ -191,6 +191,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
         rtol: 1e-10,
         atol: 1e-12,
     },
+    restitution: None,
     parameters: Vec::from([]),
 });
 #[allow(clippy::approx_constant, clippy::excessive_precision)]

@@ -11,6 +11,7 @@ use super::expressions::value_and_derivatives;
 use crate::expr::{Graph, Id};
 use crate::kinematics::Symbols;
 use crate::model::{Field, Model, Profile};
+use crate::profile::Scalar;
 
 /// A point of the profile with its first two derivatives, cam-frame components.
 #[derive(Debug, Clone, Copy)]
@@ -26,12 +27,37 @@ pub struct CurvePoint {
 /// c, c′, c″ of contact `index`'s profile at the expression `at`.
 pub fn curve_at(g: &mut Graph, model: &Model, s: &Symbols, index: usize, at: Id) -> CurvePoint {
     let contact = &model.contacts[index];
-    let name = &contact.name;
-    let expr = s.expression(model, Field::Profile(index), contact.profile_expression());
-    match &contact.profile {
+    let first = s.expression(model, Field::Profile(index), contact.profile_expression());
+    let second = match &contact.profile {
+        Profile::Parametric { y, .. } => Some(s.expression(model, Field::ProfileY(index), y)),
+        _ => None,
+    };
+    curve(
+        g,
+        &contact.profile,
+        first,
+        second,
+        &contact.name,
+        at,
+        &s.params,
+    )
+}
+
+/// c, c′, c″ at `at` of a profile of `profile`'s form whose expressions are `first` (f, r or
+/// x(s)) and `second` (y(s) of a parametric one); `name` keeps the placeholders apart.
+pub fn curve(
+    g: &mut Graph,
+    profile: &Profile,
+    first: &Scalar,
+    second: Option<&Scalar>,
+    name: &str,
+    at: Id,
+    params: &[Id],
+) -> CurvePoint {
+    match profile {
         Profile::Explicit { .. } => {
             let placeholder = format!("__cam_{name}");
-            let [f, d1, d2] = value_and_derivatives(g, expr, &placeholder, at, &s.params);
+            let [f, d1, d2] = value_and_derivatives(g, first, &placeholder, at, params);
             let (zero, one) = (g.zero(), g.one());
             CurvePoint {
                 point: [at, f],
@@ -41,7 +67,10 @@ pub fn curve_at(g: &mut Graph, model: &Model, s: &Symbols, index: usize, at: Id)
         }
         Profile::Polar { .. } => {
             let placeholder = format!("__cam_{name}_r");
-            let [r, r1, r2] = value_and_derivatives(g, expr, &placeholder, at, &s.params);
+            let [r, r1, r2] = value_and_derivatives(g, first, &placeholder, at, params);
+            for (id, what) in [(r, "r"), (r1, "dr"), (r2, "ddr")] {
+                g.label(id, format!("{name}_{what}"));
+            }
             let (cos, sin) = (g.cos(at), g.sin(at));
             let radial = [cos, sin];
             let neg_sin = g.neg(sin);
@@ -54,12 +83,13 @@ pub fn curve_at(g: &mut Graph, model: &Model, s: &Symbols, index: usize, at: Id)
             let d2 = combine(g, r2_minus_r, radial, two_r1, tangential);
             CurvePoint { point, d1, d2 }
         }
-        Profile::Parametric { y, .. } => {
-            let y_expr = s.expression(model, Field::ProfileY(index), y);
+        Profile::Parametric { .. } => {
+            let zero = Scalar::Const(0.0);
+            let y_expr = second.unwrap_or(&zero);
             let px = format!("__cam_{name}_x");
             let py = format!("__cam_{name}_y");
-            let [x0, x1, x2] = value_and_derivatives(g, expr, &px, at, &s.params);
-            let [y0, y1, y2] = value_and_derivatives(g, y_expr, &py, at, &s.params);
+            let [x0, x1, x2] = value_and_derivatives(g, first, &px, at, params);
+            let [y0, y1, y2] = value_and_derivatives(g, y_expr, &py, at, params);
             CurvePoint {
                 point: [x0, y0],
                 d1: [x1, y1],
@@ -67,6 +97,48 @@ pub fn curve_at(g: &mut Graph, model: &Model, s: &Symbols, index: usize, at: Id)
             }
         }
     }
+}
+
+/// A profile evaluated at one value of its variable (for the build's checks).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProfileSample {
+    /// The profile's variable (x, θ or s).
+    pub at: f64,
+    /// The polar radius r(θ) of a polar profile (NaN for the other forms).
+    pub radius: f64,
+    /// The curvature, positive where the profile is hollow seen from the follower (1/m).
+    pub curvature: f64,
+}
+
+/// `samples` + 1 evenly spaced samples of `profile` (its expressions with every parameter
+/// resolved) over `range`, with its symbolic derivatives evaluated by the interpreter.
+pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> Vec<ProfileSample> {
+    let mut g = Graph::new();
+    let at = g.var("s");
+    let (first, second) = match profile {
+        Profile::Explicit { f, .. } => (f, None),
+        Profile::Polar { r, .. } => (r, None),
+        Profile::Parametric { x, y, .. } => (x, Some(y)),
+    };
+    let c = curve(&mut g, profile, first, second, "check", at, &[]);
+    let f = frame(&mut g, &c, follower_side(profile));
+    (0..=samples)
+        .map(|k| {
+            let s = range.0 + (range.1 - range.0) * k as f64 / samples.max(1) as f64;
+            let mut vars = vec![f64::NAN; g.var_names().len()];
+            vars[0] = s;
+            let curvature = g.eval(&[f.curvature], &vars)[0];
+            let radius = match profile {
+                Profile::Polar { r, .. } => r.eval(s),
+                _ => f64::NAN,
+            };
+            ProfileSample {
+                at: s,
+                radius,
+                curvature,
+            }
+        })
+        .collect()
 }
 
 /// a·u + b·v for scalars a, b and 2-vectors u, v.
@@ -99,6 +171,26 @@ pub struct Frame {
     pub curvature: Id,
 }
 
+/// Names the point and its derivatives for the emitted code: `<label>_cx`, `<label>_dcx`,
+/// `<label>_ddcx`, … (the first label a node gets stays).
+pub fn label_curve(g: &mut Graph, c: &CurvePoint, label: &str) {
+    for (k, axis) in ["x", "y"].iter().enumerate() {
+        g.label(c.point[k], format!("{label}_c{axis}"));
+        g.label(c.d1[k], format!("{label}_dc{axis}"));
+        g.label(c.d2[k], format!("{label}_ddc{axis}"));
+    }
+}
+
+/// The frame of the profile at `c` for a follower on `side` ([`follower_side`]), its terms
+/// named after `label`.
+pub fn labelled_frame(g: &mut Graph, c: &CurvePoint, side: f64, label: &str) -> Frame {
+    let f = frame(g, c, side);
+    g.label(f.tangent[0], format!("{label}_tx"));
+    g.label(f.tangent[1], format!("{label}_ty"));
+    g.label(f.curvature, format!("{label}_kappa"));
+    f
+}
+
 /// The frame of the profile at `c` for a follower on `side` ([`follower_side`]).
 pub fn frame(g: &mut Graph, c: &CurvePoint, side: f64) -> Frame {
     let speed2 = {
@@ -107,6 +199,7 @@ pub fn frame(g: &mut Graph, c: &CurvePoint, side: f64) -> Frame {
         g.add(a, b)
     };
     let speed = g.sqrt(speed2);
+    g.label(speed2, "speed_sq");
     let tangent = c.d1.map(|d| g.div(d, speed));
     // side · rot90(t): rot90(a, b) = (−b, a).
     let normal = [g.scale(-side, tangent[1]), g.scale(side, tangent[0])];

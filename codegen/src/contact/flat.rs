@@ -14,7 +14,9 @@
 //! the last term from the support point's motion ṡ = −ω_r (m⊥·c′)/(m·c″).
 
 use super::ContactTerms;
-use super::curve::{add_scaled, curve_at, dot2, follower_side, frame, perp, sub2};
+use super::curve::{
+    add_scaled, curve_at, dot2, follower_side, label_curve, labelled_frame, perp, sub2,
+};
 use super::relative::Relative;
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{BodyKinematics, Symbols, vec3};
@@ -45,6 +47,7 @@ pub fn flat(
         g.var(&format!("__{name}_my")),
     );
     let at_u = curve_at(g, model, s, index, u);
+    label_curve(g, &at_u, "trial");
     let residual = dot2(g, [mx, my], at_u.d1);
     let derivative = dot2(g, [mx, my], at_u.d2);
     let extent = dot2(g, [mx, my], at_u.point);
@@ -69,7 +72,10 @@ pub fn flat(
         },
     );
     let at = curve_at(g, model, s, index, solution);
+    label_curve(g, &at, name);
     let offset = sub2(g, rel.xy, at.point);
+    g.label(offset[0], format!("{name}_offset_x"));
+    g.label(offset[1], format!("{name}_offset_y"));
     let h = dot2(g, m, offset);
     let m_perp = perp(g, m);
     let lever = dot2(g, m_perp, offset);
@@ -102,12 +108,13 @@ pub fn flat(
         g.add(b, support)
     };
     let side = follower_side(&contact.profile);
-    let f = frame(g, &at, side);
+    let f = labelled_frame(g, &at, side, name);
     g.label(f.curvature, format!("{name}_kappa"));
     let to_contact = sub2(g, at.point, rel.xy);
     let swing = perp(g, to_contact);
     let material = add_scaled(g, rel.velocity, w, swing);
-    let sliding = dot2(g, m_perp, material);
+    // Along the profile's tangent (increasing s), as for the other kinds.
+    let sliding = dot2(g, f.tangent, material);
     let position = rel.to_ground(g, at.point);
     vec3::label(g, position, &format!("{name}_contact"));
     ContactTerms {

@@ -14,7 +14,7 @@
 //! (κ D < 1 wherever the roller does not undercut the profile.)
 
 use super::ContactTerms;
-use super::curve::{self, curve_at, dot2, follower_side, frame, perp, sub2};
+use super::curve::{self, curve_at, dot2, follower_side, label_curve, labelled_frame, perp, sub2};
 use super::relative::Relative;
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{Symbols, vec3};
@@ -39,7 +39,10 @@ pub fn nearest(
         g.var(&format!("__{name}_py")),
     );
     let at_u = curve_at(g, model, s, index, u);
+    label_curve(g, &at_u, "trial");
     let d = sub2(g, [px, py], at_u.point);
+    g.label(d[0], "offset_x");
+    g.label(d[1], "offset_y");
     let residual = dot2(g, at_u.d1, d);
     let derivative = {
         let bend = dot2(g, at_u.d2, d);
@@ -72,8 +75,11 @@ pub fn nearest(
         },
     );
     let at = curve_at(g, model, s, index, solution);
-    let f = frame(g, &at, side);
+    label_curve(g, &at, name);
+    let f = labelled_frame(g, &at, side, name);
     let offset = sub2(g, rel.xy, at.point);
+    g.label(offset[0], format!("{name}_offset_x"));
+    g.label(offset[1], format!("{name}_offset_y"));
     let distance = dot2(g, f.normal, offset);
     g.label(distance, format!("{name}_distance"));
     let rho = match radius {

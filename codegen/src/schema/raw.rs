@@ -346,6 +346,7 @@ pub(super) struct Simulation {
     pub dt: f64,
     pub rtol: f64,
     pub atol: f64,
+    pub restitution: Option<f64>,
 }
 
 impl Default for Simulation {
@@ -357,6 +358,7 @@ impl Default for Simulation {
             dt: 1e-3,
             rtol: 1e-10,
             atol: 1e-12,
+            restitution: None,
         }
     }
 }

@@ -6,14 +6,17 @@ use super::Locator;
 use super::raw;
 use crate::error::ModelError;
 use crate::model::{
-    Body, Contact, Field, FieldLocation, Follower, Initial, IntegratorChoice, Joint, JointKind,
-    JointLoad, Marker, Model, Parameter, ParameterMode, Prescribed, Profile, RuntimeCheck,
-    Simulation, SpringDamper,
+    Body, Field, FieldLocation, Follower, Initial, IntegratorChoice, Joint, JointKind, JointLoad,
+    Marker, Model, Parameter, ParameterMode, Prescribed, Profile, RuntimeCheck, Simulation,
+    SpringDamper,
 };
 use crate::profile::{Scalar, parse_expression_with};
 use camchain_runtime::parameters::{Bound, checks};
 use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
+
+mod contacts;
+use contacts::contacts;
 
 /// The reserved parent name of the fixed base.
 const GROUND: &str = "ground";
@@ -58,9 +61,18 @@ pub(super) fn validate(
     parameter_names_free(&parameters, &bodies, at)?;
     joint_loads(&file.bodies, &tree, &mut bodies, &cx)?;
     let markers = markers(&file.markers, &tree, &cx)?;
-    let contacts = contacts(&file.contacts, &markers, &tree, &cx)?;
+    let contacts = contacts(&file.contacts, &markers, &tree, &bodies, &cx)?;
     let initial = initial(&file.initial, &bodies, &cx)?;
     let simulation = simulation(&file.simulation, at)?;
+    if simulation.restitution.is_some() && contacts.len() != 1 {
+        return Err(at.error(
+            "simulation.restitution",
+            format!(
+                "one-sided contact (`restitution`) needs exactly one contact; this model has {}",
+                contacts.len()
+            ),
+        ));
+    }
     Ok(Model {
         name,
         description: file.description.clone(),
@@ -956,232 +968,6 @@ fn markers(list: &[raw::Marker], tree: &BodyTree, cx: &Context) -> Checked<Vec<M
         .collect()
 }
 
-fn contacts(
-    list: &[raw::Contact],
-    markers: &[Marker],
-    tree: &BodyTree,
-    cx: &Context,
-) -> Checked<Vec<Contact>> {
-    let at = cx.at;
-    let by_name: HashMap<&str, usize> = markers
-        .iter()
-        .enumerate()
-        .map(|(i, m)| (m.name.as_str(), i))
-        .collect();
-    let mut names: HashMap<&str, usize> = HashMap::new();
-    for (i, c) in list.iter().enumerate() {
-        let (field, name) = match &c.name {
-            Some(name) => (format!("contacts[{i}].name"), name.as_str()),
-            None => (format!("contacts[{i}].marker"), c.marker.as_str()),
-        };
-        identifier(at, &field, name, "contact name")?;
-        if let Some(first) = names.insert(name, i) {
-            let message = if c.name.is_some() {
-                format!("duplicate contact name `{name}` (contacts[{first}])")
-            } else {
-                format!(
-                    "marker `{name}` already has a contact (contacts[{first}]): a second contact \
-                     on it needs a `name` of its own"
-                )
-            };
-            return Err(at.error(&field, message));
-        }
-    }
-    list.iter()
-        .enumerate()
-        .map(|(i, c)| {
-            let field = format!("contacts[{i}].marker");
-            let marker = lookup(at, &field, &by_name, &c.marker, "marker")?;
-            contact(cx, tree, i, c, marker, markers[marker].body)
-        })
-        .collect()
-}
-
-fn contact(
-    cx: &Context,
-    tree: &BodyTree,
-    i: usize,
-    c: &raw::Contact,
-    marker: usize,
-    follower_body: usize,
-) -> Checked<Contact> {
-    let at = cx.at;
-    let path = format!("contacts[{i}]");
-    let cam_body = match c.cam_body.as_deref() {
-        None | Some(GROUND) => None,
-        Some(name) => Some(tree.sorted_body(at, &format!("{path}.cam_body"), name)?),
-    };
-    if cam_body == Some(follower_body) {
-        return Err(at.error(
-            &format!("{path}.cam_body"),
-            format!(
-                "the cam is on the body that carries the marker `{}`: a contact needs two \
-                 bodies that move relative to each other",
-                c.marker
-            ),
-        ));
-    }
-    let (x_axis, y_axis) = cam_axes(cx, &format!("{path}.frame"), &c.frame)?;
-    let profile = profile(cx, &path, c, i)?;
-    let follower = follower(cx, &path, &c.follower, i)?;
-    let range = contact_range(at, &path, c, &profile, &follower)?;
-    Ok(Contact {
-        name: c.name.clone().unwrap_or_else(|| c.marker.clone()),
-        marker,
-        follower,
-        profile,
-        cam_body,
-        origin: cx.vector_of(&format!("{path}.frame.origin"), &c.frame.origin, |k| {
-            Field::Origin(i, k)
-        })?,
-        x_axis,
-        y_axis,
-        range,
-    })
-}
-
-/// The profile: exactly one of `profile` (explicit), `polar` and `parametric`.
-fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Profile> {
-    let given = [
-        c.profile.is_some(),
-        c.polar.is_some(),
-        c.parametric.is_some(),
-    ];
-    if given.iter().filter(|g| **g).count() != 1 {
-        let message = if given.contains(&true) {
-            "give only one of `profile`, `polar` and `parametric`"
-        } else {
-            "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
-             `polar: \"r(theta)\"` or `parametric: (x: \"x(s)\", y: \"y(s)\")`"
-        };
-        let field = if c.polar.is_some() && given[0] {
-            format!("{path}.polar")
-        } else if c.parametric.is_some() && given.iter().filter(|g| **g).count() > 1 {
-            format!("{path}.parametric")
-        } else {
-            format!("{path}.marker")
-        };
-        return Err(cx.at.error(&field, message));
-    }
-    if let Some(source) = &c.profile {
-        let f = expression(
-            cx,
-            &format!("{path}.profile"),
-            source,
-            "x",
-            Field::Profile(i),
-        )?;
-        return Ok(Profile::Explicit {
-            source: source.clone(),
-            f,
-        });
-    }
-    if let Some(source) = &c.polar {
-        let r = expression(
-            cx,
-            &format!("{path}.polar"),
-            source,
-            "theta",
-            Field::Profile(i),
-        )?;
-        return Ok(Profile::Polar {
-            source: source.clone(),
-            r,
-        });
-    }
-    let p = c.parametric.as_ref().ok_or_else(|| {
-        cx.at
-            .error(&format!("{path}.parametric"), "missing parametric profile")
-    })?;
-    let x = expression(
-        cx,
-        &format!("{path}.parametric.x"),
-        &p.x,
-        "s",
-        Field::Profile(i),
-    )?;
-    let y = expression(
-        cx,
-        &format!("{path}.parametric.y"),
-        &p.y,
-        "s",
-        Field::ProfileY(i),
-    )?;
-    Ok(Profile::Parametric {
-        x_source: p.x.clone(),
-        y_source: p.y.clone(),
-        x,
-        y,
-    })
-}
-
-fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
-    Ok(match f {
-        raw::Follower::Knife => Follower::Knife,
-        raw::Follower::Roller { radius } => Follower::Roller {
-            radius: cx.positive(
-                &format!("{path}.follower.radius"),
-                radius,
-                Field::Radius(i),
-                "the roller radius",
-            )?,
-        },
-        raw::Follower::Flat { normal } => {
-            let field = format!("{path}.follower.normal");
-            let v = cx.vector(&field, normal, None)?;
-            Follower::Flat {
-                normal: unit_vector(cx.at, &field, "the face normal", v)?,
-            }
-        }
-    })
-}
-
-/// The profile interval a contact may touch: given (finite, increasing), or [0, 2π] for a
-/// polar profile; required where the contact point is searched for along the profile
-/// (a parametric profile) or undercutting is checked (a roller or a flat face).
-fn contact_range(
-    at: &Locator,
-    path: &str,
-    c: &raw::Contact,
-    profile: &Profile,
-    follower: &Follower,
-) -> Checked<Option<(f64, f64)>> {
-    let field = format!("{path}.range");
-    if let Some((a, b)) = c.range {
-        finite(at, &format!("{field}[0]"), a)?;
-        finite(at, &format!("{field}[1]"), b)?;
-        if a >= b {
-            return Err(at.error(
-                &field,
-                format!("the range must be increasing, got ({a}, {b})"),
-            ));
-        }
-        return Ok(Some((a, b)));
-    }
-    let needs = match (profile, follower) {
-        (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
-        (Profile::Parametric { .. }, _) => Some("a parametric profile"),
-        (Profile::Explicit { .. }, Follower::Knife) => None,
-        (Profile::Explicit { .. }, Follower::Roller { .. }) => {
-            Some("a roller on an explicit profile")
-        }
-        (Profile::Explicit { .. }, Follower::Flat { .. }) => {
-            Some("a flat face on an explicit profile")
-        }
-    };
-    match needs {
-        None => Ok(None),
-        Some(what) => Err(at.error(
-            &format!("{path}.marker"),
-            format!(
-                "{what} needs `range: (from, to)`: the interval of the profile's variable the \
-                 follower may touch, where undercutting is checked and the contact point is \
-                 first searched for"
-            ),
-        )),
-    }
-}
-
 /// Unit, orthogonal in-plane axes of the cam frame (constant: they fix the plane's
 /// orientation in the generated code).
 fn cam_axes(cx: &Context, path: &str, frame: &raw::Frame) -> Checked<([f64; 3], [f64; 3])> {
@@ -1327,6 +1113,17 @@ fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulation> {
             ))
         }
     };
+    let restitution = match s.restitution {
+        Some(e) => Some(in_range("restitution", e, (0.0, 1.0))?),
+        None => None,
+    };
+    if restitution.is_some() && !adaptive {
+        return Err(at.error(
+            &field("restitution"),
+            "one-sided contact (`restitution`) needs an adaptive integrator (dopri5 or \
+             dop853), which locates lift-off and impact",
+        ));
+    }
     Ok(Simulation {
         t_end,
         dt_out,
@@ -1334,5 +1131,6 @@ fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulation> {
         dt,
         rtol: in_range("rtol", s.rtol, ranges::RTOL)?,
         atol: in_range("atol", s.atol, ranges::ATOL)?,
+        restitution,
     })
 }

@@ -137,6 +137,7 @@ pub fn paper_concave() -> Model {
             dt: 1e-3,
             rtol: 1e-10,
             atol: 1e-12,
+            restitution: None,
         },
     }
 }
@@ -269,6 +270,7 @@ pub fn spatial_tree() -> Model {
             dt: 1e-3,
             rtol: 1e-9,
             atol: 1e-9,
+            restitution: None,
         },
     }
 }

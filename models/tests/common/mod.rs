@@ -148,7 +148,7 @@ pub fn compare_dynamics(
             let (a, b) = both(&|m| {
                 let ck = m.contact_kinematics(&q, &qd, k);
                 let g = ck.geometry;
-                let mut v = geometry_values(&g);
+                let mut v = geometry_values(&g, m.info().contacts[k].profile);
                 v.extend([ck.x, ck.y, ck.conv1, ck.conv2]);
                 v.extend(ck.j1);
                 v.extend(ck.j2);
@@ -164,7 +164,13 @@ pub fn compare_dynamics(
         }
         let (a, b) = both(&|m| {
             let e = m.energy(&q, &qd);
-            vec![e.kinetic, e.gravity, e.spring, m.damper_power(&qd)]
+            vec![
+                e.kinetic,
+                e.gravity,
+                e.spring,
+                m.damper_power(&qd),
+                m.load_power(t, &q, &qd),
+            ]
         });
         assert_close_recorded(&a, &b, tol, &format!("{name}: energies"), &worst);
         let (a, b) = both(&|m| {
@@ -177,19 +183,20 @@ pub fn compare_dynamics(
     worst.get()
 }
 
-/// Every number of a contact's geometry, for comparisons.
-pub fn geometry_values(g: &camchain::runtime::ContactGeometry) -> Vec<f64> {
+/// Every number of a contact's geometry, for comparisons. The angle of a polar profile's
+/// contact point is defined modulo 2π: its cosine and sine are compared instead.
+pub fn geometry_values(
+    g: &camchain::runtime::ContactGeometry,
+    profile: camchain::runtime::ProfileKind,
+) -> Vec<f64> {
     let mut v = Vec::new();
     for vector in [g.position, g.follower, g.normal, g.axis, g.direction] {
         v.extend(vector);
     }
-    v.extend([
-        g.x,
-        g.y,
-        g.force_scale,
-        g.parameter,
-        g.curvature,
-        g.sliding_speed,
-    ]);
+    v.extend([g.x, g.y, g.force_scale, g.curvature, g.sliding_speed]);
+    match profile {
+        camchain::runtime::ProfileKind::Polar => v.extend([g.parameter.cos(), g.parameter.sin()]),
+        _ => v.push(g.parameter),
+    }
     v
 }

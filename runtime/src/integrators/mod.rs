@@ -427,7 +427,13 @@ fn controlled_step(
     let mut last_failure = None;
     loop {
         if h.is_nan() || h < floor {
-            let error = last_failure.unwrap_or(SimError::StepSizeTooSmall { t, h });
+            // Steps can also shrink onto a point beyond which the right-hand side does not
+            // exist without any attempt reaching past it (the energy quadratures of a
+            // mechanism moved only by its drives grow without bound at a dead point): a
+            // short probe past it names the cause.
+            let error = last_failure
+                .or_else(|| attempt(PROBE_STEP * t.abs().max(1.0)).err())
+                .unwrap_or(SimError::StepSizeTooSmall { t, h });
             return (Err(error), rejected);
         }
         match attempt(h) {
@@ -441,7 +447,9 @@ fn controlled_step(
                 return (Ok(AcceptedStep { h, h_next }), rejected);
             }
             Ok(error) => {
-                last_failure = None;
+                // A failure seen at a longer attempt stays the likely cause: steps that shrink
+                // onto a dead point alternate between stages beyond it (which fail) and
+                // inaccurate ones before it.
                 h *= controller.rejected(error);
             }
             Err(failure) => {
@@ -456,6 +464,10 @@ fn controlled_step(
         rejected += 1;
     }
 }
+
+/// The step of the probe past a point onto which the steps shrank (times max(1, |t|)): a
+/// right-hand side that fails that close beyond it is the cause of the shrinking.
+const PROBE_STEP: f64 = 1e-10;
 
 /// β of the step-size [`Controller`] of both adaptive integrators: Hairer's default for
 /// DOPRI5, and for DOP853 the better of 0 (Hairer's default there) and 0.04 on the reference

@@ -1,0 +1,397 @@
+//! Contacts: the follower (a marker and its shape), the cam body and frame, the profile,
+//! and the checks that the follower can follow the profile (a roller no larger than the
+//! profile's hollows, a flat face on a convex profile turning only about the cam's axis, a
+//! polar radius that stays positive), each located at the field it concerns.
+
+use super::{
+    BodyTree, Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile, cam_axes,
+    expression, finite, identifier, lookup, unit_vector,
+};
+use crate::contact::curve::profile_samples;
+use crate::model::{Body, Contact, JointKind};
+use crate::schema::raw;
+use std::collections::HashMap;
+
+/// Samples of the profile's range where the build checks its radius and curvature.
+pub const PROFILE_CHECK_SAMPLES: usize = 4096;
+
+pub(super) fn contacts(
+    list: &[raw::Contact],
+    markers: &[Marker],
+    tree: &BodyTree,
+    bodies: &[Body],
+    cx: &Context,
+) -> Checked<Vec<Contact>> {
+    let at = cx.at;
+    let by_name: HashMap<&str, usize> = markers
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (m.name.as_str(), i))
+        .collect();
+    let mut names: HashMap<&str, usize> = HashMap::new();
+    for (i, c) in list.iter().enumerate() {
+        let (field, name) = match &c.name {
+            Some(name) => (format!("contacts[{i}].name"), name.as_str()),
+            None => (format!("contacts[{i}].marker"), c.marker.as_str()),
+        };
+        identifier(at, &field, name, "contact name")?;
+        if let Some(first) = names.insert(name, i) {
+            let message = if c.name.is_some() {
+                format!("duplicate contact name `{name}` (contacts[{first}])")
+            } else {
+                format!(
+                    "marker `{name}` already has a contact (contacts[{first}]): a second contact \
+                     on it needs a `name` of its own"
+                )
+            };
+            return Err(at.error(&field, message));
+        }
+    }
+    list.iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let field = format!("contacts[{i}].marker");
+            let marker = lookup(at, &field, &by_name, &c.marker, "marker")?;
+            let contact = contact(cx, tree, i, c, marker, markers[marker].body)?;
+            followable(at, i, &contact)?;
+            if matches!(contact.follower, Follower::Flat { .. }) {
+                turns_about_the_cam_axis(at, i, &contact, bodies, markers)?;
+            }
+            Ok(contact)
+        })
+        .collect()
+}
+
+fn contact(
+    cx: &Context,
+    tree: &BodyTree,
+    i: usize,
+    c: &raw::Contact,
+    marker: usize,
+    follower_body: usize,
+) -> Checked<Contact> {
+    let at = cx.at;
+    let path = format!("contacts[{i}]");
+    let cam_body = match c.cam_body.as_deref() {
+        None | Some(GROUND) => None,
+        Some(name) => Some(tree.sorted_body(at, &format!("{path}.cam_body"), name)?),
+    };
+    if cam_body == Some(follower_body) {
+        return Err(at.error(
+            &format!("{path}.cam_body"),
+            format!(
+                "the cam is on the body that carries the marker `{}`: a contact needs two \
+                 bodies that move relative to each other",
+                c.marker
+            ),
+        ));
+    }
+    let (x_axis, y_axis) = cam_axes(cx, &format!("{path}.frame"), &c.frame)?;
+    let profile = profile(cx, &path, c, i)?;
+    let follower = follower(cx, &path, &c.follower, i)?;
+    let range = contact_range(at, &path, c, &profile, &follower)?;
+    Ok(Contact {
+        name: c.name.clone().unwrap_or_else(|| c.marker.clone()),
+        marker,
+        follower,
+        profile,
+        cam_body,
+        origin: cx.vector_of(&format!("{path}.frame.origin"), &c.frame.origin, |k| {
+            Field::Origin(i, k)
+        })?,
+        x_axis,
+        y_axis,
+        range,
+    })
+}
+
+/// The profile: exactly one of `profile` (explicit), `polar` and `parametric`.
+fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Profile> {
+    let given = [
+        c.profile.is_some(),
+        c.polar.is_some(),
+        c.parametric.is_some(),
+    ];
+    if given.iter().filter(|g| **g).count() != 1 {
+        let message = if given.contains(&true) {
+            "give only one of `profile`, `polar` and `parametric`"
+        } else {
+            "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
+             `polar: \"r(theta)\"` or `parametric: (x: \"x(s)\", y: \"y(s)\")`"
+        };
+        let field = if c.polar.is_some() && given[0] {
+            format!("{path}.polar")
+        } else if c.parametric.is_some() && given.iter().filter(|g| **g).count() > 1 {
+            format!("{path}.parametric")
+        } else {
+            format!("{path}.marker")
+        };
+        return Err(cx.at.error(&field, message));
+    }
+    if let Some(source) = &c.profile {
+        let f = expression(
+            cx,
+            &format!("{path}.profile"),
+            source,
+            "x",
+            Field::Profile(i),
+        )?;
+        return Ok(Profile::Explicit {
+            source: source.clone(),
+            f,
+        });
+    }
+    if let Some(source) = &c.polar {
+        let r = expression(
+            cx,
+            &format!("{path}.polar"),
+            source,
+            "theta",
+            Field::Profile(i),
+        )?;
+        return Ok(Profile::Polar {
+            source: source.clone(),
+            r,
+        });
+    }
+    let p = c.parametric.as_ref().ok_or_else(|| {
+        cx.at
+            .error(&format!("{path}.parametric"), "missing parametric profile")
+    })?;
+    let x = expression(
+        cx,
+        &format!("{path}.parametric.x"),
+        &p.x,
+        "s",
+        Field::Profile(i),
+    )?;
+    let y = expression(
+        cx,
+        &format!("{path}.parametric.y"),
+        &p.y,
+        "s",
+        Field::ProfileY(i),
+    )?;
+    Ok(Profile::Parametric {
+        x_source: p.x.clone(),
+        y_source: p.y.clone(),
+        x,
+        y,
+    })
+}
+
+fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
+    Ok(match f {
+        raw::Follower::Knife => Follower::Knife,
+        raw::Follower::Roller { radius } => Follower::Roller {
+            radius: cx.positive(
+                &format!("{path}.follower.radius"),
+                radius,
+                Field::Radius(i),
+                "the roller radius",
+            )?,
+        },
+        raw::Follower::Flat { normal } => {
+            let field = format!("{path}.follower.normal");
+            let v = cx.vector(&field, normal, None)?;
+            Follower::Flat {
+                normal: unit_vector(cx.at, &field, "the face normal", v)?,
+            }
+        }
+    })
+}
+
+/// The profile interval a contact may touch: given (finite, increasing), or [0, 2π] for a
+/// polar profile; required where the contact point is searched for along the profile
+/// (a parametric profile) or undercutting is checked (a roller or a flat face).
+fn contact_range(
+    at: &Locator,
+    path: &str,
+    c: &raw::Contact,
+    profile: &Profile,
+    follower: &Follower,
+) -> Checked<Option<(f64, f64)>> {
+    let field = format!("{path}.range");
+    if let Some((a, b)) = c.range {
+        finite(at, &format!("{field}[0]"), a)?;
+        finite(at, &format!("{field}[1]"), b)?;
+        if a >= b {
+            return Err(at.error(
+                &field,
+                format!("the range must be increasing, got ({a}, {b})"),
+            ));
+        }
+        return Ok(Some((a, b)));
+    }
+    let needs = match (profile, follower) {
+        (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
+        (Profile::Parametric { .. }, _) => Some("a parametric profile"),
+        (Profile::Explicit { .. }, Follower::Knife) => None,
+        (Profile::Explicit { .. }, Follower::Roller { .. }) => {
+            Some("a roller on an explicit profile")
+        }
+        (Profile::Explicit { .. }, Follower::Flat { .. }) => {
+            Some("a flat face on an explicit profile")
+        }
+    };
+    match needs {
+        None => Ok(None),
+        Some(what) => Err(at.error(
+            &format!("{path}.marker"),
+            format!(
+                "{what} needs `range: (from, to)`: the interval of the profile's variable the \
+                 follower may touch, where undercutting is checked and the contact point is \
+                 first searched for"
+            ),
+        )),
+    }
+}
+
+/// The follower can follow the profile over its range: a polar radius that stays positive,
+/// a roller smaller than every hollow of the profile, a flat face on a convex profile.
+fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
+    let Some(range) = contact.range else {
+        return Ok(());
+    };
+    let path = format!("contacts[{i}]");
+    let variable = contact.profile.variable();
+    let samples = profile_samples(&contact.profile, range, PROFILE_CHECK_SAMPLES);
+    if let Profile::Polar { .. } = contact.profile {
+        if let Some(bad) = samples.iter().find(|s| s.radius <= 0.0 || s.radius.is_nan()) {
+            return Err(at.error(
+                &format!("{path}.polar"),
+                format!(
+                    "the polar radius must be positive over the cam, but r({variable} = {:.6}) \
+                     = {:e} m",
+                    bad.at, bad.radius
+                ),
+            ));
+        }
+    }
+    if let Some(bad) = samples.iter().find(|s| !s.curvature.is_finite()) {
+        return Err(at.error(
+            &format!("{path}.{}", profile_field(&contact.profile)),
+            format!(
+                "the profile has no finite curvature at {variable} = {:.6} (a corner or a \
+                 point where it stops): a follower cannot ride over it",
+                bad.at
+            ),
+        ));
+    }
+    // The most hollow place of the profile (largest curvature towards the follower).
+    let Some(hollow) = samples
+        .iter()
+        .copied()
+        .max_by(|a, b| a.curvature.total_cmp(&b.curvature))
+    else {
+        return Ok(());
+    };
+    let radius_of_curvature = 1.0 / hollow.curvature;
+    match contact.follower {
+        Follower::Roller { radius } if hollow.curvature > 0.0 && radius >= radius_of_curvature => {
+            Err(at.error(
+                &format!("{path}.follower.radius"),
+                format!(
+                    "the roller (radius {radius} m) is larger than the profile's hollow at \
+                     {variable} = {:.6}, whose radius of curvature is {radius_of_curvature:.6e} \
+                     m: the roller cannot reach the bottom of it (undercutting); use a roller \
+                     smaller than {radius_of_curvature:.6e} m or a flatter profile",
+                    hollow.at
+                ),
+            ))
+        }
+        // The face rests on one point only where the profile is strictly convex: a straight
+        // stretch (radius of curvature beyond 1e6 m) would carry it along a whole segment.
+        Follower::Flat { .. } if hollow.curvature > -FLAT_CURVATURE => Err(at.error(
+            &format!("{path}.follower"),
+            format!(
+                "a flat face needs a strictly convex profile, but at {variable} = {:.6} the \
+                 profile is {} (curvature {:.6e} 1/m): the face would bridge it",
+                hollow.at,
+                if hollow.curvature > 0.0 {
+                    "hollow"
+                } else {
+                    "straight"
+                },
+                hollow.curvature
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Below this curvature (1/m) a profile counts as straight for a flat face.
+const FLAT_CURVATURE: f64 = 1e-6;
+
+/// The field that holds a profile's expression.
+fn profile_field(profile: &Profile) -> &'static str {
+    match profile {
+        Profile::Explicit { .. } => "profile",
+        Profile::Polar { .. } => "polar",
+        Profile::Parametric { .. } => "parametric",
+    }
+}
+
+/// A flat face's normal stays in the cam plane only if the follower turns relative to the
+/// cam about the cam's axis: every revolute joint between them (below their common
+/// ancestor) must turn about that axis, and the face normal must be perpendicular to it.
+fn turns_about_the_cam_axis(
+    at: &Locator,
+    i: usize,
+    contact: &Contact,
+    bodies: &[Body],
+    markers: &[Marker],
+) -> Checked<()> {
+    let Follower::Flat { normal } = contact.follower else {
+        return Ok(());
+    };
+    let axis = contact.axis();
+    let parallel = |u: [f64; 3]| {
+        let cross = [
+            u[1] * axis[2] - u[2] * axis[1],
+            u[2] * axis[0] - u[0] * axis[2],
+            u[0] * axis[1] - u[1] * axis[0],
+        ];
+        cross.iter().all(|c| c.abs() < 1e-12)
+    };
+    let path_of = |body: Option<usize>| {
+        let mut path = Vec::new();
+        let mut at = body;
+        while let Some(b) = at {
+            path.push(b);
+            at = bodies[b].parent;
+        }
+        path
+    };
+    let follower_path = path_of(Some(markers[contact.marker].body));
+    let cam_path = path_of(contact.cam_body);
+    let between = follower_path
+        .iter()
+        .filter(|b| !cam_path.contains(b))
+        .chain(cam_path.iter().filter(|b| !follower_path.contains(b)));
+    let path = format!("contacts[{i}].follower");
+    for &b in between {
+        let joint = &bodies[b].joint;
+        if joint.kind == JointKind::Revolute && !parallel(joint.axis) {
+            return Err(at.error(
+                &path,
+                format!(
+                    "a flat face may turn relative to its cam only about the cam's axis \
+                     ({:?}), but joint `{}` between them turns about {:?}",
+                    axis, joint.coordinate, joint.axis
+                ),
+            ));
+        }
+    }
+    let dot: f64 = normal.iter().zip(&axis).map(|(a, b)| a * b).sum();
+    if dot.abs() > 1e-12 {
+        return Err(at.error(
+            &format!("{path}.normal"),
+            format!(
+                "the face normal {normal:?} must lie in the cam plane (perpendicular to the \
+                 cam's axis {axis:?})"
+            ),
+        ));
+    }
+    Ok(())
+}
