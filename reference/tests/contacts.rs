@@ -134,11 +134,7 @@ fn the_reference_jacobian_and_convective_term_match_its_own_differences() {
                     // As in the generator's test: 1e-7 on entries of order 0.1 … 1 (the
                     // reference's golden-section search leaves 1e-9 of the range, polished
                     // by Newton).
-                    assert!(
-                        (jk - fd).abs() < 1e-7,
-                        "{}: J[{k}] {jk} vs {fd}",
-                        kind.name
-                    );
+                    assert!((jk - fd).abs() < 1e-7, "{}: J[{k}] {jk} vs {fd}", kind.name);
                 }
                 let mut c = [0.0];
                 m.constraint_bias(&q, &qd, &mut c);

@@ -257,7 +257,10 @@ fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
     let variable = contact.profile.variable();
     let samples = profile_samples(&contact.profile, range, PROFILE_CHECK_SAMPLES);
     if let Profile::Polar { .. } = contact.profile {
-        if let Some(bad) = samples.iter().find(|s| s.radius <= 0.0 || s.radius.is_nan()) {
+        if let Some(bad) = samples
+            .iter()
+            .find(|s| s.radius <= 0.0 || s.radius.is_nan())
+        {
             return Err(at.error(
                 &format!("{path}.polar"),
                 format!(
