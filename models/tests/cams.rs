@@ -232,6 +232,26 @@ fn the_motor_driven_camshaft_keeps_its_energy_balance_and_its_follower_jumps() {
         speed > jump * 0.95 && speed < jump * 1.3,
         "lift-off at {speed} rad/s, jump speed {jump}"
     );
+    // Every landing approaches the cam and rebounds by Newton's law (or stays): a rebound
+    // re-found at its own take-off once counted as a landing that flipped it back.
+    for event in &run.events {
+        if let EventKind::Impact {
+            normal_velocity,
+            rebound,
+            stays,
+            ..
+        } = event.kind
+        {
+            assert!(normal_velocity < 0.0, "t = {}: lands at {normal_velocity}", event.t);
+            let expected = if stays {
+                0.0
+            } else {
+                -restitution * normal_velocity
+            };
+            // Newton's law on the impulse, rounding of ~1e-16 m/s.
+            assert!((rebound - expected).abs() < 1e-12, "t = {}", event.t);
+        }
+    }
     let speeds: Vec<f64> = run.samples.iter().map(|s| s.qd[0]).collect();
     assert!(speeds.iter().cloned().fold(0.0, f64::max) > jump);
     eprintln!(

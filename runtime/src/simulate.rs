@@ -446,6 +446,36 @@ fn controlled_len(nu: usize, _dim: usize) -> usize {
     if nu == 0 { 2 } else { 2 * nu }
 }
 
+/// The first closing of a gap that opens at `t0` (where it is zero) and is negative at `t1`:
+/// an interval [a, b] with g(a) > 0 ≥ g(b), found on 32 points of [t0, t1], then of
+/// [t0, first point], three levels deep; `None` when the gap never opens measurably.
+#[allow(clippy::type_complexity)]
+fn bracket_landing(
+    g: &mut impl FnMut(f64) -> Result<f64, SimError>,
+    t0: f64,
+    (t1, g1): (f64, f64),
+) -> Result<Option<((f64, f64), (f64, f64))>, SimError> {
+    const POINTS: usize = 32;
+    let mut end = (t1, g1);
+    for _ in 0..3 {
+        let mut previous: Option<(f64, f64)> = None;
+        for i in 1..=POINTS {
+            let t = t0 + (end.0 - t0) * i as f64 / POINTS as f64;
+            let value = if i == POINTS { end.1 } else { g(t)? };
+            if value <= 0.0 {
+                if let Some(open) = previous {
+                    return Ok(Some((open, (t, value))));
+                }
+                // Closed already at the first point: look closer to the take-off.
+                end = (t, value);
+                break;
+            }
+            previous = Some((t, value));
+        }
+    }
+    Ok(None)
+}
+
 /// Length of the integrated vector y = (u, u̇, dissipated, driven work, v, v̇).
 fn integrated_len(partition: &Partition) -> usize {
     2 * partition.independent().len() + 2 + 2 * partition.dependent().len()
@@ -904,12 +934,27 @@ impl Phase<'_, '_> {
                 Watch::Gap { .. } => g0 > 0.0,
             };
             let mut y = vec![0.0; state.engine.y.len()];
-            let g = |t: f64| -> Result<f64, SimError> {
+            let mut g = |t: f64| -> Result<f64, SimError> {
                 interpolate_last_step(model, state, self.settings, t, &mut y)?;
                 let values = self.watch_values(model, state, ws, t, &y)?;
                 Ok(values[k])
             };
-            let t = locate_root(g, (t0, g0), (t1, g1), EVENT_TIME_TOLERANCE)?;
+            // A flight that starts on the cam (its gap counted as just above zero) and lands
+            // within its first step: the gap rises, then falls through zero. Bracket the
+            // landing from a point where the gap is really open, not from the take-off.
+            let (mut a, mut b) = ((t0, g0), (t1, g1));
+            if gap && g0 <= f64::MIN_POSITIVE {
+                match bracket_landing(&mut g, t0, (t1, g1))? {
+                    Some(bracket) => (a, b) = bracket,
+                    None => {
+                        // A hop shorter than a 32768th of the step: the follower never
+                        // really left the cam; it lands where it took off.
+                        found.push((t0, k, stops));
+                        continue;
+                    }
+                }
+            }
+            let t = locate_root(g, a, b, EVENT_TIME_TOLERANCE)?;
             found.push((t, k, stops));
         }
         found.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -191,7 +191,9 @@ fn impact<D: Dynamics + ?Sized>(
     if !(denominator > 0.0 && denominator.is_finite()) {
         return Err(singular());
     }
-    let stays = restitution * normal_velocity.abs() < RESTING_SPEED;
+    // A "landing" that does not approach (a take-off too short to resolve, the rebound
+    // re-found at once) ends the flight plastically: the follower stays on the cam.
+    let stays = normal_velocity >= 0.0 || restitution * normal_velocity.abs() < RESTING_SPEED;
     let e = if stays { 0.0 } else { restitution };
     let impulse = -(1.0 + e) * normal_velocity / denominator;
     let mut after = qd.to_vec();
