@@ -1,6 +1,7 @@
 //! Compiles the built-in models (`*.ron` in this directory) through `camchain-build`, the same
 //! API a user's build script calls, and, with the `random-models` feature, the random models
-//! of the property tests (`tests/random_models/*.ron`, not user-facing).
+//! of the property tests (`tests/random_models/*.ron`) and the contact test models
+//! (`tests/contact_models/*.ron`), not user-facing.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     camchain_build::Config::new()
@@ -15,6 +16,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .out_dir(out)
             .include_file("random_models.rs")
             .compile_models(&["tests/random_models"])?;
+        // The contact kinds the built-in models do not use (tests/contacts_compiled.rs).
+        let contacts = std::path::PathBuf::from(std::env::var("OUT_DIR")?).join("contact_models");
+        camchain_build::Config::new()
+            .out_dir(contacts)
+            .include_file("contact_models.rs")
+            .compile_models(&["tests/contact_models"])?;
     }
     // Set by cargo when the `parameter-modes` feature is on (this package's own tests): the
     // built-in models again with every parameter folded and with every parameter read at

@@ -40,6 +40,18 @@ pub mod random_models {
     include!(concat!(env!("OUT_DIR"), "/random_models/random_models.rs"));
 }
 
+/// The contact kinds the built-in models do not use (`tests/contact_models/`: parametric
+/// profiles, rollers and flat faces on explicit ones, an applied joint torque), compiled like
+/// the built-in ones for `tests/contacts_compiled.rs`. Behind the `random-models` feature.
+#[cfg(feature = "random-models")]
+#[doc(hidden)]
+pub mod contact_models {
+    include!(concat!(
+        env!("OUT_DIR"),
+        "/contact_models/contact_models.rs"
+    ));
+}
+
 /// The built-in models compiled with every parameter folded (`ParameterMode::FoldAll`) and
 /// with every parameter read at run time (`ParameterMode::AllAtRunTime`), and the test models
 /// of `tests/parameter_models/`: what `tests/parameters.rs` compares. Compiled only with the

@@ -242,7 +242,11 @@ fn the_motor_driven_camshaft_keeps_its_energy_balance_and_its_follower_jumps() {
             ..
         } = event.kind
         {
-            assert!(normal_velocity < 0.0, "t = {}: lands at {normal_velocity}", event.t);
+            assert!(
+                normal_velocity < 0.0,
+                "t = {}: lands at {normal_velocity}",
+                event.t
+            );
             let expected = if stays {
                 0.0
             } else {
