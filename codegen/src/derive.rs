@@ -17,6 +17,20 @@ pub struct DriveTerms {
     pub motion: [Id; 3],
 }
 
+/// A profile's polar radius and curvature at a placeholder, for the generated code's run-time
+/// check that a follower can follow it ([`crate::model::RuntimeCheck::Followable`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ProfileCheck {
+    /// The contact.
+    pub contact: usize,
+    /// The placeholder variable of the profile's parameter.
+    pub at: Id,
+    /// r of a polar profile.
+    pub radius: Option<Id>,
+    /// The curvature, positive where the profile is hollow seen from the follower.
+    pub curvature: Id,
+}
+
 /// Every symbolic term of a model.
 #[derive(Debug, Clone)]
 pub struct Derivation {
@@ -38,6 +52,34 @@ pub struct Derivation {
     /// (profiles and drives, which are functions of x and t, are not in it): what the
     /// generated code checks and the initial guess it computes.
     pub fields: std::collections::BTreeMap<Field, Id>,
+    /// The profiles whose followers the generated code checks at run time.
+    pub profile_checks: Vec<ProfileCheck>,
+}
+
+/// [`ProfileCheck`] of contact `k`.
+fn profile_check(g: &mut Graph, model: &Model, s: &Symbols, k: usize) -> ProfileCheck {
+    let contact = &model.contacts[k];
+    g.set_section(format!(
+        "contact {}: the profile's curvature, checked at run time",
+        contact.name
+    ));
+    let at = g.var(&format!("__check_{}", contact.name));
+    let c = crate::contact::curve::curve_at(g, model, s, k, at);
+    let side = crate::contact::curve::follower_side(&contact.profile);
+    let f = crate::contact::curve::frame(g, &c, side);
+    let radius = match &contact.profile {
+        crate::model::Profile::Polar { r, .. } => {
+            let r = s.expression(model, Field::Profile(k), r);
+            Some(scalar_to_expr(g, r, at, &s.params))
+        }
+        _ => None,
+    };
+    ProfileCheck {
+        contact: k,
+        at,
+        radius,
+        curvature: f.curvature,
+    }
 }
 
 impl Derivation {
@@ -86,6 +128,15 @@ impl Derivation {
             })
             .map(|(&f, expr)| (f, scalar_to_expr(&mut g, expr, zero, &symbols.params)))
             .collect();
+        let profile_checks = model
+            .runtime_checks
+            .iter()
+            .filter_map(|c| match c {
+                crate::model::RuntimeCheck::Followable(k, _) => Some(*k),
+                _ => None,
+            })
+            .map(|k| profile_check(&mut g, model, &symbols, k))
+            .collect();
         Derivation {
             graph: g,
             symbols,
@@ -95,6 +146,7 @@ impl Derivation {
             drives,
             parameter_values: model.parameters.iter().map(|p| p.value).collect(),
             fields,
+            profile_checks,
         }
     }
 

@@ -497,7 +497,7 @@ impl Graph {
         }
     }
 
-    /// a / b with folding; division by a constant becomes a multiplication.
+    /// a / b with folding; division by a constant becomes a multiplication, signs go out.
     pub fn div(&mut self, a: Id, b: Id) -> Id {
         if self.is_zero(a) {
             return self.zero();
@@ -505,7 +505,18 @@ impl Graph {
         match (self.as_const(a), self.as_const(b)) {
             (Some(x), Some(y)) => self.constant(x / y),
             (_, Some(y)) if y != 0.0 => self.scale(1.0 / y, a),
-            _ => self.intern(Node::Div(a, b)),
+            _ => match (self.node(a), self.node(b)) {
+                // Signs are pulled out, as for products, so that −(−x)/y folds to x/y.
+                (Node::Neg(x), _) => {
+                    let q = self.div(x, b);
+                    self.neg(q)
+                }
+                (_, Node::Neg(y)) => {
+                    let q = self.div(a, y);
+                    self.neg(q)
+                }
+                _ => self.intern(Node::Div(a, b)),
+            },
         }
     }
 

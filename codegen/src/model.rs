@@ -355,6 +355,10 @@ pub enum RuntimeCheck {
     NonNegative(Field, &'static str, FieldLocation),
     /// The inertia tensor of a body (sorted index) is physical.
     Inertia(usize, FieldLocation),
+    /// Contact c's follower can follow its profile (no undercutting roller, a flat face on a
+    /// convex profile, a positive polar radius): `camchain_runtime::contact::followable`,
+    /// reported at the roller's radius, the follower and the profile (in that order).
+    Followable(usize, [FieldLocation; 3]),
 }
 
 /// A numeric field of the model, by position (body and coordinate indices are the sorted,

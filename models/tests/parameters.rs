@@ -275,6 +275,61 @@ fn a_bad_value_at_run_time_gets_the_error_the_build_gives() {
     }
 }
 
+/// The model file of `checks::undercut`, as its build shows it.
+const UNDERCUT: &str = "models/tests/parameter_models/undercut.ron";
+
+#[test]
+fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {
+    // Run-time values that make the roller larger than its hollow (rho, or depth: the
+    // hollow's radius of curvature is 1/(2 depth) = 0.1 m by default) or the polar cam's
+    // radius negative (base < 0.01): the generated check samples the profile as the build
+    // does, with the build's message and location.
+    let cases: [(&str, f64, &str); 3] = [
+        (
+            "rho",
+            0.2,
+            "undercut.ron:26:48: contacts[0].follower.radius: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
+        ),
+        (
+            "depth",
+            50.0,
+            "undercut.ron:26:48: contacts[0].follower.radius: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
+        ),
+        (
+            "base",
+            0.005,
+            "undercut.ron:27:30: contacts[1].polar: the polar radius must be positive over the cam, but r(theta = 2.095418)",
+        ),
+    ];
+    let text = std::fs::read_to_string(format!(
+        "{}/tests/parameter_models/undercut.ron",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("the test model");
+    for (name, value, expected) in cases {
+        let generated = checks::undercut::Model::with(&[(name, value)])
+            .map(|_| ())
+            .expect_err("a follower that cannot follow")
+            .to_string();
+        let numeric = NumericModel::from_source_with(
+            &text,
+            Path::new(UNDERCUT),
+            &[(name.to_string(), value)],
+            ParameterMode::AsDeclared,
+        )
+        .map(|_| ())
+        .expect_err("a follower that cannot follow")
+        .to_string();
+        assert_eq!(generated, numeric, "{name} = {value}");
+        assert!(
+            generated.contains(expected),
+            "{name} = {value}: `{generated}` lacks `{expected}`"
+        );
+    }
+    // Values that keep every follower on its profile are accepted.
+    assert!(checks::undercut::Model::with(&[("rho", 0.09), ("base", 0.011)]).is_ok());
+}
+
 #[test]
 fn a_field_error_at_run_time_is_the_files_own_error() {
     // The same value written into the file as the parameter's default: the build reports it

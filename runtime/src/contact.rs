@@ -84,6 +84,155 @@ fn scan(range: (f64, f64), objective: &impl Fn(f64) -> f64) -> f64 {
     best.1
 }
 
+/// The shape the profile must admit (for [`followable`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// A knife edge: any smooth profile.
+    Knife,
+    /// A roller of this radius (m): no hollow tighter than it.
+    Roller(f64),
+    /// A flat face: a strictly convex profile.
+    Flat,
+}
+
+/// Where a problem [`followable`] finds is reported in the model file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Place {
+    /// The roller's radius.
+    Radius,
+    /// The follower (a flat face on a profile it cannot rest on).
+    Follower,
+    /// The profile's expression.
+    Profile,
+}
+
+/// One sample of a profile: its variable, its polar radius (NaN for the other forms) and
+/// its curvature, positive where it is hollow seen from the follower (1/m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProfileSample {
+    /// The profile's variable (x, θ or s).
+    pub at: f64,
+    /// r(θ) of a polar profile, NaN otherwise.
+    pub radius: f64,
+    /// The curvature (1/m).
+    pub curvature: f64,
+}
+
+/// Samples of a profile's range where the build and the generated checks look for hollows.
+pub const PROFILE_CHECK_SAMPLES: usize = 4096;
+
+/// Below this curvature (1/m) a profile counts as straight for a flat face (a radius of
+/// curvature beyond 1e6 m).
+pub const FLAT_CURVATURE: f64 = 1e-6;
+
+/// The follower `shape` can follow a profile whose samples are `samples` (`variable` names
+/// the profile's variable in messages): a polar radius that stays positive, a finite
+/// curvature, a roller smaller than every hollow (else it undercuts), a flat face only on a
+/// strictly convex profile. The build checks the model file with it; generated code repeats
+/// it when a radius or a profile depends on run-time parameters. The error says where to
+/// report it and what is wrong, with the place on the profile and the numbers.
+pub fn followable(
+    variable: &str,
+    shape: Shape,
+    samples: &[ProfileSample],
+) -> Result<(), (Place, String)> {
+    if let Some(bad) = samples.iter().find(|s| s.radius <= 0.0) {
+        return Err((
+            Place::Profile,
+            format!(
+                "the polar radius must be positive over the cam, but r({variable} = {:.6}) = \
+                 {:e} m",
+                bad.at, bad.radius
+            ),
+        ));
+    }
+    if let Some(bad) = samples.iter().find(|s| !s.curvature.is_finite()) {
+        return Err((
+            Place::Profile,
+            format!(
+                "the profile has no finite curvature at {variable} = {:.6} (a corner or a point \
+                 where it stops): a follower cannot ride over it",
+                bad.at
+            ),
+        ));
+    }
+    // The most hollow place of the profile (largest curvature towards the follower).
+    let Some(hollow) = samples
+        .iter()
+        .copied()
+        .max_by(|a, b| a.curvature.total_cmp(&b.curvature))
+    else {
+        return Ok(());
+    };
+    let radius_of_curvature = 1.0 / hollow.curvature;
+    match shape {
+        Shape::Roller(radius) if hollow.curvature > 0.0 && radius >= radius_of_curvature => Err((
+            Place::Radius,
+            format!(
+                "the roller (radius {radius} m) is larger than the profile's hollow at \
+                 {variable} = {:.6}, whose radius of curvature is {radius_of_curvature:.6e} m: \
+                 the roller cannot reach the bottom of it (undercutting); use a roller smaller \
+                 than {radius_of_curvature:.6e} m or a flatter profile",
+                hollow.at
+            ),
+        )),
+        // The face rests on one point only where the profile is strictly convex: a straight
+        // stretch would carry it along a whole segment.
+        Shape::Flat if hollow.curvature > -FLAT_CURVATURE => Err((
+            Place::Follower,
+            format!(
+                "a flat face needs a strictly convex profile, but at {variable} = {:.6} the \
+                 profile is {} (curvature {:.6e} 1/m): the face would bridge it",
+                hollow.at,
+                if hollow.curvature > 0.0 {
+                    "hollow"
+                } else {
+                    "straight"
+                },
+                hollow.curvature
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// [`followable`] on `samples` + 1 points of `range` evaluated by `at` (the polar radius and
+/// the curvature there), located by `places` ([`Place::Radius`], [`Place::Follower`],
+/// [`Place::Profile`] in that order): what generated `check` functions call.
+pub fn followable_located(
+    places: [crate::parameters::Location; 3],
+    variable: &str,
+    shape: Shape,
+    range: (f64, f64),
+    at: impl Fn(f64) -> [f64; 2],
+) -> Result<(), crate::ParameterError> {
+    let samples: Vec<ProfileSample> = (0..=PROFILE_CHECK_SAMPLES)
+        .map(|k| {
+            let s = range.0 + (range.1 - range.0) * k as f64 / PROFILE_CHECK_SAMPLES as f64;
+            let [radius, curvature] = at(s);
+            ProfileSample {
+                at: s,
+                radius,
+                curvature,
+            }
+        })
+        .collect();
+    followable(variable, shape, &samples).map_err(|(place, message)| {
+        let at = match place {
+            Place::Radius => places[0],
+            Place::Follower => places[1],
+            Place::Profile => places[2],
+        };
+        crate::ParameterError {
+            file: at.file.to_string(),
+            line: at.line,
+            column: at.column,
+            field: at.field.to_string(),
+            message,
+        }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

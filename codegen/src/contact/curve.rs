@@ -99,20 +99,13 @@ pub fn curve(
     }
 }
 
-/// A profile evaluated at one value of its variable (for the build's checks).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ProfileSample {
-    /// The profile's variable (x, θ or s).
-    pub at: f64,
-    /// The polar radius r(θ) of a polar profile (NaN for the other forms).
-    pub radius: f64,
-    /// The curvature, positive where the profile is hollow seen from the follower (1/m).
-    pub curvature: f64,
-}
-
 /// `samples` + 1 evenly spaced samples of `profile` (its expressions with every parameter
 /// resolved) over `range`, with its symbolic derivatives evaluated by the interpreter.
-pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> Vec<ProfileSample> {
+pub fn profile_samples(
+    profile: &Profile,
+    range: (f64, f64),
+    samples: usize,
+) -> Vec<camchain_runtime::contact::ProfileSample> {
     let mut g = Graph::new();
     let at = g.var("s");
     let (first, second) = match profile {
@@ -132,7 +125,7 @@ pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> 
                 Profile::Polar { r, .. } => r.eval(s),
                 _ => f64::NAN,
             };
-            ProfileSample {
+            camchain_runtime::contact::ProfileSample {
                 at: s,
                 radius,
                 curvature,

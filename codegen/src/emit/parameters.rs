@@ -324,6 +324,7 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
     for check in &model.runtime_checks {
         let (fields, at): (Vec<Field>, &FieldLocation) = match check {
             RuntimeCheck::Bounds { .. } => continue,
+            RuntimeCheck::Followable(k, at) => (vec![Field::Radius(*k)], &at[0]),
             RuntimeCheck::Finite(f, at)
             | RuntimeCheck::Positive(f, _, at)
             | RuntimeCheck::NonNegative(f, _, at) => (vec![*f], at),
@@ -400,6 +401,31 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
                     value_of(*field)
                 );
             }
+            RuntimeCheck::Followable(k, at) => {
+                let contact = &model.contacts[*k];
+                let shape = match contact.follower {
+                    crate::model::Follower::Knife => "rt::contact::Shape::Knife".to_string(),
+                    crate::model::Follower::Roller { .. } => {
+                        need(Field::Radius(*k));
+                        format!(
+                            "rt::contact::Shape::Roller({})",
+                            value_of(Field::Radius(*k))
+                        )
+                    }
+                    crate::model::Follower::Flat { .. } => "rt::contact::Shape::Flat".to_string(),
+                };
+                let (a, b) = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
+                let places: Vec<String> = at.iter().map(|a| location_from(a, file)).collect();
+                let _ = writeln!(
+                    statements,
+                    "rt::contact::followable_located([{}], {:?}, {shape}, ({}, {}), |s| {}(p, s))?;",
+                    places.join(", "),
+                    contact.profile.variable(),
+                    lit(a),
+                    lit(b),
+                    followable_name(model, *k)
+                );
+            }
             RuntimeCheck::Inertia(body, at) => {
                 let rows: Vec<String> = (0..3)
                     .map(|r| {
@@ -439,6 +465,56 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
         tail: format!("{statements}Ok(())"),
     };
     let (text, _) = emit_function_given(d, &spec, "", false, &[]);
+    let mut out = format!("{ALLOW_LITERALS}\n{text}");
+    for check in &d.profile_checks {
+        out.push_str(&followable_function(model, d, check));
+    }
+    out
+}
+
+/// The name of contact `k`'s profile sampler for its run-time check.
+fn followable_name(model: &Model, k: usize) -> String {
+    format!("{}_profile_check", value_name(&model.contacts[k].name))
+}
+
+/// `<contact>_profile_check(p, s)`: the polar radius (NaN for other forms) and the curvature
+/// of a contact's profile at s for the parameters `p`.
+fn followable_function(
+    model: &Model,
+    d: &Derivation,
+    check: &crate::derive::ProfileCheck,
+) -> String {
+    let mut outputs = vec![("let curvature".to_string(), check.curvature)];
+    let radius = match check.radius {
+        Some(r) => {
+            outputs.push(("let radius".to_string(), r));
+            "radius"
+        }
+        None => "f64::NAN",
+    };
+    let spec = FunctionSpec {
+        doc: format!(
+            "The polar radius and the curvature of contact `{}`'s profile at s, for `check`.",
+            model.contacts[check.contact].name
+        ),
+        name: followable_name(model, check.contact),
+        params: vec![
+            Param {
+                name: "p",
+                ty: "&Parameters",
+                always_used: false,
+            },
+            Param {
+                name: "s",
+                ty: "f64",
+                always_used: false,
+            },
+        ],
+        ret: Some("[f64; 2]"),
+        outputs,
+        tail: format!("[{radius}, curvature]"),
+    };
+    let (text, _) = emit_function_given(d, &spec, "", false, &[(check.at, "s".to_string())]);
     format!("{ALLOW_LITERALS}\n{text}")
 }
 

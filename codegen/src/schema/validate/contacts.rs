@@ -8,12 +8,12 @@ use super::{
     expression, finite, identifier, lookup, unit_vector,
 };
 use crate::contact::curve::profile_samples;
-use crate::model::{Body, Contact, JointKind};
+use crate::model::{Body, Contact, JointKind, RuntimeCheck};
 use crate::schema::raw;
+use camchain_runtime::contact::{
+    PROFILE_CHECK_SAMPLES, Place, Shape, followable as followable_checked,
+};
 use std::collections::HashMap;
-
-/// Samples of the profile's range where the build checks its radius and curvature.
-pub const PROFILE_CHECK_SAMPLES: usize = 4096;
 
 pub(super) fn contacts(
     list: &[raw::Contact],
@@ -54,6 +54,7 @@ pub(super) fn contacts(
             let marker = lookup(at, &field, &by_name, &c.marker, "marker")?;
             let contact = contact(cx, tree, i, c, marker, markers[marker].body)?;
             followable(at, i, &contact)?;
+            recheck_at_run_time(cx, i, &contact);
             if matches!(contact.follower, Follower::Flat { .. }) {
                 turns_about_the_cam_axis(at, i, &contact, bodies, markers)?;
             }
@@ -247,84 +248,82 @@ fn contact_range(
     }
 }
 
-/// The follower can follow the profile over its range: a polar radius that stays positive,
-/// a roller smaller than every hollow of the profile, a flat face on a convex profile.
+/// The follower can follow the profile over its range (`camchain_runtime::contact::
+/// followable`, which generated code repeats when the radius or the profile depends on
+/// run-time parameters), and a polar profile closes on itself.
 fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
     let Some(range) = contact.range else {
         return Ok(());
     };
     let path = format!("contacts[{i}]");
-    let variable = contact.profile.variable();
     let samples = profile_samples(&contact.profile, range, PROFILE_CHECK_SAMPLES);
-    if let Profile::Polar { .. } = contact.profile {
-        if let Some(bad) = samples
-            .iter()
-            .find(|s| s.radius <= 0.0 || s.radius.is_nan())
-        {
+    let shape = match contact.follower {
+        Follower::Knife => Shape::Knife,
+        Follower::Roller { radius } => Shape::Roller(radius),
+        Follower::Flat { .. } => Shape::Flat,
+    };
+    followable_checked(contact.profile.variable(), shape, &samples).map_err(
+        |(place, message)| {
+            let field = match place {
+                Place::Radius => format!("{path}.follower.radius"),
+                Place::Follower => format!("{path}.follower"),
+                Place::Profile => format!("{path}.{}", profile_field(&contact.profile)),
+            };
+            at.error(&field, message)
+        },
+    )?;
+    if let Profile::Polar { r, .. } = &contact.profile {
+        closes(at, &format!("{path}.polar"), r)?;
+    }
+    Ok(())
+}
+
+/// When the roller's radius or the profile depends on run-time parameters, the generated
+/// code repeats [`followable`] for each parameter set.
+fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
+    let table = cx.table;
+    let runtime_radius = table.is_runtime(Field::Radius(i));
+    let runtime_profile =
+        table.is_runtime(Field::Profile(i)) || table.is_runtime(Field::ProfileY(i));
+    let matters = match contact.follower {
+        Follower::Knife => matches!(contact.profile, Profile::Polar { .. }),
+        Follower::Roller { .. } | Follower::Flat { .. } => true,
+    };
+    if contact.range.is_some() && matters && (runtime_radius || runtime_profile) {
+        let path = format!("contacts[{i}]");
+        table.check(RuntimeCheck::Followable(
+            i,
+            [
+                super::location(cx.at, &format!("{path}.follower.radius")),
+                super::location(cx.at, &format!("{path}.follower")),
+                super::location(
+                    cx.at,
+                    &format!("{path}.{}", profile_field(&contact.profile)),
+                ),
+            ],
+        ));
+    }
+}
+
+/// A polar profile is periodic: r(θ + 2π) = r(θ) (a disc cam closes on itself), checked at
+/// 16 angles to 1e-9 of the radius.
+fn closes(at: &Locator, field: &str, r: &crate::profile::Scalar) -> Checked<()> {
+    for k in 0..16 {
+        let theta = std::f64::consts::TAU * k as f64 / 16.0;
+        let (a, b) = (r.eval(theta), r.eval(theta + std::f64::consts::TAU));
+        if (a - b).abs() > 1e-9 * a.abs().max(b.abs()).max(1e-3) {
             return Err(at.error(
-                &format!("{path}.polar"),
+                field,
                 format!(
-                    "the polar radius must be positive over the cam, but r({variable} = {:.6}) \
-                     = {:e} m",
-                    bad.at, bad.radius
+                    "a polar profile must close on itself, r(theta + 2π) = r(theta), but \
+                     r({theta:.6}) = {a:e} m and r({:.6}) = {b:e} m",
+                    theta + std::f64::consts::TAU
                 ),
             ));
         }
     }
-    if let Some(bad) = samples.iter().find(|s| !s.curvature.is_finite()) {
-        return Err(at.error(
-            &format!("{path}.{}", profile_field(&contact.profile)),
-            format!(
-                "the profile has no finite curvature at {variable} = {:.6} (a corner or a \
-                 point where it stops): a follower cannot ride over it",
-                bad.at
-            ),
-        ));
-    }
-    // The most hollow place of the profile (largest curvature towards the follower).
-    let Some(hollow) = samples
-        .iter()
-        .copied()
-        .max_by(|a, b| a.curvature.total_cmp(&b.curvature))
-    else {
-        return Ok(());
-    };
-    let radius_of_curvature = 1.0 / hollow.curvature;
-    match contact.follower {
-        Follower::Roller { radius } if hollow.curvature > 0.0 && radius >= radius_of_curvature => {
-            Err(at.error(
-                &format!("{path}.follower.radius"),
-                format!(
-                    "the roller (radius {radius} m) is larger than the profile's hollow at \
-                     {variable} = {:.6}, whose radius of curvature is {radius_of_curvature:.6e} \
-                     m: the roller cannot reach the bottom of it (undercutting); use a roller \
-                     smaller than {radius_of_curvature:.6e} m or a flatter profile",
-                    hollow.at
-                ),
-            ))
-        }
-        // The face rests on one point only where the profile is strictly convex: a straight
-        // stretch (radius of curvature beyond 1e6 m) would carry it along a whole segment.
-        Follower::Flat { .. } if hollow.curvature > -FLAT_CURVATURE => Err(at.error(
-            &format!("{path}.follower"),
-            format!(
-                "a flat face needs a strictly convex profile, but at {variable} = {:.6} the \
-                 profile is {} (curvature {:.6e} 1/m): the face would bridge it",
-                hollow.at,
-                if hollow.curvature > 0.0 {
-                    "hollow"
-                } else {
-                    "straight"
-                },
-                hollow.curvature
-            ),
-        )),
-        _ => Ok(()),
-    }
+    Ok(())
 }
-
-/// Below this curvature (1/m) a profile counts as straight for a flat face.
-const FLAT_CURVATURE: f64 = 1e-6;
 
 /// The field that holds a profile's expression.
 fn profile_field(profile: &Profile) -> &'static str {
