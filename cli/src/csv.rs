@@ -2,11 +2,17 @@
 //!
 //! Columns, in order: `t`; every coordinate by name; every velocity as `<name>_dot`; for
 //! each contact C: `C_x`, `C_y` (and `C_z` in a spatial model: the contact point in ground
-//! coordinates), `C_normal_force` (N, positive when the cam pushes on the follower), `C_h`
-//! (the constraint residual); for each driven coordinate, `<name>_drive` (the force or torque
-//! of its drive); then `energy` (kinetic + potential of gravity and springs), `dissipated`
-//! (work done by the dampers so far) and `driven_work` (work done by the drives so far), so
-//! that `energy + dissipated − driven_work` stays constant.
+//! coordinates, m), `C_cam_x`, `C_cam_y` (the same point in the cam's frame, which turns with
+//! the cam's body, m), `C_cam_angle` (only when the cam's body turns on a revolute joint of
+//! its own: that joint's angle, rad), `C_normal_force` (N, positive when the cam pushes on
+//! the follower), `C_pressure_angle` (rad, between the contact normal and the direction in
+//! which the follower's own joint moves the follower point), `C_sliding_speed` (m/s, the
+//! follower's tangential speed over the cam at the contact point), `C_h` (the constraint
+//! residual, m; in flight the gap); for each driven coordinate, `<name>_drive` (the force or
+//! torque of its drive); then `energy` (kinetic + potential of gravity and springs),
+//! `dissipated` (work done by the dampers so far) and `driven_work` (work done by the drives
+//! and the applied joint loads so far), so that `energy + dissipated − driven_work` stays
+//! constant.
 //!
 //! Numbers are written with Rust's shortest round-trip formatting (`{:?}`): parsing a value
 //! gives back exactly the `f64` the simulation computed.
@@ -19,15 +25,21 @@ pub fn header(info: &ModelInfo) -> Vec<String> {
     let mut columns = vec!["t".to_string()];
     columns.extend(info.coordinates.iter().map(|c| c.name.clone()));
     columns.extend(info.coordinates.iter().map(|c| format!("{}_dot", c.name)));
-    for contact in info.contacts.iter().map(|c| &c.name) {
+    for (k, contact) in info.contacts.iter().map(|c| &c.name).enumerate() {
         let axes: &[&str] = if info.spatial {
             &["x", "y", "z"]
         } else {
             &["x", "y"]
         };
         columns.extend(axes.iter().map(|a| format!("{contact}_{a}")));
-        columns.push(format!("{contact}_normal_force"));
-        columns.push(format!("{contact}_h"));
+        columns.extend(["cam_x", "cam_y"].map(|a| format!("{contact}_{a}")));
+        if info.contacts[k].cam_coordinate.is_some() {
+            columns.push(format!("{contact}_cam_angle"));
+        }
+        columns.extend(
+            ["normal_force", "pressure_angle", "sliding_speed", "h"]
+                .map(|a| format!("{contact}_{a}")),
+        );
     }
     columns.extend(
         info.coordinates
@@ -45,10 +57,18 @@ pub fn row(info: &ModelInfo, sample: &Sample) -> Vec<f64> {
     values.extend(&sample.q);
     values.extend(&sample.qd);
     let dims = if info.spatial { 3 } else { 2 };
-    for (k, contact) in sample.contacts.iter().enumerate() {
+    for (k, (contact, about)) in sample.contacts.iter().zip(&info.contacts).enumerate() {
         values.extend(&contact.position[..dims]);
-        values.push(sample.normal_force[k]);
-        values.push(sample.h[k]);
+        values.extend([contact.x, contact.y]);
+        if let Some(i) = about.cam_coordinate {
+            values.push(sample.q[i]);
+        }
+        values.extend([
+            sample.normal_force[k],
+            contact.pressure_angle(),
+            contact.sliding_speed,
+            sample.h[k],
+        ]);
     }
     values.extend(
         info.coordinates
@@ -96,6 +116,8 @@ mod tests {
             "driven_convex",
             "spatial_arm",
             "double_pendulum",
+            "eccentric_roller",
+            "paper_rotating",
         ] {
             let model = models::by_name(name).unwrap();
             let info = model.info();
@@ -126,5 +148,21 @@ mod tests {
         let driven = header(models::by_name("driven_convex").unwrap().info());
         assert!(driven.iter().any(|c| c == "q1_drive"));
         assert!(!driven.iter().any(|c| c == "q2_drive" || c == "A_z"));
+        // A turning cam's angle is a column of its contact; a cam on the ground has none.
+        assert!(!driven.iter().any(|c| c == "A_cam_angle"));
+        let model = models::by_name("eccentric_roller").unwrap();
+        let columns = header(model.info());
+        let sample = model.sample(&model.assemble(0.1).unwrap()).unwrap();
+        let values = row(model.info(), &sample);
+        let at = |name: &str| columns.iter().position(|c| c == name).unwrap();
+        assert_eq!(values[at("roller_cam_angle")], values[at("cam_angle")]);
+        assert_eq!(values[at("roller_cam_angle")], 2.0, "20 rad/s for 0.1 s");
+        for column in [
+            "roller_cam_x",
+            "roller_pressure_angle",
+            "roller_sliding_speed",
+        ] {
+            assert!(values[at(column)] != 0.0, "{column}");
+        }
     }
 }

@@ -7,6 +7,9 @@
 //!   paper's figures 4 and 6);
 //! - `contact`: each contact's normal force (with the first lift-off time, if any) and
 //!   constraint residual against time;
+//! - `follower`: for a cam turned by a revolute joint, the follower's displacement, velocity
+//!   and acceleration and the pressure angle against the cam's angle, one curve per
+//!   revolution (the designer's s, v, a diagram as the dynamics produced it);
 //! - `comparison`: two runs side by side (the concave and the convex cam), on common
 //!   scales so that the difference between them shows at a glance.
 
@@ -230,7 +233,9 @@ pub fn contact(run: &RunView) -> Option<Figure> {
         panels.push((
             LINE_ROW,
             Panel::Lines(LinePanel {
-                title: format!("{name}: constraint residual h = f2(q) − f3(f1(q))"),
+                title: format!(
+                    "{name}: constraint residual h (the gap where the follower is off the cam)"
+                ),
                 x_label: TIME_AXIS.into(),
                 y_label: format!("{name}_h [m]"),
                 x_range: time_range(run.samples),
@@ -251,6 +256,119 @@ pub fn contact(run: &RunView) -> Option<Figure> {
     ))
 }
 
+/// Units of a coordinate's displacement, velocity and acceleration.
+fn motion_units(kind: CoordinateKind) -> [&'static str; 3] {
+    match kind {
+        CoordinateKind::Revolute => ["rad", "rad/s", "rad/s²"],
+        CoordinateKind::Prismatic => ["m", "m/s", "m/s²"],
+    }
+}
+
+/// `(cam angle in degrees within one turn, value)` split into one curve per revolution: a
+/// new curve starts where the wrapped angle jumps by more than half a turn.
+fn per_revolution(points: impl Iterator<Item = (f64, f64)>) -> Vec<Vec<(f64, f64)>> {
+    let mut curves: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut previous: Option<f64> = None;
+    for (angle, value) in points {
+        let wrapped = angle.to_degrees().rem_euclid(360.0);
+        if previous.is_none_or(|p| (wrapped - p).abs() > 180.0) {
+            curves.push(Vec::new());
+        }
+        previous = Some(wrapped);
+        if let Some(curve) = curves.last_mut() {
+            curve.push((wrapped, value));
+        }
+    }
+    curves
+}
+
+/// A panel of `value` against the cam angle, one curve per revolution coloured early → late.
+fn against_cam_angle(
+    run: &RunView,
+    cam: usize,
+    title: String,
+    y_label: String,
+    value: impl Fn(&Sample) -> f64,
+) -> Panel {
+    let curves = per_revolution(run.samples.iter().map(|s| (s.q[cam], value(s))));
+    let last = curves.len().saturating_sub(1).max(1) as f64;
+    let y_range = padded(data_range(curves.iter().flatten().map(|p| p.1)));
+    let series = curves
+        .into_iter()
+        .enumerate()
+        .map(|(j, points)| Series {
+            label: None,
+            color: time_color(j as f64 / last),
+            points,
+        })
+        .collect();
+    Panel::Lines(LinePanel {
+        title,
+        x_label: format!("{} within a turn [deg]", run.info.coordinates[cam].name),
+        y_label,
+        x_range: (0.0, 360.0),
+        y_range,
+        series,
+        zero_line: true,
+        markers: Vec::new(),
+    })
+}
+
+/// For each contact whose cam turns on a revolute joint: the follower's displacement,
+/// velocity and acceleration (its own joint's coordinate) and the pressure angle against the
+/// cam's angle. `None` when no cam turns or the follower's joint is unknown.
+pub fn follower(run: &RunView) -> Option<Figure> {
+    let geometry = run.geometry?;
+    let mut panels = Vec::new();
+    for (k, contact) in run.info.contacts.iter().enumerate() {
+        let (Some(cam), Some(f)) = (contact.cam_coordinate, geometry.follower_body(k)) else {
+            continue;
+        };
+        let Some(c) = run.info.coordinates.get(f) else {
+            continue;
+        };
+        let units = motion_units(c.kind);
+        let name = &contact.name;
+        let quantities: [(&str, String, fn(&Sample, usize) -> f64); 3] = [
+            ("displacement", c.name.clone(), |s, i| s.q[i]),
+            ("velocity", format!("{}_dot", c.name), |s, i| s.qd[i]),
+            ("acceleration", format!("{}_ddot", c.name), |s, i| s.qdd[i]),
+        ];
+        for ((what, column, value), unit) in quantities.into_iter().zip(units) {
+            panels.push((
+                LINE_ROW,
+                against_cam_angle(
+                    run,
+                    cam,
+                    format!("{name}: follower {what} ({})", c.name),
+                    format!("{column} [{unit}]"),
+                    move |s| value(s, f),
+                ),
+            ));
+        }
+        panels.push((
+            LINE_ROW,
+            against_cam_angle(
+                run,
+                cam,
+                format!("{name}: pressure angle (contact normal against the follower's motion)"),
+                format!("{name}_pressure_angle [deg]"),
+                move |s| s.contacts[k].pressure_angle().to_degrees(),
+            ),
+        ));
+    }
+    if panels.is_empty() {
+        return None;
+    }
+    Some(single_column(
+        format!(
+            "{}: follower against cam angle (a curve per turn, dark → light)",
+            run.label
+        ),
+        panels,
+    ))
+}
+
 /// Indices of `count` evenly spaced samples (first and last included).
 fn snapshot_indices(len: usize, count: usize) -> Vec<usize> {
     match len {
@@ -267,7 +385,23 @@ fn snapshot_indices(len: usize, count: usize) -> Vec<usize> {
     }
 }
 
-fn frame(geometry: &Geometry, sample: &Sample, color: RGBColor) -> Frame {
+/// The range of contact `k`'s cam-frame x over the run, widened by half its width (at
+/// least 2 cm) each side: where an explicit profile on a moving body is drawn.
+fn cam_x_range(samples: &[Sample], k: usize) -> (f64, f64) {
+    let (lo, hi) = data_range(
+        samples
+            .iter()
+            .filter_map(|s| s.contacts.get(k))
+            .map(|c| c.x),
+    );
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (-0.1, 0.1);
+    }
+    let pad = (0.5 * (hi - lo)).max(0.02);
+    (lo - pad, hi + pad)
+}
+
+fn frame(geometry: &Geometry, sample: &Sample, color: RGBColor, x_ranges: &[(f64, f64)]) -> Frame {
     let pose = geometry.pose(&sample.q);
     let project = |p: &[f64; 3]| geometry.plane.project(p);
     let origins: Vec<(f64, f64)> = pose.origins.iter().map(project).collect();
@@ -303,7 +437,18 @@ fn frame(geometry: &Geometry, sample: &Sample, color: RGBColor) -> Frame {
             .map(|c| project(&c.position))
             .collect(),
         coms,
+        cams: x_ranges
+            .iter()
+            .enumerate()
+            .filter_map(|(k, range)| geometry.cam_picture(&sample.q, k, *range))
+            .collect(),
     }
+}
+
+/// `x` with one decimal, and no minus sign on a value that rounds to zero.
+fn one_decimal(x: f64) -> String {
+    let text = format!("{x:.1}");
+    if text == "-0.0" { "0.0".into() } else { text }
 }
 
 /// A time for a legend: at most 3 decimals, no trailing zeros.
@@ -315,10 +460,16 @@ fn round_time(t: f64) -> String {
 fn frames(run: &RunView, geometry: &Geometry) -> Vec<Frame> {
     let indices = snapshot_indices(run.samples.len(), SNAPSHOTS);
     let last = indices.len().saturating_sub(1).max(1) as f64;
+    let x_ranges: Vec<(f64, f64)> = (0..run.info.n_contacts())
+        .map(|k| cam_x_range(run.samples, k))
+        .collect();
     indices
         .iter()
         .enumerate()
-        .map(|(j, &i)| frame(geometry, &run.samples[i], time_color(j as f64 / last)))
+        .map(|(j, &i)| {
+            let color = time_color(j as f64 / last);
+            frame(geometry, &run.samples[i], color, &x_ranges)
+        })
         .collect()
 }
 
@@ -329,6 +480,13 @@ fn frame_bounds(frames: &[Frame]) -> ((f64, f64), (f64, f64)) {
                 .iter()
                 .chain(&f.tips)
                 .chain(f.links.iter().flatten())
+                .chain(f.cams.iter().flat_map(|c| {
+                    c.outline
+                        .iter()
+                        .chain(&c.roller)
+                        .chain(&c.face)
+                        .chain(&c.base_circle)
+                }))
         })
     };
     let xs = data_range(points().map(|p| p.0));
@@ -358,6 +516,7 @@ fn mechanism_panel(run: &RunView, geometry: &Geometry, prefix: &str) -> Mechanis
         bounds: frame_bounds(&frames),
         cam: geometry.profile.as_ref().map(|(expr, _)| expr.clone()),
         frames,
+        legend: true,
     }
 }
 
@@ -365,11 +524,70 @@ fn mechanism_panel(run: &RunView, geometry: &Geometry, prefix: &str) -> Mechanis
 /// not available.
 pub fn snapshots(run: &RunView) -> Result<Figure, String> {
     let geometry = usable_geometry(run)?;
-    let panel = Panel::Mechanism(mechanism_panel(run, geometry, ""));
+    let panel = mechanism_panel(run, geometry, "");
+    if geometry.has_moving_cam() {
+        return Ok(snapshot_grid(run, panel));
+    }
     Ok(single_column(
         format!("{}: snapshots", run.label),
-        vec![(SNAPSHOT_ROW, panel)],
+        vec![(SNAPSHOT_ROW, Panel::Mechanism(panel))],
     ))
+}
+
+/// Snapshots per row of the grid drawn for a moving cam.
+const GRID_COLUMNS: usize = 3;
+
+/// One small panel per snapshot, on common scales, each titled with its time and the cam's
+/// angle: a turning cam drawn nine times over itself would hide the mechanism.
+fn snapshot_grid(run: &RunView, panel: MechanismPanel) -> Figure {
+    let angle = run
+        .info
+        .contacts
+        .first()
+        .and_then(|c| c.cam_coordinate)
+        .map(|i| (i, &run.info.coordinates[i].name));
+    let indices = snapshot_indices(run.samples.len(), SNAPSHOTS);
+    let mut panels: Vec<Panel> = panel
+        .frames
+        .into_iter()
+        .zip(indices)
+        .map(|(frame, i)| {
+            let sample = &run.samples[i];
+            let title = match angle {
+                Some((c, name)) => format!(
+                    "t = {} s, {name} = {}°",
+                    round_time(sample.t),
+                    one_decimal(sample.q[c].to_degrees())
+                ),
+                None => format!("t = {} s", round_time(sample.t)),
+            };
+            Panel::Mechanism(MechanismPanel {
+                title,
+                x_label: panel.x_label.clone(),
+                y_label: panel.y_label.clone(),
+                bounds: panel.bounds,
+                cam: panel.cam.clone(),
+                frames: vec![frame],
+                legend: false,
+            })
+        })
+        .collect();
+    let mut rows = Vec::new();
+    while !panels.is_empty() {
+        let rest = panels.split_off(GRID_COLUMNS.min(panels.len()));
+        rows.push(Row {
+            height: SNAPSHOT_ROW / 2 + 60,
+            panels: std::mem::replace(&mut panels, rest),
+        });
+    }
+    Figure {
+        title: format!(
+            "{}: snapshots (cam material grey, base circle thin, follower in colour)",
+            run.label
+        ),
+        width: COLUMN_WIDTH + 200,
+        rows,
+    }
 }
 
 fn usable_geometry<'a>(run: &RunView<'a>) -> Result<&'a Geometry, String> {
@@ -464,6 +682,25 @@ mod tests {
         assert_eq!(snapshot_indices(1001, 9).last(), Some(&1000));
         assert_eq!(snapshot_indices(3, 9), vec![0, 1, 2]);
         assert!(snapshot_indices(0, 9).is_empty());
+    }
+
+    #[test]
+    fn a_curve_per_revolution() {
+        // Three turns forwards in 0.1 rad steps: three curves, each within [0°, 360°).
+        let forwards = per_revolution((0..189).map(|i| (0.1 * i as f64, i as f64)));
+        assert_eq!(forwards.len(), 3);
+        assert!(
+            forwards
+                .iter()
+                .flatten()
+                .all(|p| (0.0..360.0).contains(&p.0))
+        );
+        assert_eq!(forwards.iter().map(Vec::len).sum::<usize>(), 189);
+        // Backwards: wraps the other way, a new curve at each turn too.
+        let backwards = per_revolution((0..189).map(|i| (-0.1 * i as f64, 0.0)));
+        assert_eq!(backwards.len(), 4);
+        assert_eq!(one_decimal(-0.04), "0.0");
+        assert_eq!(one_decimal(-0.06), "-0.1");
     }
 
     #[test]

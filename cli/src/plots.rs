@@ -6,6 +6,7 @@
 //! bitmap backend and encoded with `png`). Text is laid out and rasterised by ab_glyph from
 //! DejaVu Sans embedded in the binary, so no system font or font library is needed.
 
+use super::kinematics::CamPicture;
 use camchain_codegen::profile::Scalar;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -148,6 +149,8 @@ pub struct MechanismPanel {
     pub cam: Option<Scalar>,
     /// The snapshots, in time order.
     pub frames: Vec<Frame>,
+    /// Draw the legend column (the snapshots' times) beside the chart.
+    pub legend: bool,
 }
 
 /// The mechanism at one instant, in plane coordinates.
@@ -166,6 +169,8 @@ pub struct Frame {
     pub tips: Vec<(f64, f64)>,
     /// Centres of mass of bodies drawn only up to them (no child, no marker).
     pub coms: Vec<(f64, f64)>,
+    /// The cams and follower shapes where they are at this instant.
+    pub cams: Vec<CamPicture>,
 }
 
 /// What a figure is drawn for.
@@ -633,9 +638,10 @@ fn draw_mechanism<DB: DrawingBackend>(
 ) -> Result<(), PlotError> {
     let area = caption(area, &p.title)?;
     let (w, h) = area.dim_in_pixel();
-    let (area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_COLUMN));
+    let legend_width = if p.legend { LEGEND_COLUMN } else { 0 };
+    let (area, legend_area) = area.split_horizontally(w.saturating_sub(legend_width));
     let plot = (
-        w.saturating_sub(LEGEND_COLUMN + Y_LABEL_AREA + 2 * MARGIN),
+        w.saturating_sub(legend_width + Y_LABEL_AREA + 2 * MARGIN),
         h.saturating_sub(X_LABEL_AREA + 2 * MARGIN),
     );
     let ((x0, x1), (y0, y1)) = equal_scales(p.bounds, plot);
@@ -669,9 +675,65 @@ fn draw_mechanism<DB: DrawingBackend>(
         chart.draw_series(LineSeries::new(curve, CAM_EDGE.stroke_width(2)))?;
     }
     for frame in &p.frames {
+        for cam in &frame.cams {
+            draw_cam(&mut chart, cam, frame.color)?;
+        }
+    }
+    for frame in &p.frames {
         draw_frame(&mut chart, frame)?;
     }
-    draw_time_legend(&legend_area, p)
+    if p.legend {
+        draw_time_legend(&legend_area, p)?;
+    }
+    Ok(())
+}
+
+/// A cam where its body carries it (material filled, profile edge, base circle thin, centre
+/// as a small cross) and its follower's roller or flat face in the snapshot's colour.
+fn draw_cam<DB: DrawingBackend>(
+    chart: &mut PlaneChart<'_, DB>,
+    cam: &CamPicture,
+    color: RGBColor,
+) -> Result<(), PlotError> {
+    if !cam.material.is_empty() {
+        chart.draw_series(std::iter::once(Polygon::new(
+            cam.material.clone(),
+            CAM_FILL.filled(),
+        )))?;
+    }
+    if cam.closed {
+        chart.draw_series(std::iter::once(Polygon::new(
+            cam.outline.clone(),
+            CAM_FILL.filled(),
+        )))?;
+    }
+    if !cam.outline.is_empty() {
+        let mut edge = cam.outline.clone();
+        if cam.closed {
+            edge.push(cam.outline[0]);
+        }
+        chart.draw_series(LineSeries::new(edge, CAM_EDGE.stroke_width(2)))?;
+    }
+    if !cam.base_circle.is_empty() {
+        chart.draw_series(LineSeries::new(
+            cam.base_circle.clone(),
+            NEUTRAL.stroke_width(1),
+        ))?;
+    }
+    if cam.centre.0.is_finite() && cam.centre.1.is_finite() {
+        chart.draw_series(std::iter::once(Cross::new(
+            cam.centre,
+            4,
+            CAM_EDGE.stroke_width(1),
+        )))?;
+    }
+    if !cam.roller.is_empty() {
+        chart.draw_series(LineSeries::new(cam.roller.clone(), color.stroke_width(2)))?;
+    }
+    if !cam.face.is_empty() {
+        chart.draw_series(LineSeries::new(cam.face.clone(), color.stroke_width(3)))?;
+    }
+    Ok(())
 }
 
 /// The legend of a snapshot panel, beside the chart: the cam, then one line per snapshot.
@@ -682,7 +744,11 @@ fn draw_time_legend<DB: DrawingBackend>(
     let font = (FONT, LEGEND_SIZE).into_font();
     let row = |i: usize| (MARGIN + 10 + 24 * i as u32) as i32;
     let mut entries = 0;
-    if p.cam.is_some() {
+    let moving_cam = p
+        .frames
+        .iter()
+        .any(|f| f.cams.iter().any(|c| !c.outline.is_empty()));
+    if p.cam.is_some() || moving_cam {
         let y = row(0);
         area.draw(&Rectangle::new(
             [(4, y - 7), (28, y + 7)],

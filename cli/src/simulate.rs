@@ -322,6 +322,9 @@ fn draw_run(
     if let Some(figure) = figures::contact(&run) {
         figures.push((figure, "contact"));
     }
+    if let Some(figure) = figures::follower(&run) {
+        figures.push((figure, "follower"));
+    }
     let mut paths = Vec::new();
     for (figure, stem) in &figures {
         paths.extend(figure.save(dir, stem).map_err(|e| e.to_string())?);

@@ -1,7 +1,8 @@
 //! The short table printed after each run.
 //!
-//! It gives the range and max |·| of every coordinate, the range of each contact's position
-//! and normal force, each drive's load, max |h|, how well `energy + dissipated − driven
+//! It gives the range and max |·| of every coordinate, the range of each contact's position,
+//! normal force, pressure angle and sliding speed, each drive's load, max |h|, where each
+//! contact's pressure angle is largest (in degrees, with the cam's angle there), how well `energy + dissipated − driven
 //! work` stayed constant, the integrator's work (steps, rejected steps, right-hand sides,
 //! re-partitions) and the wall time, and warns when a normal force becomes negative: a
 //! real, one-sided follower would lift off the cam there.
@@ -9,7 +10,10 @@
 use super::args::integrator_name;
 use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
-use camchain_runtime::{CoordinateKind, IntegratorKind, ModelInfo, Sample, SimSettings, Stats};
+use camchain_runtime::{
+    ContactInfo, CoordinateKind, FollowerKind, IntegratorKind, ModelInfo, ProfileKind, Sample,
+    SimSettings, Stats,
+};
 use std::fmt::Write;
 use std::time::Duration;
 
@@ -140,6 +144,10 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
         }
         let (lo, hi) = range(samples, |s| s.normal_force[k]);
         rows.push((format!("{name}_normal_force [N]"), lo, hi));
+        let (lo, hi) = range(samples, |s| s.contacts[k].pressure_angle());
+        rows.push((format!("{name}_pressure_angle [rad]"), lo, hi));
+        let (lo, hi) = range(samples, |s| s.contacts[k].sliding_speed);
+        rows.push((format!("{name}_sliding_speed [m/s]"), lo, hi));
     }
     for (i, c) in info.coordinates.iter().enumerate() {
         if c.driven {
@@ -148,6 +156,57 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
         }
     }
     rows
+}
+
+/// What a contact is, in words: `roller on a polar profile turned by cam_angle`.
+pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
+    let follower = match contact.follower {
+        FollowerKind::Knife => "knife edge",
+        FollowerKind::Roller => "roller",
+        FollowerKind::Flat => "flat face",
+    };
+    let profile = match contact.profile {
+        ProfileKind::Explicit => "an explicit profile y = f(x)",
+        ProfileKind::Polar => "a polar profile r(θ)",
+        ProfileKind::Parametric => "a parametric profile (x(s), y(s))",
+    };
+    let turned = contact
+        .cam_coordinate
+        .and_then(|i| info.coordinates.get(i))
+        .map_or_else(String::new, |c| format!(" turned by {}", c.name));
+    format!("{follower} on {profile}{turned}")
+}
+
+/// One line per contact: its kind and where its pressure angle is largest (degrees, the
+/// designer's unit), over the samples in contact.
+fn contact_lines(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for (k, contact) in info.contacts.iter().enumerate() {
+        let steepest = samples
+            .iter()
+            .filter(|s| !s.dependent.is_empty())
+            .map(|s| (s, s.contacts[k].pressure_angle().abs()))
+            .filter(|(_, a)| a.is_finite())
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let mut line = format!("{}: {}", contact.name, contact_kind(info, contact));
+        if let Some((s, angle)) = steepest {
+            let _ = write!(
+                line,
+                "; largest pressure angle {:.2}° at t = {} s",
+                angle.to_degrees(),
+                number(s.t)
+            );
+            if let Some(i) = contact.cam_coordinate {
+                let _ = write!(
+                    line,
+                    " (cam angle {:.1}°)",
+                    s.q[i].to_degrees().rem_euclid(360.0)
+                );
+            }
+        }
+        lines.push(line);
+    }
+    lines
 }
 
 /// The scale the energy drift is measured against: the largest kinetic energy plus the
@@ -208,6 +267,9 @@ pub fn render(report: &RunReport) -> String {
                 number(hi),
                 number(lo.abs().max(hi.abs()))
             );
+        }
+        for line in contact_lines(info, samples) {
+            let _ = writeln!(text, "  {line}");
         }
         let mut checks = Vec::new();
         for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
@@ -422,7 +484,8 @@ pub fn result_warnings(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
     let Some(first) = samples.first() else {
         return out;
     };
-    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
+    for (k, contact) in info.contacts.iter().enumerate() {
+        let name = &contact.name;
         let in_contact: Vec<&Sample> = samples.iter().filter(|s| !s.dependent.is_empty()).collect();
         let negative = in_contact
             .iter()
@@ -433,18 +496,32 @@ pub fn result_warnings(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
         if at_start || share > 0.5 {
             out.push(format!(
                 "the normal force on {name} is negative {} ({:.0} % of the samples): the cam \
-                 pulls the follower. Check which side of the profile the material is on: the \
-                 cam lies on the side y < f(x) of its frame and pushes towards +y",
+                 pulls the follower. Check which side of the profile the material is on: {}",
                 if at_start {
                     "from the start"
                 } else {
                     "for most of the run"
                 },
-                100.0 * share
+                100.0 * share,
+                material_side(contact.profile)
             ));
         }
     }
     out
+}
+
+/// Where a profile kind's material is, for the warning about a pulling cam.
+fn material_side(profile: ProfileKind) -> &'static str {
+    match profile {
+        ProfileKind::Explicit => {
+            "the cam lies on the side y < f(x) of its frame and pushes towards +y"
+        }
+        ProfileKind::Polar => "the cam is the region r < r(θ) of its frame and pushes outwards",
+        ProfileKind::Parametric => {
+            "the cam lies on the left of its curve as s increases (inside a curve traced \
+             counterclockwise) and pushes to the right"
+        }
+    }
 }
 
 #[cfg(test)]

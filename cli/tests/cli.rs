@@ -10,10 +10,12 @@ mod common;
 use common::{camchain, scratch};
 use std::path::Path;
 
-const PAPER_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_normal_force,\
-                            A_h,energy,dissipated,driven_work";
-const DRIVEN_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_normal_force,\
-                             A_h,q1_drive,energy,dissipated,driven_work";
+const PAPER_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_cam_x,A_cam_y,\
+                            A_normal_force,A_pressure_angle,A_sliding_speed,A_h,energy,\
+                            dissipated,driven_work";
+const DRIVEN_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_cam_x,A_cam_y,\
+                             A_normal_force,A_pressure_angle,A_sliding_speed,A_h,q1_drive,\
+                             energy,dissipated,driven_work";
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
@@ -60,13 +62,21 @@ fn expected(info: &camchain_runtime::ModelInfo, sample: &Sample, column: &str) -
             return sample.drive[i];
         }
     }
-    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
-        let position = &sample.contacts[k].position;
-        match column.strip_prefix(name.as_str()) {
+    for (k, contact) in info.contacts.iter().enumerate() {
+        let geometry = &sample.contacts[k];
+        let position = &geometry.position;
+        match column.strip_prefix(contact.name.as_str()) {
             Some("_x") => return position[0],
             Some("_y") => return position[1],
             Some("_z") => return position[2],
+            Some("_cam_x") => return geometry.x,
+            Some("_cam_y") => return geometry.y,
+            Some("_cam_angle") => {
+                return sample.q[contact.cam_coordinate.expect("a turning cam")];
+            }
             Some("_normal_force") => return sample.normal_force[k],
+            Some("_pressure_angle") => return geometry.pressure_angle(),
+            Some("_sliding_speed") => return geometry.sliding_speed,
             Some("_h") => return sample.h[k],
             _ => {}
         }
@@ -256,6 +266,45 @@ fn the_default_run_writes_csv_and_figures_of_both_cams() {
     for line in ["max |·|", "max |A_h|", "right-hand sides", "wall time"] {
         assert!(stdout.contains(line), "summary line {line}: {stdout}");
     }
+}
+
+#[test]
+fn a_turning_cam_writes_its_contact_columns_and_the_follower_figure() {
+    let dir = scratch("turning-cam");
+    let out = camchain(
+        &dir,
+        &[
+            "simulate",
+            "eccentric_roller",
+            "--t-end",
+            "0.4",
+            "--out",
+            "runs",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let run = dir.join("runs/eccentric_roller");
+    let csv = std::fs::read_to_string(run.join("eccentric_roller.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.contains(
+            "roller_x,roller_y,roller_cam_x,roller_cam_y,roller_cam_angle,roller_normal_force,\
+             roller_pressure_angle,roller_sliding_speed,roller_h"
+        ),
+        "{header}"
+    );
+    let model = models::by_name("eccentric_roller").unwrap();
+    assert_csv_is_the_library_run(&csv, model, &settings_with_t_end(model, 0.4));
+    for figure in ["snapshots", "contact", "follower"] {
+        assert_png(&run.join(format!("{figure}.png")));
+    }
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains(
+            "roller: roller on a polar profile r(θ) turned by cam_angle; largest pressure angle"
+        ),
+        "{stdout}"
+    );
 }
 
 fn assert_png(path: &Path) {

@@ -125,6 +125,59 @@ fn in_line_roller_on_an_eccentric_disc_follows_the_closed_form() {
     );
 }
 
+/// The outputs a cam designer reads, against the geometry of the eccentric disc: the contact
+/// point in the cam frame (which turns with the camshaft; its axes are the ground's y and −x
+/// at θ = 0), the pressure angle (for an in-line roller sin φ = e sin θ / (R + ρ), the
+/// normal running through the disc's centre) and the sliding speed (the flat face does not
+/// move sideways: the cam's material slides under it at ω times the face's height; the
+/// roller's rim against a cam point C: t·(ṡ ŷ − ω ẑ × C)).
+#[test]
+fn contact_outputs_follow_the_disc_geometry() {
+    for (name, roller) in [("eccentric_flat", false), ("eccentric_roller", true)] {
+        let model = models::by_name(name).expect("built in");
+        let trajectory = three_revolutions(model);
+        for s in &trajectory.samples {
+            let (theta, lift, lift_dot) = (s.q[0], s.q[1], s.qd[1]);
+            let g = &s.contacts[0];
+            // The cam-frame point turned by θ is the ground point. Rounding of ~0.05 m
+            // lengths: 1e-15 m; 1e-14 leaves room for the rotation's few operations.
+            let (sn, cs) = theta.sin_cos();
+            let (x_axis, y_axis) = ([-sn, cs], [-cs, -sn]);
+            for a in 0..2 {
+                let turned = g.x * x_axis[a] + g.y * y_axis[a];
+                assert!((turned - g.position[a]).abs() < 1e-14, "{name} t = {}", s.t);
+            }
+            let centre = [-E * sn, E * cs];
+            let (pressure, sliding) = if roller {
+                // The normal from the disc's centre to the roller's centre (0, s).
+                let n = [-centre[0] / (R + RHO), (lift - centre[1]) / (R + RHO)];
+                let c = [centre[0] + R * n[0], centre[1] + R * n[1]];
+                let t = [-n[1], n[0]];
+                let relative = [OMEGA * c[1], lift_dot - OMEGA * c[0]];
+                (
+                    (E * (-sn) / (R + RHO)).asin(),
+                    t[0] * relative[0] + t[1] * relative[1],
+                )
+            } else {
+                (0.0, OMEGA * lift)
+            };
+            // Angles from unit vectors of rounding 1e-16: 1e-12 rad; speeds ~1 m/s: 1e-12.
+            assert!(
+                (g.pressure_angle().abs() - pressure.abs()).abs() < 1e-12,
+                "{name} t = {}: pressure angle {} vs {pressure}",
+                s.t,
+                g.pressure_angle()
+            );
+            assert!(
+                (g.sliding_speed.abs() - sliding.abs()).abs() < 1e-12,
+                "{name} t = {}: sliding speed {} vs {sliding}",
+                s.t,
+                g.sliding_speed
+            );
+        }
+    }
+}
+
 #[test]
 fn a_roller_moves_like_a_knife_edge_on_the_offset_curve() {
     // The same model with the roller replaced by a knife edge on the disc of radius R + ρ

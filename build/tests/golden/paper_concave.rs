@@ -1098,7 +1098,7 @@ impl rt::Dynamics for Model {
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
         // outputs: the follower's direction of motion
-        let contact0_direction_0_t2 = (contact0_direction_0_t1 * contact0_direction_0_t1
+        let contact0_direction_1_t2 = (contact0_direction_0_t1 * contact0_direction_0_t1
             + contact0_direction_1_t1 * contact0_direction_1_t1)
             .sqrt();
         out[0].position[0] = a_x;
@@ -1113,8 +1113,8 @@ impl rt::Dynamics for Model {
         out[0].axis[0] = 0.0;
         out[0].axis[1] = 0.0;
         out[0].axis[2] = 1.0;
-        out[0].direction[0] = -contact0_direction_0_t1 / contact0_direction_0_t2;
-        out[0].direction[1] = contact0_direction_1_t1 / contact0_direction_0_t2;
+        out[0].direction[0] = -contact0_direction_0_t1 / contact0_direction_1_t2;
+        out[0].direction[1] = contact0_direction_1_t1 / contact0_direction_1_t2;
         out[0].direction[2] = 0.0;
         out[0].x = a_x;
         out[0].y = a_y;
@@ -1511,7 +1511,7 @@ fn contact_kinematics_0(
     let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
         - q4_dot * a_segment_q4_y;
     // outputs: the follower's direction of motion
-    let geometry_direction_0_t2 = (geometry_direction_0_t1 * geometry_direction_0_t1
+    let geometry_direction_1_t2 = (geometry_direction_0_t1 * geometry_direction_0_t1
         + geometry_direction_1_t1 * geometry_direction_1_t1)
         .sqrt();
     out.geometry.position[0] = a_x;
@@ -1526,8 +1526,8 @@ fn contact_kinematics_0(
     out.geometry.axis[0] = 0.0;
     out.geometry.axis[1] = 0.0;
     out.geometry.axis[2] = 1.0;
-    out.geometry.direction[0] = -geometry_direction_0_t1 / geometry_direction_0_t2;
-    out.geometry.direction[1] = geometry_direction_1_t1 / geometry_direction_0_t2;
+    out.geometry.direction[0] = -geometry_direction_0_t1 / geometry_direction_1_t2;
+    out.geometry.direction[1] = geometry_direction_1_t1 / geometry_direction_1_t2;
     out.geometry.direction[2] = 0.0;
     out.geometry.x = a_x;
     out.geometry.y = a_y;
