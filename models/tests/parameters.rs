@@ -288,17 +288,17 @@ fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {
         (
             "rho",
             0.2,
-            "undercut.ron:26:48: contacts[0].follower.radius: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
+            "undercut.ron:26:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
         ),
         (
             "depth",
             50.0,
-            "undercut.ron:26:48: contacts[0].follower.radius: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
+            "undercut.ron:26:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
         ),
         (
             "base",
             0.005,
-            "undercut.ron:27:30: contacts[1].polar: the polar radius must be positive over the cam, but r(theta = 2.095418)",
+            "undercut.ron:27:30: contacts[1].polar: contact `K`: the polar radius must be positive over the cam, but r(theta = 2.095418)",
         ),
     ];
     let text = std::fs::read_to_string(format!(

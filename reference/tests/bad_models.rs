@@ -1,6 +1,10 @@
-//! The bad-model corpus: every file of `tests/bad_models/` is a valid model
-//! (`models/paper_concave.ron`, `driven_concave.ron` or `spatial_arm.ron`) with one defect,
-//! named in its first comment line. The loader the build uses
+//! The bad-model corpus: every file of `tests/bad_models/` is a valid model with one defect,
+//! named in its first comment line; its second says which model it derives from:
+//! `models/paper_concave.ron`, `driven_concave.ron`, `spatial_arm.ron`, or one of the models
+//! of cams on moving bodies, `eccentric_roller.ron`, `eccentric_flat.ron`, `rocker_roller.ron`,
+//! `camshaft_flywheel.ron` and `paper_rotating.ron` (a defect that needs two contacts adds a
+//! second roller under the cam of `eccentric_roller` or `camshaft_flywheel`, otherwise valid).
+//! The loader the build uses
 //! (`camchain_codegen::generate_file`) must reject each with an error that names the file,
 //! the line and column of the defect, the dotted field path and the problem; the numeric
 //! reference (`NumericModel::load`, what `camchain simulate file.ron` runs) must reject it
@@ -78,6 +82,38 @@ const CASES: &[Case] = &[
         "contacts[0].frame.y_axis",
         "must be orthogonal",
     ),
+    // `"disc"` after `cam_body:`.
+    case(
+        "cam_body_unknown.ron",
+        122,
+        23,
+        "contacts[0].cam_body",
+        "unknown body `disc`",
+    ),
+    // `"type"` after the contact's `name:`.
+    case(
+        "contact_name_keyword.ron",
+        120,
+        19,
+        "contacts[0].name",
+        "contact name `type` is not a valid Rust identifier",
+    ),
+    // `"roller"` after the contact's `marker:` (the contact is named after its marker).
+    case(
+        "contact_name_taken.ron",
+        45,
+        21,
+        "contacts[0].marker",
+        "clashes with coordinate `roller_parameter`",
+    ),
+    // `"roller"`, the second contact's name.
+    case(
+        "contact_names_differ_in_case.ron",
+        65,
+        19,
+        "contacts[1].name",
+        "differs from `Roller` (contacts[0]) only in letter case",
+    ),
     // `"B"` after `marker:`.
     case(
         "contact_on_unknown_marker.ron",
@@ -85,6 +121,22 @@ const CASES: &[Case] = &[
         18,
         "contacts[0].marker",
         "unknown marker `B`",
+    ),
+    // The follower's `coordinate: "cam_angle_dot"`.
+    case(
+        "coordinate_named_like_a_velocity.ron",
+        41,
+        29,
+        "bodies[1].joint.coordinate",
+        "taken by the velocity of coordinate `cam_angle`",
+    ),
+    // The rocker's `coordinate: "t"`.
+    case(
+        "coordinate_named_t.ron",
+        35,
+        29,
+        "bodies[1].joint.coordinate",
+        "`t` already means something in expressions",
     ),
     // The second `"body3"` name (the fourth body's).
     case(
@@ -94,6 +146,14 @@ const CASES: &[Case] = &[
         "bodies[3].name",
         "duplicate body name `body3`",
     ),
+    // The second `"cam_follower"`.
+    case(
+        "duplicate_contact_name.ron",
+        65,
+        19,
+        "contacts[1].name",
+        "duplicate contact name `cam_follower` (contacts[0])",
+    ),
     // body4's `coordinate: "q3"`.
     case(
         "duplicate_coordinate.ron",
@@ -101,6 +161,30 @@ const CASES: &[Case] = &[
         29,
         "bodies[3].joint.coordinate",
         "duplicate coordinate `q3`",
+    ),
+    // The normal `(0.0, -1.0, 0.1)`.
+    case(
+        "flat_face_normal_out_of_plane.ron",
+        44,
+        36,
+        "contacts[0].follower.normal",
+        "must lie in the cam plane",
+    ),
+    // `Flat(` after `follower:`.
+    case(
+        "flat_face_on_hollow_profile.ron",
+        44,
+        23,
+        "contacts[0].follower",
+        "a flat face needs a strictly convex profile, but at theta = 3.141593 the profile is hollow",
+    ),
+    // `Flat(` after `follower:`.
+    case(
+        "flat_face_tilted_camshaft.ron",
+        44,
+        23,
+        "contacts[0].follower",
+        "but joint `cam_angle` between them turns about",
     ),
     // `[]` after `bodies:`.
     case("empty_body_list.ron", 7, 13, "bodies", "at least one body"),
@@ -179,6 +263,30 @@ const CASES: &[Case] = &[
             "not a valid Rust identifier",
         )
     },
+    // `"-0.01*cam_angle_dot"` after `load:`.
+    case(
+        "load_on_prescribed_joint.ron",
+        24,
+        114,
+        "bodies[0].joint.load",
+        "a prescribed joint cannot also have a load",
+    ),
+    // `cam_speed` inside the load's string.
+    case(
+        "load_unknown_variable.ron",
+        29,
+        38,
+        "bodies[0].joint.load",
+        "unknown name `cam_speed`: a load is an expression of the time `t`, the coordinates (cam_angle, lift)",
+    ),
+    // The `)` right after `cam_angle_dot/`, where the divisor is missing.
+    case(
+        "load_unparsable.ron",
+        29,
+        52,
+        "bodies[0].joint.load",
+        "not a valid expression",
+    ),
     // `"body5"` after `body:`.
     case(
         "marker_on_unknown_body.ron",
@@ -267,6 +375,86 @@ const CASES: &[Case] = &[
         "simulation.t_end",
         "t_end must be positive",
     ),
+    // The second `"k2"`.
+    case(
+        "parameter_duplicate.ron",
+        32,
+        16,
+        "parameters[19].name",
+        "duplicate parameter name `k2`",
+    ),
+    // `"l1/(l2 - 0.1)"`: 0.3/0.
+    case(
+        "parameter_expression_infinite.ron",
+        45,
+        19,
+        "bodies[0].com[0]",
+        "must be finite, got inf",
+    ),
+    // The end of `"l1/"`, where the divisor is missing.
+    case(
+        "parameter_expression_syntax.ron",
+        45,
+        23,
+        "bodies[0].com[0]",
+        "not a valid expression",
+    ),
+    // `"k2"`, the first component of body3's axis.
+    case(
+        "parameter_in_axis.ron",
+        76,
+        24,
+        "bodies[2].joint.axis[0]",
+        "this field must be constant, but k2 is read at run time",
+    ),
+    // `-1.0` after `max:`.
+    case(
+        "parameter_min_above_max.ron",
+        37,
+        65,
+        "parameters[24].max",
+        "the maximum -1 is below the minimum 1",
+    ),
+    // `"q3"`, the last parameter's name.
+    case(
+        "parameter_named_like_coordinate.ron",
+        37,
+        16,
+        "parameters[24].name",
+        "is taken by coordinate `q3`",
+    ),
+    // `"m2 - 1.0"` = -0.5.
+    case(
+        "parameter_negative_mass.ron",
+        57,
+        19,
+        "bodies[1].mass",
+        "mass must be positive and finite, got -0.5",
+    ),
+    // `"x"`, the last parameter's name.
+    case(
+        "parameter_reserved_name.ron",
+        37,
+        16,
+        "parameters[24].name",
+        "`x` already means something in expressions",
+    ),
+    // `m2` inside the string after `mass:`.
+    case(
+        "parameter_undeclared.ron",
+        24,
+        20,
+        "bodies[1].mass",
+        "unknown name `m2`: the model declares no parameters",
+    ),
+    // `-40.0`, k3's value.
+    case(
+        "parameter_value_below_min.ron",
+        32,
+        29,
+        "parameters[19].value",
+        "its value is below the minimum 0 declared for `k3`",
+    ),
     // body1's `parent: "body4"`.
     case(
         "parent_cycle.ron",
@@ -274,6 +462,22 @@ const CASES: &[Case] = &[
         21,
         "bodies[0].parent",
         "cycle: body1 -> body4 -> body3 -> body2 -> body1",
+    ),
+    // The opening quote of `"r0 + h*theta/(2.0*PI)"`.
+    case(
+        "polar_not_closed.ron",
+        49,
+        20,
+        "contacts[0].polar",
+        "a polar profile must close on itself",
+    ),
+    // The opening quote of `"r0 - 3.0*h*(1.0 - theta.cos())"`.
+    case(
+        "polar_radius_not_positive.ron",
+        49,
+        20,
+        "contacts[0].polar",
+        "the polar radius must be positive over the cam, but r(theta = 1.8",
     ),
     // `loop` inside the drive's string.
     case(
@@ -371,6 +575,54 @@ const CASES: &[Case] = &[
         "contacts[0].profile",
         "the only variable allowed here is `x`",
     ),
+    // `1.5` after `restitution:`.
+    case(
+        "restitution_above_one.ron",
+        59,
+        103,
+        "simulation.restitution",
+        "restitution must be in [0e0, 1e0], got 1.5e0",
+    ),
+    // `-0.5` after `restitution:`.
+    case(
+        "restitution_negative.ron",
+        59,
+        103,
+        "simulation.restitution",
+        "restitution must be in [0e0, 1e0], got -5e-1",
+    ),
+    // `0.5` after `restitution:`.
+    case(
+        "restitution_two_contacts.ron",
+        79,
+        103,
+        "simulation.restitution",
+        "needs exactly one contact; this model has 2",
+    ),
+    // `0.5` after `restitution:`.
+    case(
+        "restitution_with_rk4.ron",
+        59,
+        100,
+        "simulation.restitution",
+        "needs an adaptive integrator",
+    ),
+    // `"rho"` in `Roller(radius: "rho")`.
+    case(
+        "roller_undercut.ron",
+        46,
+        38,
+        "contacts[0].follower.radius",
+        "is larger than the profile's hollow at theta = 3.926991, whose radius of curvature is 4.566038e-3 m",
+    ),
+    // `"A"` after `marker:`, the contact that lacks its range.
+    case(
+        "roller_without_range.ron",
+        120,
+        21,
+        "contacts[0].marker",
+        "a roller on an explicit profile needs `range: (from, to)`",
+    ),
     // The `]` closing body2's anchor.
     case(
         "syntax_mismatched_bracket.ron",
@@ -458,86 +710,6 @@ const CASES: &[Case] = &[
         19,
         "bodies[1].mass",
         "Expected a number or a string with an expression of the parameters",
-    ),
-    // `m2` inside the string after `mass:`.
-    case(
-        "parameter_undeclared.ron",
-        24,
-        20,
-        "bodies[1].mass",
-        "unknown name `m2`: the model declares no parameters",
-    ),
-    // `-40.0`, k3's value.
-    case(
-        "parameter_value_below_min.ron",
-        32,
-        29,
-        "parameters[19].value",
-        "its value is below the minimum 0 declared for `k3`",
-    ),
-    // The second `"k2"`.
-    case(
-        "parameter_duplicate.ron",
-        32,
-        16,
-        "parameters[19].name",
-        "duplicate parameter name `k2`",
-    ),
-    // `"x"`, the last parameter's name.
-    case(
-        "parameter_reserved_name.ron",
-        37,
-        16,
-        "parameters[24].name",
-        "`x` already means something in expressions",
-    ),
-    // `-1.0` after `max:`.
-    case(
-        "parameter_min_above_max.ron",
-        37,
-        65,
-        "parameters[24].max",
-        "the maximum -1 is below the minimum 1",
-    ),
-    // `"k2"`, the first component of body3's axis.
-    case(
-        "parameter_in_axis.ron",
-        76,
-        24,
-        "bodies[2].joint.axis[0]",
-        "this field must be constant, but k2 is read at run time",
-    ),
-    // `"q3"`, the last parameter's name.
-    case(
-        "parameter_named_like_coordinate.ron",
-        37,
-        16,
-        "parameters[24].name",
-        "is taken by coordinate `q3`",
-    ),
-    // The end of `"l1/"`, where the divisor is missing.
-    case(
-        "parameter_expression_syntax.ron",
-        45,
-        23,
-        "bodies[0].com[0]",
-        "not a valid expression",
-    ),
-    // `"l1/(l2 - 0.1)"`: 0.3/0.
-    case(
-        "parameter_expression_infinite.ron",
-        45,
-        19,
-        "bodies[0].com[0]",
-        "must be finite, got inf",
-    ),
-    // `"m2 - 1.0"` = -0.5.
-    case(
-        "parameter_negative_mass.ron",
-        57,
-        19,
-        "bodies[1].mass",
-        "mass must be positive and finite, got -0.5",
     ),
     // `colour`.
     case(

@@ -132,6 +132,17 @@ pub const FLAT_CURVATURE: f64 = 1e-6;
 /// it when a radius or a profile depends on run-time parameters. The error says where to
 /// report it and what is wrong, with the place on the profile and the numbers.
 pub fn followable(
+    contact: &str,
+    variable: &str,
+    shape: Shape,
+    samples: &[ProfileSample],
+) -> Result<(), (Place, String)> {
+    followable_unnamed(variable, shape, samples)
+        .map_err(|(place, message)| (place, format!("contact `{contact}`: {message}")))
+}
+
+/// [`followable`] without the contact's name in the message.
+fn followable_unnamed(
     variable: &str,
     shape: Shape,
     samples: &[ProfileSample],
@@ -201,6 +212,7 @@ pub fn followable(
 /// [`Place::Profile`] in that order): what generated `check` functions call.
 pub fn followable_located(
     places: [crate::parameters::Location; 3],
+    contact: &str,
     variable: &str,
     shape: Shape,
     range: (f64, f64),
@@ -217,7 +229,7 @@ pub fn followable_located(
             }
         })
         .collect();
-    followable(variable, shape, &samples).map_err(|(place, message)| {
+    followable(contact, variable, shape, &samples).map_err(|(place, message)| {
         let at = match place {
             Place::Radius => places[0],
             Place::Follower => places[1],

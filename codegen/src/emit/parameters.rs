@@ -418,8 +418,9 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
                 let places: Vec<String> = at.iter().map(|a| location_from(a, file)).collect();
                 let _ = writeln!(
                     statements,
-                    "rt::contact::followable_located([{}], {:?}, {shape}, ({}, {}), |s| {}(p, s))?;",
+                    "rt::contact::followable_located([{}], {:?}, {:?}, {shape}, ({}, {}), |s| {}(p, s))?;",
                     places.join(", "),
+                    contact.name,
                     contact.profile.variable(),
                     lit(a),
                     lit(b),

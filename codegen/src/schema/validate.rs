@@ -331,8 +331,28 @@ impl<'a> Table<'a> {
             .chain(&rates)
             .map(String::as_str)
             .collect();
-        let parsed = parse_expression_with(source, Some("t"), &names)
-            .map_err(|e| self.at.error_in_string(field, e.offset, e.message))?;
+        let parsed = parse_expression_with(source, Some("t"), &names).map_err(|e| {
+            let message = match e.message.strip_prefix("unknown name `") {
+                // The parser calls every name it was given a parameter.
+                Some(rest) if e.message.contains("the only variable allowed here is `t`") => {
+                    let written = rest.split('`').next().unwrap_or_default();
+                    let parameters = if self.names.is_empty() {
+                        "the model declares no parameters".to_string()
+                    } else {
+                        format!("the parameters are {}", self.names.join(", "))
+                    };
+                    format!(
+                        "unknown name `{written}`: a load is an expression of the time `t`, the \
+                         coordinates ({}) and their velocities ({}); the constants are PI and \
+                         E; {parameters}",
+                        coordinates.join(", "),
+                        rates.join(", ")
+                    )
+                }
+                _ => e.message,
+            };
+            self.at.error_in_string(field, e.offset, message)
+        })?;
         let folded = parsed.resolve(&self.values, &|i| i < np && self.constant[i]);
         if folded.parameters().iter().any(|&i| i < np) {
             self.symbolic.borrow_mut().insert(key, folded);
@@ -646,6 +666,7 @@ impl<'f> BodyTree<'f> {
             }),
             "coordinate",
         )?;
+        coordinate_names_free(bodies, at)?;
         let parents = bodies
             .iter()
             .enumerate()
@@ -681,6 +702,35 @@ impl<'f> BodyTree<'f> {
         let i = lookup(at, field, &self.by_name, name, "body")?;
         Ok(self.sorted_index[i])
     }
+}
+
+/// Coordinates are variables of the generated code and of joint loads beside the time `t`,
+/// the velocities `<coordinate>_dot` and the build's own `__` names: none may be called so.
+fn coordinate_names_free(bodies: &[raw::Body], at: &Locator) -> Checked<()> {
+    let names: Vec<&str> = bodies.iter().map(|b| b.joint.coordinate.as_str()).collect();
+    for (i, &name) in names.iter().enumerate() {
+        let field = format!("bodies[{i}].joint.coordinate");
+        if ["t", "PI", "E"].contains(&name) || name.starts_with("__") {
+            return Err(at.error(
+                &field,
+                format!(
+                    "`{name}` already means something in expressions (the time t and the \
+                     constants PI and E in a joint's load; names starting with `__` are \
+                     reserved): choose another coordinate name"
+                ),
+            ));
+        }
+        if let Some(base) = name.strip_suffix("_dot").filter(|b| names.contains(b)) {
+            return Err(at.error(
+                &field,
+                format!(
+                    "`{name}` is taken by the velocity of coordinate `{base}` (`{base}_dot` in a \
+                     joint's load and in the generated code): choose another coordinate name"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn body_names<'f>(bodies: &'f [raw::Body], at: &Locator) -> Checked<HashMap<&'f str, usize>> {

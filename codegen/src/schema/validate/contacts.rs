@@ -29,6 +29,7 @@ pub(super) fn contacts(
         .map(|(i, m)| (m.name.as_str(), i))
         .collect();
     let mut names: HashMap<&str, usize> = HashMap::new();
+    let mut spelled: HashMap<String, (usize, &str)> = HashMap::new();
     for (i, c) in list.iter().enumerate() {
         let (field, name) = match &c.name {
             Some(name) => (format!("contacts[{i}].name"), name.as_str()),
@@ -46,6 +47,18 @@ pub(super) fn contacts(
             };
             return Err(at.error(&field, message));
         }
+        let spelling = generated_spelling(name);
+        if let Some((first, other)) = spelled.insert(spelling.clone(), (i, name)) {
+            return Err(at.error(
+                &field,
+                format!(
+                    "contact name `{name}` differs from `{other}` (contacts[{first}]) only in \
+                     letter case or underscores: the generated code spells both `{spelling}`; \
+                     choose another contact name"
+                ),
+            ));
+        }
+        name_free(cx, &field, name, c.name.is_some(), bodies)?;
     }
     list.iter()
         .enumerate()
@@ -61,6 +74,42 @@ pub(super) fn contacts(
             Ok(contact)
         })
         .collect()
+}
+
+/// How the generated code spells a contact's name in its function names: lower case, with
+/// runs of `_` as one and none at either end (`emit::parameters::value_name`).
+fn generated_spelling(name: &str) -> String {
+    name.to_ascii_lowercase()
+        .split('_')
+        .filter(|part| !part.is_empty())
+        .collect::<Vec<_>>()
+        .join("_")
+}
+
+/// The build names the point of contact `name` on its profile `<name>_parameter`, among the
+/// variables of the coordinates and the run-time parameters: no coordinate or parameter may
+/// be called so (the two would be one variable).
+fn name_free(cx: &Context, field: &str, name: &str, named: bool, bodies: &[Body]) -> Checked<()> {
+    let variable = format!("{name}_parameter");
+    let owner = if bodies.iter().any(|b| b.joint.coordinate == variable) {
+        "coordinate"
+    } else if cx.table.names.contains(&variable) {
+        "parameter"
+    } else {
+        return Ok(());
+    };
+    let whose = if named {
+        format!("contact name `{name}`")
+    } else {
+        format!("contact name `{name}` (its marker's, as the contact has no `name`)")
+    };
+    Err(cx.at.error(
+        field,
+        format!(
+            "{whose} clashes with {owner} `{variable}`: the build calls the contact's point on \
+             its profile `{variable}`; give the contact another `name` or rename the {owner}"
+        ),
+    ))
 }
 
 fn contact(
@@ -262,7 +311,7 @@ fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
         Follower::Roller { radius } => Shape::Roller(radius),
         Follower::Flat { .. } => Shape::Flat,
     };
-    followable_checked(contact.profile.variable(), shape, &samples).map_err(
+    followable_checked(&contact.name, contact.profile.variable(), shape, &samples).map_err(
         |(place, message)| {
             let field = match place {
                 Place::Radius => format!("{path}.follower.radius"),
@@ -378,9 +427,12 @@ fn turns_about_the_cam_axis(
             return Err(at.error(
                 &path,
                 format!(
-                    "a flat face may turn relative to its cam only about the cam's axis \
-                     ({:?}), but joint `{}` between them turns about {:?}",
-                    axis, joint.coordinate, joint.axis
+                    "contact `{}`: a flat face may turn relative to its cam only about the \
+                     cam's axis {}, but joint `{}` between them turns about {}",
+                    contact.name,
+                    vector(axis),
+                    joint.coordinate,
+                    vector(joint.axis)
                 ),
             ));
         }
@@ -390,10 +442,19 @@ fn turns_about_the_cam_axis(
         return Err(at.error(
             &format!("{path}.normal"),
             format!(
-                "the face normal {normal:?} must lie in the cam plane (perpendicular to the \
-                 cam's axis {axis:?})"
+                "contact `{}`: the face normal {} must lie in the cam plane (perpendicular to \
+                 the cam's axis {})",
+                contact.name,
+                vector(normal),
+                vector(axis)
             ),
         ));
     }
     Ok(())
+}
+
+/// `(x, y, z)` as a model file writes it (no `-0`).
+fn vector(v: [f64; 3]) -> String {
+    let [x, y, z] = v.map(|c| c + 0.0);
+    format!("({x:?}, {y:?}, {z:?})")
 }
