@@ -149,7 +149,9 @@ pub enum BenchWhat {
     All,
     /// Run time against error over a ladder of steps and tolerances, every integrator.
     WorkPrecision,
-    /// One evaluation of each term, generated against numeric, side by side.
+    /// One evaluation of each term, generated against numeric, side by side; the reduced
+    /// right-hand side of the cams on moving bodies against the fixed-cam paper model, and one
+    /// camshaft revolution at 1e-10.
     Evaluations,
     /// Whole-run overhead, sweep throughput with 1 and 2 workers, sweep memory.
     Sweep,

@@ -256,6 +256,9 @@ pub fn contact(run: &RunView) -> Option<Figure> {
     ))
 }
 
+/// How a figure reads one quantity of coordinate `i` from a sample.
+type Reading = fn(&Sample, usize) -> f64;
+
 /// Units of a coordinate's displacement, velocity and acceleration.
 fn motion_units(kind: CoordinateKind) -> [&'static str; 3] {
     match kind {
@@ -329,7 +332,7 @@ pub fn follower(run: &RunView) -> Option<Figure> {
         };
         let units = motion_units(c.kind);
         let name = &contact.name;
-        let quantities: [(&str, String, fn(&Sample, usize) -> f64); 3] = [
+        let quantities: [(&str, String, Reading); 3] = [
             ("displacement", c.name.clone(), |s, i| s.q[i]),
             ("velocity", format!("{}_dot", c.name), |s, i| s.qd[i]),
             ("acceleration", format!("{}_ddot", c.name), |s, i| s.qdd[i]),

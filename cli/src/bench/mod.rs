@@ -5,6 +5,9 @@
 //!   and tolerances, on the reference models, against a checked reference solution;
 //! - `evaluations`: one evaluation of M+F+Q, the constraint terms, the reduced right-hand
 //!   side and one RK4 step, generated code against the numeric recursion, on the same states;
+//!   then (section `cams`) the reduced right-hand side of the cams on moving bodies against
+//!   the fixed-cam paper model's, and one full camshaft revolution at 1e-10 of the camshaft
+//!   models;
 //! - `sweep`: the whole-run overhead of a metrics run, the throughput of `camchain sweep` with
 //!   1 and 2 workers, and its memory against the number of runs;
 //! - `scaling-figure`: the figure of the scaling study from the CSV of
@@ -13,6 +16,7 @@
 //! Timings are medians over batches, generated and numeric batches interleaved so that
 //! machine noise hits both alike. No timing is asserted anywhere (see the tests).
 
+mod cams;
 mod evaluations;
 mod markdown;
 mod scaling;
@@ -38,6 +42,9 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         let section = evaluations::run(args.quick)?;
         markdown::replace_section(report, "evaluations", &section)?;
         println!("updated {} (section evaluations)", report.display());
+        let section = cams::run(args.quick)?;
+        markdown::replace_section(report, "cams", &section)?;
+        println!("updated {} (section cams)", report.display());
     }
     if let BenchWhat::ScalingFigure = args.what {
         let csv = args.scaling_csv.as_deref().ok_or_else(|| {
