@@ -537,6 +537,17 @@ pub fn snapshots(run: &RunView) -> Result<Figure, String> {
     ))
 }
 
+/// True when a snapshot of `rows` draws a base circle.
+fn geometry_has_base_circle(rows: &[Row]) -> bool {
+    rows.iter().flat_map(|r| &r.panels).any(|p| match p {
+        Panel::Mechanism(m) => m
+            .frames
+            .iter()
+            .any(|f| f.cams.iter().any(|c| !c.base_circle.is_empty())),
+        _ => false,
+    })
+}
+
 /// Snapshots per row of the grid drawn for a moving cam.
 const GRID_COLUMNS: usize = 3;
 
@@ -583,9 +594,14 @@ fn snapshot_grid(run: &RunView, panel: MechanismPanel) -> Figure {
             panels: std::mem::replace(&mut panels, rest),
         });
     }
+    let base_circle = if geometry_has_base_circle(&rows) {
+        "base circle thin, "
+    } else {
+        ""
+    };
     Figure {
         title: format!(
-            "{}: snapshots (cam material grey, base circle thin, follower in colour)",
+            "{}: snapshots (cam material grey, {base_circle}follower in colour)",
             run.label
         ),
         width: COLUMN_WIDTH + 200,

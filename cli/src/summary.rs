@@ -254,15 +254,21 @@ pub fn render(report: &RunReport) -> String {
         settings_text(settings)
     );
     if !samples.is_empty() {
+        let rows = rows(info, samples);
+        // The names' column: 24 characters, wider when a name needs it.
+        let width = rows
+            .iter()
+            .map(|(name, _, _)| name.chars().count() + 2)
+            .fold(24, usize::max);
         let _ = writeln!(
             text,
-            "  {:<24}{:>14}{:>14}{:>14}",
+            "  {:<width$}{:>14}{:>14}{:>14}",
             "quantity", "min", "max", "max |·|"
         );
-        for (name, lo, hi) in rows(info, samples) {
+        for (name, lo, hi) in rows {
             let _ = writeln!(
                 text,
-                "  {name:<24}{:>14}{:>14}{:>14}",
+                "  {name:<width$}{:>14}{:>14}{:>14}",
                 number(lo),
                 number(hi),
                 number(lo.abs().max(hi.abs()))

@@ -40,7 +40,14 @@ fn every_generated_model_agrees_with_the_numeric_recursion() {
 
 #[test]
 fn generated_and_numeric_trajectories_coincide() {
-    for name in ["paper_concave", "driven_convex", "spatial_arm"] {
+    for name in [
+        "paper_concave",
+        "driven_convex",
+        "spatial_arm",
+        "paper_rotating",
+        "rocker_roller",
+        "eccentric_flat",
+    ] {
         let generated = models::by_name(name).expect("built in");
         let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
         let numeric = NumericModel::load(std::path::Path::new(&path)).expect("loads");
