@@ -14,6 +14,9 @@
 //!   output.
 //! - [`settings`]: the ranges of the settings a run accepts, checked before it starts.
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
+//! - [`spline`]: C² cubic splines through tables of points (profiles given as points).
+//! - [`contact`]: contact parameters (Newton on the profile) and the checks that a
+//!   follower can follow its profile.
 //! - [`metrics`]: runs that keep a summary (extreme forces, lift-off, drift) instead of a
 //!   trajectory, for parameter sweeps.
 //! - [`unilateral`]: one-sided contact: lift-off, flight, impact with restitution.
@@ -31,6 +34,7 @@ pub mod parameters;
 pub mod partition;
 pub mod settings;
 pub mod simulate;
+pub mod spline;
 pub mod unilateral;
 
 pub use dynamics::*;
