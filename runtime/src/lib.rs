@@ -14,6 +14,8 @@
 //!   output.
 //! - [`settings`]: the ranges of the settings a run accepts, checked before it starts.
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
+//! - [`motion_law`]: follower motion laws (dwell, cycloidal, harmonic, polynomials,
+//!   modified trapezoid and sine) in closed form, and programs of them over a turn.
 //! - [`spline`]: C² cubic splines through tables of points (profiles given as points).
 //! - [`contact`]: contact parameters (Newton on the profile) and the checks that a
 //!   follower can follow its profile.
@@ -30,6 +32,7 @@ pub mod error;
 pub mod events;
 pub mod integrators;
 pub mod metrics;
+pub mod motion_law;
 pub mod parameters;
 pub mod partition;
 pub mod settings;
