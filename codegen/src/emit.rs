@@ -207,6 +207,7 @@ pub fn generate_with(
     let mut helpers =
         contact_kinematics_helpers(&d, &kinematics_specs, &mut op_counts, &derived(""));
     helpers.push_str(&implicit_helpers(&d, &mut op_counts, &derived("")));
+    helpers.push_str(&table_helpers(&d.graph));
     if let Some(rp) = &runtime {
         op_counts.push(("derive".to_string(), rp.derive_count(&d)));
     }
@@ -262,6 +263,43 @@ pub fn generate_with(
         ),
         op_counts,
     })
+}
+
+/// Every tabulated function of the graph as its table (abscissas, values and the spline's
+/// second derivatives at the knots, computed at build time) and a function `<name>(s)`
+/// returning [S, S′, S″, S‴] at s (`camchain_runtime::spline::evaluate`).
+fn table_helpers(g: &Graph) -> String {
+    let mut out = String::new();
+    for table in g.tables() {
+        let spline = &table.spline;
+        let upper = table.name.to_uppercase();
+        let n = spline.abscissas().len();
+        let _ = writeln!(
+            out,
+            "/// {name}: the table's abscissas, values and second derivatives at the knots.\n\
+             {ALLOW_LITERALS}\n\
+             const {upper}_X: [f64; {n}] = {};\n\
+             {ALLOW_LITERALS}\n\
+             const {upper}_Y: [f64; {n}] = {};\n\
+             {ALLOW_LITERALS}\n\
+             const {upper}_M: [f64; {n}] = {};\n\
+             /// {name}: the spline and its first three derivatives at s ({}).\n\
+             #[inline]\n\
+             fn {name}(s: f64) -> [f64; 4] {{\n\
+             rt::spline::evaluate(&{upper}_X, &{upper}_Y, &{upper}_M, {}, s)\n}}",
+            float_list(spline.abscissas()),
+            float_list(spline.values()),
+            float_list(spline.knot_curvatures()),
+            if spline.is_periodic() {
+                "periodic: repeats every period"
+            } else {
+                "open: its end cubics continue beyond the table"
+            },
+            spline.is_periodic(),
+            name = table.name,
+        );
+    }
+    out
 }
 
 /// `text` as a raw string literal (`r#"…"#` with enough `#`s), so that embedded model text
@@ -1067,8 +1105,10 @@ impl FusedTerms {
             .filter(|&i| in_position[i] && in_velocity[i])
             .map(|i| id_at(g, i))
             .filter(|&id| {
-                matches!(g.node(id), Node::Call(..) | Node::Powf(..) | Node::Div(..))
-                    || g.implicit_of(id).is_some()
+                matches!(
+                    g.node(id),
+                    Node::Call(..) | Node::Powf(..) | Node::Div(..) | Node::Table(..)
+                ) || g.implicit_of(id).is_some()
             })
             .collect();
         let memo = trig_pairs(g, &in_position, &d.symbols.params);
@@ -2029,7 +2069,7 @@ impl<'g> Emitter<'g> {
         }
         match self.g.node(id) {
             Node::Const(_) | Node::Var(_) | Node::Neg(_) => false,
-            Node::Call(..) | Node::Powf(..) => true,
+            Node::Call(..) | Node::Powf(..) | Node::Table(..) => true,
             _ => self.uses[id.index()] >= 2 || self.g.label_of(id).is_some(),
         }
     }
@@ -2256,6 +2296,12 @@ impl<'g> Emitter<'g> {
             return Some(sanitize(label));
         }
         match self.g.node(id) {
+            Node::Table(t, order, _) => self.g.tables().get(t as usize).map(|t| {
+                let suffix = ["", "_d1", "_d2", "_d3"]
+                    .get(usize::from(order))
+                    .unwrap_or(&"");
+                format!("{}{suffix}", t.name)
+            }),
             Node::Add(..) => angle_name(self.g, id).map(|parts| format!("angle_{parts}")),
             Node::Mul(a, b) if a == b => self.names.get(&a).map(|name| format!("{name}_sq")),
             _ => None,
@@ -2313,6 +2359,10 @@ impl<'g> Emitter<'g> {
                 4,
             ),
             Node::Call(f, a) => (format!("{}.{}()", self.receiver(a), method_name(f)), 4),
+            Node::Table(t, order, a) => {
+                let name = self.g.tables().get(t as usize).map_or("table", |t| &t.name);
+                (format!("{name}({})[{order}]", self.print(a, 0)), 4)
+            }
         }
     }
 

@@ -119,9 +119,24 @@ impl Spline {
         })
     }
 
+    /// The abscissas of the table.
+    pub fn abscissas(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// The values of the table.
+    pub fn values(&self) -> &[f64] {
+        &self.y
+    }
+
     /// The second derivatives at the knots (what generated code stores beside the table).
     pub fn knot_curvatures(&self) -> &[f64] {
         &self.m
+    }
+
+    /// True for a closed (periodic) spline.
+    pub fn is_periodic(&self) -> bool {
+        self.periodic
     }
 
     /// [S, S′, S″, S‴] at `s` ([`evaluate`]).
