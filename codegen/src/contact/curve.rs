@@ -164,6 +164,42 @@ pub struct Frame {
     pub curvature: Id,
 }
 
+/// The residual's unknowns of contact `index` called `name`: a trial parameter
+/// `__<name>_s`, two placeholders `__<name>_<p>` for the inputs, and the profile at the trial
+/// parameter (named `trial_…`).
+pub fn trial_point(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    name: &str,
+    placeholders: [&str; 2],
+) -> (Id, [Id; 2], CurvePoint) {
+    let u = g.var(&format!("__{name}_s"));
+    let p = placeholders.map(|p| g.var(&format!("__{name}_{p}")));
+    let at = curve_at(g, model, s, index, u);
+    label_curve(g, &at, "trial");
+    (u, p, at)
+}
+
+/// The profile at the solved contact parameter (named after the contact) and the follower
+/// point's offset from it, `<name>_offset_x`, `<name>_offset_y`.
+pub fn solved_point(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    name: &str,
+    (parameter, follower): (Id, [Id; 2]),
+) -> (CurvePoint, [Id; 2]) {
+    let at = curve_at(g, model, s, index, parameter);
+    label_curve(g, &at, name);
+    let offset = sub2(g, follower, at.point);
+    g.label(offset[0], format!("{name}_offset_x"));
+    g.label(offset[1], format!("{name}_offset_y"));
+    (at, offset)
+}
+
 /// Names the point and its derivatives for the emitted code: `<label>_cx`, `<label>_dcx`,
 /// `<label>_ddcx`, … (the first label a node gets stays).
 pub fn label_curve(g: &mut Graph, c: &CurvePoint, label: &str) {

@@ -15,7 +15,7 @@
 
 use super::ContactTerms;
 use super::curve::{
-    add_scaled, curve_at, dot2, follower_side, label_curve, labelled_frame, perp, sub2,
+    add_scaled, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
 };
 use super::relative::Relative;
 use crate::expr::{Graph, Guess, Implicit};
@@ -41,13 +41,7 @@ pub fn flat(
     g.label(m[0], format!("{name}_face_x"));
     g.label(m[1], format!("{name}_face_y"));
     // ψ(u; m) = m·c′(u) on placeholders, then the support point.
-    let (u, mx, my) = (
-        g.var(&format!("__{name}_s")),
-        g.var(&format!("__{name}_mx")),
-        g.var(&format!("__{name}_my")),
-    );
-    let at_u = curve_at(g, model, s, index, u);
-    label_curve(g, &at_u, "trial");
+    let (u, [mx, my], at_u) = trial_point(g, model, s, index, name, ["mx", "my"]);
     let residual = dot2(g, [mx, my], at_u.d1);
     let derivative = dot2(g, [mx, my], at_u.d2);
     let extent = dot2(g, [mx, my], at_u.point);
@@ -71,11 +65,7 @@ pub fn flat(
             range: contact.range.unwrap_or((0.0, std::f64::consts::TAU)),
         },
     );
-    let at = curve_at(g, model, s, index, solution);
-    label_curve(g, &at, name);
-    let offset = sub2(g, rel.xy, at.point);
-    g.label(offset[0], format!("{name}_offset_x"));
-    g.label(offset[1], format!("{name}_offset_y"));
+    let (at, offset) = solved_point(g, model, s, index, name, (solution, rel.xy));
     let h = dot2(g, m, offset);
     let m_perp = perp(g, m);
     let lever = dot2(g, m_perp, offset);

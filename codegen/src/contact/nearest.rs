@@ -14,7 +14,9 @@
 //! (κ D < 1 wherever the roller does not undercut the profile.)
 
 use super::ContactTerms;
-use super::curve::{self, curve_at, dot2, follower_side, label_curve, labelled_frame, perp, sub2};
+use super::curve::{
+    self, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
+};
 use super::relative::Relative;
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{Symbols, vec3};
@@ -33,13 +35,7 @@ pub fn nearest(
     let name = &contact.name;
     let side = follower_side(&contact.profile);
     // ψ(u; p) on placeholders, then the solution.
-    let (u, px, py) = (
-        g.var(&format!("__{name}_s")),
-        g.var(&format!("__{name}_px")),
-        g.var(&format!("__{name}_py")),
-    );
-    let at_u = curve_at(g, model, s, index, u);
-    label_curve(g, &at_u, "trial");
+    let (u, [px, py], at_u) = trial_point(g, model, s, index, name, ["px", "py"]);
     let d = sub2(g, [px, py], at_u.point);
     g.label(d[0], "offset_x");
     g.label(d[1], "offset_y");
@@ -74,12 +70,8 @@ pub fn nearest(
             range: contact.range.unwrap_or((0.0, std::f64::consts::TAU)),
         },
     );
-    let at = curve_at(g, model, s, index, solution);
-    label_curve(g, &at, name);
+    let (at, offset) = solved_point(g, model, s, index, name, (solution, rel.xy));
     let f = labelled_frame(g, &at, side, name);
-    let offset = sub2(g, rel.xy, at.point);
-    g.label(offset[0], format!("{name}_offset_x"));
-    g.label(offset[1], format!("{name}_offset_y"));
     let distance = dot2(g, f.normal, offset);
     g.label(distance, format!("{name}_distance"));
     let rho = match radius {
