@@ -292,9 +292,11 @@ impl Geometry {
     /// cam fixed to the ground with an explicit profile (drawn once, from `profile`).
     pub fn cam_picture(&self, q: &[f64], k: usize, x_range: (f64, f64)) -> Option<CamPicture> {
         let cam = self.cams.get(k)?;
+        let (rotations, origins) = self.transforms(q);
+        let frames = (rotations.as_slice(), origins.as_slice());
         if cam.body.is_none() && matches!(cam.outline, Outline::Explicit(_)) {
             return self
-                .follower_picture(q, cam)
+                .follower_picture(frames, cam)
                 .map(|(roller, face)| CamPicture {
                     roller,
                     face,
@@ -302,7 +304,6 @@ impl Geometry {
                     ..CamPicture::default()
                 });
         }
-        let (rotations, origins) = self.transforms(q);
         let (rotation, offset) = cam.body.map_or((Matrix3::identity(), Vec3::zeros()), |b| {
             (rotations[b], origins[b])
         });
@@ -342,20 +343,20 @@ impl Geometry {
                 .map(|p| self.plane.project(&(*p).into()))
                 .collect();
         }
-        if let Some((roller, face)) = self.follower_picture(q, cam) {
+        if let Some((roller, face)) = self.follower_picture(frames, cam) {
             (picture.roller, picture.face) = (roller, face);
         }
         Some(picture)
     }
 
-    /// The roller's rim or the flat face of a contact's follower at `q`, plane coordinates.
+    /// The roller's rim or the flat face of a contact's follower where the body frames
+    /// ([`Geometry::transforms`]) put it, plane coordinates.
     #[allow(clippy::type_complexity)]
     fn follower_picture(
         &self,
-        q: &[f64],
+        (rotations, origins): (&[Matrix3<f64>], &[Vec3]),
         cam: &CamShape,
     ) -> Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)> {
-        let (rotations, origins) = self.transforms(q);
         let (body, position) = self.markers.get(cam.marker)?;
         let rotation = rotations.get(*body)?;
         let centre = origins[*body] + rotation * position;
@@ -539,6 +540,8 @@ mod tests {
                 assert!(distance_to(&outline, point) < 1e-6, "{name} at t = {t}");
                 match rim {
                     Some(tol) => assert!(distance_to(&picture.roller, point) < tol, "{name}"),
+                    // The face is a straight segment through the contact point: rounding of
+                    // 0.05 m coordinates, 1e-12 m.
                     None => assert!(distance_to(&picture.face, point) < 1e-12, "{name}"),
                 }
             }

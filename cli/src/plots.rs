@@ -413,6 +413,36 @@ fn axes<'a, DB: DrawingBackend>(
     Ok((chart, scale))
 }
 
+/// A chart on exactly these ranges (no scaling of the axis), with the grid or without it.
+fn plain_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    (x_label, y_label): (&str, &str),
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    grid: bool,
+) -> Result<Chart<'a, DB>, PlotError> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    let (x_format, y_format) = (tick_format((x0, x1)), tick_format((y0, y1)));
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_label)
+        .y_desc(y_label)
+        .x_label_formatter(&x_format)
+        .y_label_formatter(&y_format)
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_SIZE));
+    if grid {
+        mesh.bold_line_style(GRID_BOLD).light_line_style(GRID_LIGHT);
+    } else {
+        mesh.disable_mesh();
+    }
+    mesh.draw()?;
+    Ok(chart)
+}
+
 /// The cell edges around increasing grid values: midway between neighbours, half a gap
 /// beyond the ends (a single value gets ±5 % of itself, or ±0.5).
 fn cell_edges(values: &[f64]) -> Vec<f64> {
@@ -477,22 +507,8 @@ fn draw_heat<DB: DrawingBackend>(
     } else {
         (0.0, 1.0)
     };
-    let mut chart = ChartBuilder::on(&map)
-        .margin(MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    let (x_format, y_format) = (tick_format((x0, x1)), tick_format((y0, y1)));
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(p.x_label.as_str())
-        .y_desc(p.y_label.as_str())
-        .x_label_formatter(&x_format)
-        .y_label_formatter(&y_format)
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_SIZE))
-        .draw()?;
+    let labels = (p.x_label.as_str(), p.y_label.as_str());
+    let mut chart = plain_chart(&map, labels, (x0, x1), (y0, y1), false)?;
     let mut cells = Vec::new();
     for (i, column) in p.z.iter().enumerate() {
         for (j, z) in column.iter().enumerate() {
@@ -645,23 +661,8 @@ fn draw_mechanism<DB: DrawingBackend>(
         h.saturating_sub(X_LABEL_AREA + 2 * MARGIN),
     );
     let ((x0, x1), (y0, y1)) = equal_scales(p.bounds, plot);
-    let mut chart = ChartBuilder::on(&area)
-        .margin(MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    let (x_format, y_format) = (tick_format((x0, x1)), tick_format((y0, y1)));
-    chart
-        .configure_mesh()
-        .x_desc(p.x_label.as_str())
-        .y_desc(p.y_label.as_str())
-        .x_label_formatter(&x_format)
-        .y_label_formatter(&y_format)
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_SIZE))
-        .bold_line_style(GRID_BOLD)
-        .light_line_style(GRID_LIGHT)
-        .draw()?;
+    let labels = (p.x_label.as_str(), p.y_label.as_str());
+    let mut chart = plain_chart(&area, labels, (x0, x1), (y0, y1), true)?;
     if let Some(profile) = &p.cam {
         let curve: Vec<(f64, f64)> = (0..=PROFILE_POINTS)
             .map(|i| x0 + (x1 - x0) * i as f64 / PROFILE_POINTS as f64)
@@ -691,7 +692,7 @@ fn draw_mechanism<DB: DrawingBackend>(
 /// A cam where its body carries it (material filled, profile edge, base circle thin, centre
 /// as a small cross) and its follower's roller or flat face in the snapshot's colour.
 fn draw_cam<DB: DrawingBackend>(
-    chart: &mut PlaneChart<'_, DB>,
+    chart: &mut Chart<'_, DB>,
     cam: &CamPicture,
     color: RGBColor,
 ) -> Result<(), PlotError> {
@@ -777,14 +778,8 @@ fn draw_time_legend<DB: DrawingBackend>(
     Ok(())
 }
 
-type PlaneChart<'a, DB> = ChartContext<
-    'a,
-    DB,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
-
 fn draw_frame<DB: DrawingBackend>(
-    chart: &mut PlaneChart<'_, DB>,
+    chart: &mut Chart<'_, DB>,
     frame: &Frame,
 ) -> Result<(), PlotError> {
     let link = frame.color.stroke_width(3);
