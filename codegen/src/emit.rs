@@ -11,7 +11,7 @@ use crate::contact::ContactTerms;
 use crate::derive::Derivation;
 use crate::expr::{Graph, Guess, Id, Node, OpCount, method_name};
 use crate::model::{IntegratorChoice, JointKind, Model};
-use crate::profile::Func;
+use crate::profile::{Func, TabulatedFunction};
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
@@ -265,44 +265,81 @@ pub fn generate_with(
     })
 }
 
-/// Every tabulated function of the graph as its table (abscissas, values and the spline's
-/// second derivatives at the knots, computed at build time) and a function `<name>(s)`
-/// returning [S, S′, S″, S‴] at s (`camchain_runtime::spline::evaluate`).
+/// Every tabulated function of the graph as constants and a function `<name>(s)` returning
+/// its value and first three derivatives at s: a spline's table (abscissas, values and the
+/// second derivatives at the knots, computed at build time) for
+/// `camchain_runtime::spline::evaluate`, or a motion law's segments for
+/// `camchain_runtime::motion_law::evaluate`.
 fn table_helpers(g: &Graph) -> String {
     let mut out = String::new();
     for table in g.tables() {
-        let spline = &table.spline;
-        let upper = table.name.to_uppercase();
-        let n = spline.abscissas().len();
-        let _ = writeln!(
-            out,
-            "/// {name}: the table's abscissas, values and second derivatives at the knots.\n\
-             {ALLOW_LITERALS}\n\
-             const {upper}_X: [f64; {n}] = {};\n\
-             {ALLOW_LITERALS}\n\
-             const {upper}_Y: [f64; {n}] = {};\n\
-             {ALLOW_LITERALS}\n\
-             const {upper}_M: [f64; {n}] = {};\n\
-             /// {name}: the spline and its first three derivatives at s ({}).\n\
-             #[inline]\n\
-             fn {name}(s: f64) -> [f64; 4] {{\n\
-             rt::spline::evaluate(&{upper}_X, &{upper}_Y, &{upper}_M, {}, s)\n}}",
-            float_list(spline.abscissas()),
-            float_list(spline.values()),
-            float_list(spline.knot_curvatures()),
-            if spline.is_periodic() {
-                "periodic: repeats every period"
-            } else {
-                "open: its end cubics continue beyond the table"
-            },
-            spline.is_periodic(),
-            name = table.name,
-        );
+        let text = match &table.function {
+            TabulatedFunction::Spline(spline) => spline_helper(&table.name, spline),
+            TabulatedFunction::Law(program) => law_helper(&table.name, program),
+        };
+        out.push_str(&text);
     }
     out
 }
 
-/// `text` as a raw string literal (`r#"…"#` with enough `#`s), so that embedded model text
+/// The constants and the evaluation function of a spline named `name`.
+fn spline_helper(name: &str, spline: &camchain_runtime::spline::Spline) -> String {
+    let upper = name.to_uppercase();
+    let n = spline.abscissas().len();
+    format!(
+        "/// {name}: the table's abscissas, values and second derivatives at the knots.\n\
+         {ALLOW_LITERALS}\n\
+         const {upper}_X: [f64; {n}] = {};\n\
+         {ALLOW_LITERALS}\n\
+         const {upper}_Y: [f64; {n}] = {};\n\
+         {ALLOW_LITERALS}\n\
+         const {upper}_M: [f64; {n}] = {};\n\
+         /// {name}: the spline and its first three derivatives at s ({}).\n\
+         #[inline]\n\
+         fn {name}(s: f64) -> [f64; 4] {{\n\
+         rt::spline::evaluate(&{upper}_X, &{upper}_Y, &{upper}_M, {}, s)\n}}\n",
+        float_list(spline.abscissas()),
+        float_list(spline.values()),
+        float_list(spline.knot_curvatures()),
+        if spline.is_periodic() {
+            "periodic: repeats every period"
+        } else {
+            "open: its end cubics continue beyond the table"
+        },
+        spline.is_periodic(),
+    )
+}
+
+/// The segments and the evaluation function of a motion law named `name`.
+fn law_helper(name: &str, program: &camchain_runtime::motion_law::MotionProgram) -> String {
+    let upper = name.to_uppercase();
+    let segments: Vec<String> = program
+        .segments()
+        .iter()
+        .map(|s| {
+            format!(
+                "rt::motion_law::Segment {{ law: rt::motion_law::Law::{:?}, angle: {}, lift: {} }}",
+                s.law,
+                lit(s.angle),
+                lit(s.lift)
+            )
+        })
+        .collect();
+    format!(
+        "/// {name}: the follower's motion law, segment by segment (its law, the cam angle it \
+         takes in rad, the lift at its end).\n\
+         {ALLOW_LITERALS}\n\
+         const {upper}: [rt::motion_law::Segment; {}] = [{}];\n\
+         /// {name}: the follower's displacement and its first three derivatives with respect \
+         to the cam's angle at theta (repeats every turn).\n\
+         #[inline]\n\
+         fn {name}(theta: f64) -> [f64; 4] {{\n\
+         rt::motion_law::evaluate(&{upper}, theta)\n}}\n",
+        segments.len(),
+        segments.join(", "),
+    )
+}
+
 /// reads as written.
 fn raw_string(text: &str) -> String {
     let mut hashes = String::from("#");
@@ -2006,6 +2043,9 @@ struct Emitter<'g> {
     solve_inputs: HashSet<Id>,
     /// Set when a solve's call passes the derived parameter values on.
     solves_read_derived: bool,
+    /// The bound result of each tabulated function's call, by (function, argument): every
+    /// derivative read at one argument comes from one look-up.
+    table_calls: HashMap<(u32, Id), String>,
 }
 
 impl<'g> Emitter<'g> {
@@ -2057,6 +2097,7 @@ impl<'g> Emitter<'g> {
             derived_arg: String::new(),
             solve_inputs,
             solves_read_derived: false,
+            table_calls: HashMap::new(),
         }
     }
 
@@ -2146,6 +2187,9 @@ impl<'g> Emitter<'g> {
                 self.solves_read_derived |= !self.derived_arg.is_empty();
                 self.names.insert(id, name);
                 continue;
+            }
+            if let Node::Table(t, _, a) = self.g.node(id) {
+                self.bind_table_call(t, a, &mut text, &mut taken);
             }
             let expr = match self.given.get(&id) {
                 Some(source) => source.clone(),
@@ -2249,6 +2293,21 @@ impl<'g> Emitter<'g> {
             lit(def.range.0),
             lit(def.range.1)
         )
+    }
+
+    /// `let <name>_at = <name>(a);` the first time tabulated function `t` is read at `a`.
+    fn bind_table_call(&mut self, t: u32, a: Id, text: &mut String, taken: &mut HashSet<String>) {
+        if self.table_calls.contains_key(&(t, a)) {
+            return;
+        }
+        let name = self
+            .g
+            .tables()
+            .get(t as usize)
+            .map_or("table", |t| t.name.as_str());
+        let call = fresh(&format!("{name}_at"), taken);
+        let _ = writeln!(text, "let {call} = {name}({});", self.print(a, 0));
+        self.table_calls.insert((t, a), call);
     }
 
     /// `let (s_a, c_a) = rt::sin_cos_memo(a, &mut cache[k..k + 3]);`, naming both nodes.
@@ -2359,10 +2418,13 @@ impl<'g> Emitter<'g> {
                 4,
             ),
             Node::Call(f, a) => (format!("{}.{}()", self.receiver(a), method_name(f)), 4),
-            Node::Table(t, order, a) => {
-                let name = self.g.tables().get(t as usize).map_or("table", |t| &t.name);
-                (format!("{name}({})[{order}]", self.print(a, 0)), 4)
-            }
+            Node::Table(t, order, a) => match self.table_calls.get(&(t, a)) {
+                Some(call) => (format!("{call}[{order}]"), 5),
+                None => {
+                    let name = self.g.tables().get(t as usize).map_or("table", |t| &t.name);
+                    (format!("{name}({})[{order}]", self.print(a, 0)), 4)
+                }
+            },
         }
     }
 

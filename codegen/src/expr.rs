@@ -47,20 +47,15 @@ pub enum Node {
     /// an elementary function of a
     Call(Func, Id),
     /// The derivative of order `.1` (0: the value) of tabulated function `.0` of the graph
-    /// ([`Graph::add_table`]) at a: a spline through a table of points, evaluated by the
-    /// runtime (segment look-up and a cubic); orders 0 to 3 are exact, higher ones vanish.
+    /// ([`Graph::add_table`]) at a: a spline through a table of points (segment look-up and
+    /// a cubic) or a motion law (segment look-up and the law's closed form), evaluated by the
+    /// runtime; orders 0 to 3 are exact.
     Table(u32, u8, Id),
 }
 
-/// A function of one variable given by a table, evaluated by the runtime
-/// (`camchain_runtime::spline`): a profile given as points.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Table {
-    /// Its name in the emitted code (`<contact>_<field>`).
-    pub name: String,
-    /// The spline through the table's points.
-    pub spline: camchain_runtime::spline::Spline,
-}
+/// A tabulated function of the graph: a spline through a table of points or a motion law,
+/// evaluated by the runtime ([`crate::profile::Tabulated`]).
+pub type Table = std::sync::Arc<crate::profile::Tabulated>;
 
 /// Operation counts of a set of expressions, each shared node counted once.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -583,8 +578,12 @@ impl Graph {
         self.intern(Node::Call(f, a))
     }
 
-    /// Registers a tabulated function; returns its index for [`Graph::table`].
+    /// Registers a tabulated function (once per name); returns its index for
+    /// [`Graph::table`].
     pub fn add_table(&mut self, table: Table) -> u32 {
+        if let Some(k) = self.tables.iter().position(|t| t.name == table.name) {
+            return k as u32;
+        }
         self.tables.push(table);
         (self.tables.len() - 1) as u32
     }
@@ -595,18 +594,18 @@ impl Graph {
     }
 
     /// The derivative of order `order` of table `t` at a, with folding: a constant argument
-    /// gives a constant, an order above 3 zero (a cubic spline's fourth derivative vanishes
-    /// inside every segment).
+    /// gives a constant, an order above 3 a constant too (zero for a spline, whose fourth
+    /// derivative vanishes inside every segment; NaN for a law, which does not provide it).
     pub fn table(&mut self, t: u32, order: u8, a: Id) -> Id {
+        let Some(table) = self.tables.get(t as usize).cloned() else {
+            return self.constant(f64::NAN);
+        };
         if order > 3 {
-            return self.zero();
+            return self.constant(table.derivative(order, 0.0));
         }
-        match (self.as_const(a), self.tables.get(t as usize)) {
-            (Some(x), Some(table)) => {
-                let value = table.spline.eval(x)[usize::from(order)];
-                self.constant(value)
-            }
-            _ => self.intern(Node::Table(t, order, a)),
+        match self.as_const(a) {
+            Some(x) => self.constant(table.derivative(order, x)),
+            None => self.intern(Node::Table(t, order, a)),
         }
     }
 
@@ -940,11 +939,10 @@ impl Graph {
                 Node::Powi(a, n) => v(a).powi(*n),
                 Node::Powf(a, b) => v(a).powf(v(b)),
                 Node::Call(f, a) => apply(*f, v(a)),
-                Node::Table(t, order, a) => {
-                    self.tables.get(*t as usize).map_or(f64::NAN, |table| {
-                        table.spline.eval(v(a))[usize::from(*order)]
-                    })
-                }
+                Node::Table(t, order, a) => self
+                    .tables
+                    .get(*t as usize)
+                    .map_or(f64::NAN, |table| table.derivative(*order, v(a))),
             };
             values.push(value);
         }
@@ -1147,10 +1145,10 @@ mod tests {
         let spline = Spline::new(&xs, &ys, Ends::Natural).expect("a table");
         let mut g = Graph::new();
         let x = g.var("x");
-        let t = g.add_table(Table {
-            name: "cam_profile".into(),
-            spline: spline.clone(),
-        });
+        let t = g.add_table(crate::profile::Tabulated::spline(
+            "cam_profile",
+            spline.clone(),
+        ));
         let sx = g.sin(x);
         let f = g.table(t, 0, sx);
         let df = g.diff(f, x);

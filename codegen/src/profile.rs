@@ -14,10 +14,13 @@
 //! `span-locations` feature (enabled in this crate's `Cargo.toml`); outside a proc-macro
 //! proc-macro2 uses its own lexer, whose byte ranges are relative to the parsed string.
 
+use camchain_runtime::motion_law::MotionProgram;
+use camchain_runtime::spline::Spline;
 use proc_macro2::TokenStream;
 use quote::ToTokens;
 use std::cell::Cell;
 use std::str::FromStr;
+use std::sync::Arc;
 use syn::spanned::Spanned;
 use syn::{BinOp, Expr, Lit, UnOp};
 
@@ -72,6 +75,69 @@ pub enum Scalar {
     Powf(Box<Scalar>, Box<Scalar>),
     /// f(a)
     Call(Func, Box<Scalar>),
+    /// The derivative of order `.1` (0: the value) of a function given by data at a: a
+    /// spline through a table of points, or a follower's motion law ([`Tabulated`]). Built by
+    /// the schema (profiles from points, cams from motion laws), never parsed.
+    Table(Arc<Tabulated>, u8, Box<Scalar>),
+}
+
+/// A function of one variable given by data instead of a formula, with its first three
+/// derivatives exact: a profile through points (a C² cubic spline) or a follower's motion
+/// law over a turn of the cam. Generated code keeps its data in constants and evaluates it
+/// with the runtime's `spline::evaluate` or `motion_law::evaluate`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tabulated {
+    /// Its name in the generated code (`<contact>_<what>`, a Rust identifier); unique in a
+    /// model.
+    pub name: String,
+    /// The data and how it is evaluated.
+    pub function: TabulatedFunction,
+}
+
+/// What a [`Tabulated`] function is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TabulatedFunction {
+    /// A spline through a table of points.
+    Spline(Spline),
+    /// A follower's displacement against the cam's angle.
+    Law(MotionProgram),
+}
+
+impl Tabulated {
+    /// A named spline.
+    pub fn spline(name: impl Into<String>, spline: Spline) -> Arc<Self> {
+        Arc::new(Tabulated {
+            name: name.into(),
+            function: TabulatedFunction::Spline(spline),
+        })
+    }
+
+    /// A named motion law.
+    pub fn law(name: impl Into<String>, program: MotionProgram) -> Arc<Self> {
+        Arc::new(Tabulated {
+            name: name.into(),
+            function: TabulatedFunction::Law(program),
+        })
+    }
+
+    /// [F, F′, F″, F‴] at x.
+    pub fn eval(&self, x: f64) -> [f64; 4] {
+        match &self.function {
+            TabulatedFunction::Spline(s) => s.eval(x),
+            TabulatedFunction::Law(p) => p.eval(x),
+        }
+    }
+
+    /// The derivative of order `order` at x. Above the third: zero for a spline (a cubic's
+    /// fourth derivative vanishes inside every segment), NaN for a motion law (not provided;
+    /// nothing asks for it).
+    pub fn derivative(&self, order: u8, x: f64) -> f64 {
+        match (order, &self.function) {
+            (0..=3, _) => self.eval(x)[usize::from(order)],
+            (_, TabulatedFunction::Spline(_)) => 0.0,
+            (_, TabulatedFunction::Law(_)) => f64::NAN,
+        }
+    }
 }
 
 impl Scalar {
@@ -90,6 +156,7 @@ impl Scalar {
             Scalar::Powi(a, n) => a.eval(v).powi(*n),
             Scalar::Powf(a, b) => a.eval(v).powf(b.eval(v)),
             Scalar::Call(f, a) => apply(*f, a.eval(v)),
+            Scalar::Table(t, order, a) => t.derivative(*order, a.eval(v)),
         }
     }
 
@@ -108,7 +175,9 @@ impl Scalar {
         match self {
             Scalar::Const(_) => false,
             Scalar::Var | Scalar::Param(_) => true,
-            Scalar::Neg(a) | Scalar::Powi(a, _) | Scalar::Call(_, a) => a.mentions_variable(),
+            Scalar::Neg(a) | Scalar::Powi(a, _) | Scalar::Call(_, a) | Scalar::Table(_, _, a) => {
+                a.mentions_variable()
+            }
             Scalar::Add(a, b)
             | Scalar::Sub(a, b)
             | Scalar::Mul(a, b)
@@ -134,6 +203,7 @@ impl Scalar {
             Scalar::Powi(a, n) => Scalar::Powi(r(a), *n),
             Scalar::Powf(a, b) => Scalar::Powf(r(a), r(b)),
             Scalar::Call(f, a) => Scalar::Call(*f, r(a)),
+            Scalar::Table(t, order, a) => Scalar::Table(t.clone(), *order, r(a)),
         }
     }
 
@@ -148,7 +218,10 @@ impl Scalar {
             match s {
                 Scalar::Param(i) => out.push(*i),
                 Scalar::Const(_) | Scalar::Var => {}
-                Scalar::Neg(a) | Scalar::Powi(a, _) | Scalar::Call(_, a) => walk(a, out),
+                Scalar::Neg(a)
+                | Scalar::Powi(a, _)
+                | Scalar::Call(_, a)
+                | Scalar::Table(_, _, a) => walk(a, out),
                 Scalar::Add(a, b)
                 | Scalar::Sub(a, b)
                 | Scalar::Mul(a, b)

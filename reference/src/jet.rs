@@ -247,6 +247,11 @@ pub fn eval_on(expr: &Scalar, x: Jet2) -> Jet2 {
         Scalar::Powi(a, n) => ev(a).powi(*n),
         Scalar::Powf(a, b) => ev(a).powf(ev(b)),
         Scalar::Call(func, a) => ev(a).apply(*func),
+        Scalar::Table(t, order, a) => {
+            let inner = ev(a);
+            let d = |k: u8| crate::spline::derivative(t, order + k, inner.v);
+            inner.compose(d(0), d(1), d(2))
+        }
     }
 }
 
@@ -267,6 +272,7 @@ pub fn eval_with(expr: &Scalar, x: f64, values: &[f64]) -> f64 {
         Scalar::Powi(a, n) => ev(a).powi(*n),
         Scalar::Powf(a, b) => ev(a).powf(ev(b)),
         Scalar::Call(func, a) => Jet2::constant(ev(a)).apply(*func).v,
+        Scalar::Table(t, order, a) => crate::spline::derivative(t, *order, ev(a)),
     }
 }
 

@@ -26,5 +26,6 @@
 mod contact;
 pub mod jet;
 mod numeric;
+pub mod spline;
 
 pub use numeric::{NumericModel, contact_info, model_info};

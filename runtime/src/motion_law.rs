@@ -94,27 +94,52 @@ const MODIFIED_SINE: [Piece; 3] = [
     Piece::new(0.875, 0.0, -1.0, 4.0 * PI, 0.0),
 ];
 
-/// [f, f′, f″, f‴] of a law defined by its acceleration `pieces` (peak 1), before scaling:
-/// the pieces before u are integrated whole, the one holding u up to it.
-fn composite_unscaled(pieces: &[Piece], u: f64) -> [f64; 4] {
-    let (mut s, mut v) = (0.0, 0.0);
-    for (i, piece) in pieces.iter().enumerate() {
-        let end = pieces.get(i + 1).map_or(1.0, |p| p.start);
-        if u <= end || i + 1 == pieces.len() {
-            let [ds, dv, a, j] = piece.integrate(u - piece.start, v);
-            return [s + ds, v + dv, a, j];
-        }
-        let [ds, dv, _, _] = piece.integrate(end - piece.start, v);
-        s += ds;
-        v += dv;
-    }
-    [s, v, 0.0, 0.0]
+/// The state a composite law reaches at the start of each of its pieces, before scaling:
+/// (Δs, Δv) integrated over every piece before it, and f(1) (the scale).
+#[derive(Debug)]
+struct PieceStarts {
+    starts: Vec<[f64; 2]>,
+    total: f64,
 }
 
-/// [f, f′, f″, f‴] of a composite law, scaled so that f(1) = 1.
-fn composite(pieces: &[Piece], u: f64) -> [f64; 4] {
-    let total = composite_unscaled(pieces, 1.0)[0];
-    composite_unscaled(pieces, u).map(|x| x / total)
+impl PieceStarts {
+    /// Integrates `pieces` once, piece by piece.
+    fn of(pieces: &[Piece]) -> Self {
+        let (mut s, mut v) = (0.0, 0.0);
+        let mut starts = Vec::with_capacity(pieces.len());
+        for (i, piece) in pieces.iter().enumerate() {
+            starts.push([s, v]);
+            let end = pieces.get(i + 1).map_or(1.0, |p| p.start);
+            let [ds, dv, _, _] = piece.integrate(end - piece.start, v);
+            s += ds;
+            v += dv;
+        }
+        PieceStarts { starts, total: s }
+    }
+}
+
+/// [f, f′, f″, f‴] of a composite law defined by its acceleration `pieces` (peak 1), scaled
+/// so that f(1) = 1: the piece holding u integrated from its start, whose state `table` keeps.
+fn composite(pieces: &[Piece], table: &PieceStarts, u: f64) -> [f64; 4] {
+    let i = pieces
+        .partition_point(|p| p.start < u)
+        .saturating_sub(1)
+        .min(pieces.len() - 1);
+    let [s, v] = table.starts[i];
+    let [ds, dv, a, j] = pieces[i].integrate(u - pieces[i].start, v);
+    [s + ds, v + dv, a, j].map(|x| x / table.total)
+}
+
+/// The pieces' starting states of the modified trapezoid, computed once.
+fn trapezoid_starts() -> &'static PieceStarts {
+    static TABLE: std::sync::OnceLock<PieceStarts> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| PieceStarts::of(&TRAPEZOID))
+}
+
+/// The pieces' starting states of the modified sine, computed once.
+fn modified_sine_starts() -> &'static PieceStarts {
+    static TABLE: std::sync::OnceLock<PieceStarts> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| PieceStarts::of(&MODIFIED_SINE))
 }
 
 /// [f, f′, f″, f‴] of a polynomial Σ c_k u^k (coefficients from u⁰).
@@ -180,8 +205,8 @@ impl Law {
             }
             Law::Polynomial345 => polynomial(&[0.0, 0.0, 0.0, 10.0, -15.0, 6.0], u),
             Law::Polynomial4567 => polynomial(&[0.0, 0.0, 0.0, 0.0, 35.0, -84.0, 70.0, -20.0], u),
-            Law::ModifiedTrapezoid => composite(&TRAPEZOID, u),
-            Law::ModifiedSine => composite(&MODIFIED_SINE, u),
+            Law::ModifiedTrapezoid => composite(&TRAPEZOID, trapezoid_starts(), u),
+            Law::ModifiedSine => composite(&MODIFIED_SINE, modified_sine_starts(), u),
         }
     }
 }
@@ -340,27 +365,18 @@ impl MotionProgram {
 
     /// [s, ds/dθ, d²s/dθ², d³s/dθ³] of segment `i` at u ∈ [0, 1].
     fn in_segment(&self, i: usize, u: f64) -> [f64; 4] {
-        let s = &self.segments[i];
-        let (from, rise) = (self.lift_before(i), s.lift - self.lift_before(i));
-        let f = s.law.normalised(u);
-        [
-            from + rise * f[0],
-            rise * f[1] / s.angle,
-            rise * f[2] / s.angle.powi(2),
-            rise * f[3] / s.angle.powi(3),
-        ]
+        segment_values(&self.segments[i], self.lift_before(i), u)
     }
 
     /// [s, ds/dθ, d²s/dθ², d³s/dθ³] at the cam angle `theta` (rad; any value: the program
-    /// repeats every turn).
+    /// repeats every turn): [`evaluate`] on its segments.
     pub fn eval(&self, theta: f64) -> [f64; 4] {
-        let theta = theta.rem_euclid(2.0 * PI);
-        let i = self
-            .starts
-            .partition_point(|&start| start <= theta)
-            .saturating_sub(1);
-        let u = ((theta - self.starts[i]) / self.segments[i].angle).clamp(0.0, 1.0);
-        self.in_segment(i, u)
+        evaluate(&self.segments, theta)
+    }
+
+    /// The angle where each segment starts (rad).
+    pub fn starts(&self) -> &[f64] {
+        &self.starts
     }
 
     /// Every joint where the velocity, acceleration or jerk changes by more than `relative`
@@ -392,6 +408,40 @@ impl MotionProgram {
         }
         out
     }
+}
+
+/// [s, ds/dθ, d²s/dθ², d³s/dθ³] of `segment`, which starts from the lift `before`, at
+/// u ∈ [0, 1] of its angle.
+fn segment_values(segment: &Segment, before: f64, u: f64) -> [f64; 4] {
+    let rise = segment.lift - before;
+    let f = segment.law.normalised(u);
+    let beta = segment.angle;
+    [
+        before + rise * f[0],
+        rise * f[1] / beta,
+        rise * f[2] / (beta * beta),
+        rise * f[3] / (beta * beta * beta),
+    ]
+}
+
+/// [s, ds/dθ, d²s/dθ², d³s/dθ³] at the cam angle `theta` of the program `segments` (checked
+/// by [`MotionProgram::new`]; the first starts at angle 0 from lift 0), repeated every turn:
+/// what generated code calls for a cam designed from a motion law, its segments a constant
+/// array. The segment holding θ is found by adding up the angles (programs have a handful of
+/// segments); a joint belongs to the segment that starts there. NaN for no segment.
+pub fn evaluate(segments: &[Segment], theta: f64) -> [f64; 4] {
+    let theta = theta.rem_euclid(2.0 * PI);
+    let (mut start, mut before) = (0.0, 0.0);
+    for (i, segment) in segments.iter().enumerate() {
+        let end = start + segment.angle;
+        if theta < end || i + 1 == segments.len() {
+            let u = ((theta - start) / segment.angle).clamp(0.0, 1.0);
+            return segment_values(segment, before, u);
+        }
+        start = end;
+        before = segment.lift;
+    }
+    [f64::NAN; 4]
 }
 
 #[cfg(test)]

@@ -103,7 +103,7 @@ pub struct Spline {
     x: Vec<f64>,
     y: Vec<f64>,
     m: Vec<f64>,
-    periodic: bool,
+    ends: Ends,
 }
 
 impl Spline {
@@ -115,7 +115,7 @@ impl Spline {
             x: x.to_vec(),
             y: y.to_vec(),
             m,
-            periodic: ends == Ends::Periodic,
+            ends,
         })
     }
 
@@ -136,12 +136,17 @@ impl Spline {
 
     /// True for a closed (periodic) spline.
     pub fn is_periodic(&self) -> bool {
-        self.periodic
+        self.ends == Ends::Periodic
+    }
+
+    /// The end conditions it was built with.
+    pub fn ends(&self) -> Ends {
+        self.ends
     }
 
     /// [S, S′, S″, S‴] at `s` ([`evaluate`]).
     pub fn eval(&self, s: f64) -> [f64; 4] {
-        evaluate(&self.x, &self.y, &self.m, self.periodic, s)
+        evaluate(&self.x, &self.y, &self.m, self.is_periodic(), s)
     }
 }
 

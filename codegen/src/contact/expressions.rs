@@ -47,6 +47,11 @@ pub fn scalar_to_expr(g: &mut Graph, s: &Scalar, var: Id, params: &[Id]) -> Id {
             let a = to(a);
             g.call(*f, a)
         }
+        Scalar::Table(t, order, a) => {
+            let a = to(a);
+            let k = g.add_table(t.clone());
+            g.table(k, *order, a)
+        }
     }
 }
 
