@@ -14,11 +14,13 @@
 //!   (explicit, polar, parametric), knife edges, rollers and flat faces: h, J, c (1–8).
 //! - [`dynamics`]: backward Newton–Euler recursion giving M, F, Q (10–13), and energies.
 //! - [`derive`](mod@derive): the whole derivation of a model in one graph.
+//! - [`design`]: cams designed from a follower's motion law (the envelope construction).
 //! - [`emit`]: the generated Rust module.
 
 pub mod assembly;
 pub mod contact;
 pub mod derive;
+pub mod design;
 pub mod dynamics;
 pub mod emit;
 pub mod error;

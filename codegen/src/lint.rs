@@ -3,6 +3,7 @@
 //! prints them as cargo warnings and the command line before it simulates, each located in
 //! the model file like an error.
 
+use crate::design::{CamDesign, DESIGN_SAMPLES};
 use crate::model::{JointKind, Model};
 use std::f64::consts::TAU;
 
@@ -65,6 +66,48 @@ pub fn warnings(model: &Model) -> Vec<Warning> {
                 ),
             });
         }
+    }
+    for (i, contact) in model.contacts.iter().enumerate() {
+        if let Some(design) = &contact.design {
+            out.extend(design_warnings(i, &contact.name, design));
+        }
+    }
+    out
+}
+
+/// A designed cam's warnings: the acceleration jumping where two segments join (an infinite
+/// jerk), and the pressure angle above its limit.
+pub fn design_warnings(index: usize, name: &str, design: &CamDesign) -> Vec<Warning> {
+    let mut out = Vec::new();
+    for jump in design.program.jumps(1e-9) {
+        if jump.order != 2 {
+            continue;
+        }
+        let at_speed = match design.speed {
+            Some(omega) => format!(" ({:.4e} at {omega} rad/s)", jump.size * omega * omega),
+            None => String::new(),
+        };
+        out.push(Warning {
+            field: format!("contacts[{index}].law.segments[{}]", jump.segment),
+            message: format!(
+                "contact `{name}`: the follower's acceleration jumps by {:.4e} per rad²{at_speed}                  where this segment starts (cam angle {:.3}°): an infinite jerk; laws that start                  and end at zero acceleration (cycloidal, 3-4-5, 4-5-6-7, modified trapezoid,                  modified sine) avoid it",
+                jump.size,
+                jump.angle.to_degrees()
+            ),
+        });
+    }
+    let (theta, negative) = design.least(DESIGN_SAMPLES, |p| -p.pressure_angle.abs());
+    let largest = -negative;
+    if largest > design.max_pressure_angle {
+        out.push(Warning {
+            field: format!("contacts[{index}].law"),
+            message: format!(
+                "contact `{name}`: the pressure angle reaches {:.2}° at cam angle {:.3}°, above                  the limit of {:.1}° (`max_pressure_angle`): the follower is pushed sideways                  more than along its motion; a larger base circle lowers it",
+                largest.to_degrees(),
+                theta.to_degrees(),
+                design.max_pressure_angle.to_degrees()
+            ),
+        });
     }
     out
 }

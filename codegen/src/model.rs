@@ -215,6 +215,9 @@ pub struct Contact {
     /// checked, and where a contact point is first searched for a parametric profile.
     /// `[0, 2π]` for a polar profile unless given.
     pub range: Option<(f64, f64)>,
+    /// The motion law and follower the profile was designed for, when the file gives the
+    /// cam as a `law` (its profile is then the synthesised [`Profile::Parametric`]).
+    pub design: Option<crate::design::CamDesign>,
 }
 
 impl Contact {
@@ -446,6 +449,19 @@ pub struct Model {
     pub initial: Initial,
     /// Default simulation settings.
     pub simulation: Simulation,
+    /// The files the model reads besides itself (tables of points), in the order read.
+    pub files: Vec<ModelFile>,
+}
+
+/// A file a model names (a table of points), as it was read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModelFile {
+    /// The path as the model file writes it.
+    pub written: String,
+    /// Where it was read from (empty for a file embedded in the program).
+    pub path: std::path::PathBuf,
+    /// Its text.
+    pub text: String,
 }
 
 impl Model {

@@ -240,6 +240,49 @@ impl Scalar {
     }
 }
 
+/// Expressions built in code (a cam synthesised from a motion law): `a + b`, `a * b`, … make
+/// the tree nodes, and [`Scalar::from`] a constant.
+impl From<f64> for Scalar {
+    fn from(value: f64) -> Self {
+        Scalar::Const(value)
+    }
+}
+
+macro_rules! scalar_operator {
+    ($trait:ident, $method:ident, $variant:ident) => {
+        impl std::ops::$trait for Scalar {
+            type Output = Scalar;
+            fn $method(self, rhs: Scalar) -> Scalar {
+                Scalar::$variant(Box::new(self), Box::new(rhs))
+            }
+        }
+    };
+}
+
+scalar_operator!(Add, add, Add);
+scalar_operator!(Sub, sub, Sub);
+scalar_operator!(Mul, mul, Mul);
+scalar_operator!(Div, div, Div);
+
+impl std::ops::Neg for Scalar {
+    type Output = Scalar;
+    fn neg(self) -> Scalar {
+        Scalar::Neg(Box::new(self))
+    }
+}
+
+impl Scalar {
+    /// f(self) for an elementary function.
+    pub fn call(self, f: Func) -> Scalar {
+        Scalar::Call(f, Box::new(self))
+    }
+
+    /// The derivative of order `order` of `table` at self.
+    pub fn tabulated(self, table: &Arc<Tabulated>, order: u8) -> Scalar {
+        Scalar::Table(table.clone(), order, Box::new(self))
+    }
+}
+
 /// Why an expression was rejected, and where.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("byte {offset}: {message}")]

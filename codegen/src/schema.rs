@@ -36,6 +36,7 @@
 //! errors are located with a small RON scanner that maps the dotted field path
 //! (`bodies[1].mass`) back to a line and column, because serde values carry no positions.
 
+mod csv;
 mod raw;
 mod scan;
 mod validate;
@@ -78,6 +79,32 @@ pub fn parse_model_with(
     overrides: &[(String, f64)],
     mode: ParameterMode,
 ) -> Result<Model, ModelError> {
+    parse_model_from(source, file, overrides, mode, Files::BesideModel)
+}
+
+/// Where the files a model names (its tables of points) are read from.
+#[derive(Debug, Clone, Copy, Default)]
+pub enum Files<'a> {
+    /// A relative path from the directory of the model file's path (the path messages show):
+    /// right for a file loaded from where the program runs.
+    #[default]
+    BesideModel,
+    /// A relative path from this directory: the model file's own, when the path messages show
+    /// is relative to somewhere else (a build script's workspace root).
+    In(&'a Path),
+    /// Only these texts, by the path as the model writes it: a built-in model's files,
+    /// embedded in the program with it.
+    Embedded(&'a [(&'a str, &'a str)]),
+}
+
+/// [`parse_model_with`] reading the files the model names from `files`.
+pub fn parse_model_from(
+    source: &str,
+    file: &Path,
+    overrides: &[(String, f64)],
+    mode: ParameterMode,
+    files: Files,
+) -> Result<Model, ModelError> {
     let source = without_bom(source);
     let at = Locator::new(file, source);
     let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
@@ -86,7 +113,11 @@ pub fn parse_model_with(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let options = validate::Options { overrides, mode };
+    let options = validate::Options {
+        overrides,
+        mode,
+        files,
+    };
     validate::validate(&parsed, &stem, &at, &options)
 }
 

@@ -12,7 +12,7 @@
 //! - A flat face's convective term from the general three-dimensional rotation of its
 //!   normal (the generator uses the planar form).
 
-use crate::jet::{Jet2, eval_on};
+use crate::jet::{Jet2, eval_on, eval_with};
 use crate::numeric::{Motion, Pose, vec3};
 use camchain_codegen::model::{Contact, Follower, JointKind, Model, Profile};
 use camchain_runtime::{ContactGeometry, ContactKinematics};
@@ -208,6 +208,18 @@ impl ContactConst {
         }
     }
 
+    /// c(s) alone, in plain arithmetic (what the search compares).
+    fn profile_point(&self, s: f64) -> [f64; 2] {
+        match &self.profile {
+            Profile::Explicit { f, .. } => [s, eval_with(f, s, &[])],
+            Profile::Polar { r, .. } => {
+                let r = eval_with(r, s, &[]);
+                [r * s.cos(), r * s.sin()]
+            }
+            Profile::Parametric { x, y, .. } => [eval_with(x, s, &[]), eval_with(y, s, &[])],
+        }
+    }
+
     /// +1 when the follower is on the left of increasing s (explicit), −1 otherwise.
     fn side(&self) -> f64 {
         match self.profile {
@@ -238,9 +250,12 @@ impl ContactConst {
         let (a, b) = self.range;
         let step = (b - a) / SCAN as f64;
         let best = (0..=SCAN)
-            .map(|k| a + step * k as f64)
-            .min_by(|x, y| objective(*x).total_cmp(&objective(*y)))
-            .unwrap_or(a);
+            .map(|k| {
+                let s = a + step * k as f64;
+                (s, objective(s))
+            })
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .map_or(a, |(s, _)| s);
         let (mut lo, mut hi) = (best - step, best + step);
         let ratio = 0.5 * (5f64.sqrt() - 1.0);
         while hi - lo > 1e-9 * (b - a) {
@@ -303,7 +318,7 @@ impl ContactConst {
                     let p = seen.p;
                     let s = self.optimum(
                         |s| {
-                            let d = sub(p, self.curve(s).c);
+                            let d = sub(p, self.profile_point(s));
                             dot(d, d)
                         },
                         |s| {
@@ -323,7 +338,7 @@ impl ContactConst {
                 (Follower::Flat { .. }, _) => {
                     let m = seen.m;
                     let s = self.optimum(
-                        |s| -dot(m, self.curve(s).c),
+                        |s| -dot(m, self.profile_point(s)),
                         |s| {
                             let c = self.curve(s);
                             (dot(m, c.d1), dot(m, c.d2))

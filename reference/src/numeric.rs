@@ -685,6 +685,7 @@ mod tests {
                 atol: 1e-10,
                 restitution: None,
             },
+            files: Vec::new(),
         }
     }
 
@@ -702,6 +703,7 @@ mod tests {
             x_axis: [x_axis.x, x_axis.y, x_axis.z],
             y_axis: [y_axis.x, y_axis.y, y_axis.z],
             range: None,
+            design: None,
         }
     }
 

@@ -27,16 +27,28 @@ use std::cell::RefCell;
 use std::sync::Arc;
 
 /// The derivative of order `order` of `f` at x, by the reference's route.
+///
+/// An expression reads one function at one point several times (a profile designed from a
+/// law reads the law's value and slope in many places): the last evaluation is kept.
 pub fn derivative(f: &Arc<Tabulated>, order: u8, x: f64) -> f64 {
-    match &f.function {
-        TabulatedFunction::Law(_) => f.derivative(order, x),
-        TabulatedFunction::Spline(spline) => {
-            if order > 3 {
-                return 0.0;
-            }
-            with_hermite(f, spline, |h| h.eval(x)[usize::from(order)])
-        }
+    if order > 3 {
+        return f.derivative(order, x);
     }
+    let cached = LAST.with(|last| {
+        last.borrow()
+            .as_ref()
+            .filter(|(g, at, _)| Arc::ptr_eq(g, f) && *at == x.to_bits())
+            .map(|(_, _, v)| *v)
+    });
+    let values = cached.unwrap_or_else(|| {
+        let values = match &f.function {
+            TabulatedFunction::Law(_) => f.eval(x),
+            TabulatedFunction::Spline(spline) => with_hermite(f, spline, |h| h.eval(x)),
+        };
+        LAST.with(|last| *last.borrow_mut() = Some((f.clone(), x.to_bits(), values)));
+        values
+    });
+    values[usize::from(order)]
 }
 
 /// A spline in Hermite form: knots, values and slopes.
@@ -70,9 +82,7 @@ impl Hermite {
         } else {
             s
         };
-        // The segment: linear search from the end that is nearer (a different look-up from
-        // the runtime's bisection).
-        let i = (0..n).rev().find(|&i| x[i] <= s).unwrap_or(0);
+        let i = x.partition_point(|&k| k <= s).clamp(1, n) - 1;
         let h = x[i + 1] - x[i];
         let t = (s - x[i]) / h;
         let (y0, y1, m0, m1) = (self.y[i], self.y[i + 1], h * self.d[i], h * self.d[i + 1]);
@@ -173,6 +183,9 @@ fn slopes(x: &[f64], y: &[f64], ends: Ends) -> Vec<f64> {
 const CACHED: usize = 64;
 
 thread_local! {
+    /// The last evaluation: the function (held, so that its identity stays its own), the
+    /// argument's bits and the four values.
+    static LAST: RefCell<Option<(Arc<Tabulated>, u64, [f64; 4])>> = const { RefCell::new(None) };
     static BUILT: RefCell<Vec<(Arc<Tabulated>, Arc<Hermite>)>> = const { RefCell::new(Vec::new()) };
 }
 

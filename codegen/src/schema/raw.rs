@@ -212,6 +212,12 @@ pub(super) struct Contact {
     /// A parametric profile (x(s), y(s)).
     #[serde(default)]
     pub parametric: Option<Parametric>,
+    /// A profile through a table of points.
+    #[serde(default)]
+    pub table: Option<Table>,
+    /// A cam designed from the follower's motion law.
+    #[serde(default)]
+    pub law: Option<Law>,
     #[serde(default)]
     pub range: Option<(f64, f64)>,
     #[serde(default)]
@@ -238,6 +244,128 @@ pub(super) enum Follower {
 pub(super) struct Parametric {
     pub x: String,
     pub y: String,
+}
+
+/// `table: (form: …, file: "…" | points: […], ends: …, degrees: …)`: a profile through
+/// points, interpolated by a C² cubic spline.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Table {
+    pub form: TableForm,
+    /// A CSV file of two columns, relative to the model file.
+    #[serde(default)]
+    pub file: Option<String>,
+    /// The points written in the model file.
+    #[serde(default)]
+    pub points: Option<Vec<(f64, f64)>>,
+    #[serde(default)]
+    pub ends: Option<TableEnds>,
+    /// A polar table's angles are in degrees (default: radians).
+    #[serde(default)]
+    pub degrees: bool,
+}
+
+/// What a table's two columns are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub(super) enum TableForm {
+    /// x, y of y = f(x).
+    Explicit,
+    /// θ, r of r(θ).
+    Polar,
+    /// x, y of a curve, in order along it.
+    Parametric,
+}
+
+/// A spline's end conditions.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) enum TableEnds {
+    Natural,
+    Clamped { start: f64, end: f64 },
+    Periodic,
+}
+
+/// `law: (…)`: a cam designed from the follower's motion over a turn.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Law {
+    pub base_radius: Number,
+    #[serde(default)]
+    pub motion: Motion,
+    #[serde(default)]
+    pub turning: Turning,
+    pub segments: Vec<LawSegment>,
+    /// Degrees.
+    #[serde(default)]
+    pub max_pressure_angle: Option<f64>,
+    /// rad/s.
+    #[serde(default)]
+    pub speed: Option<Number>,
+}
+
+/// How the designed follower moves.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) enum Motion {
+    Translating {
+        #[serde(default)]
+        offset: Number,
+    },
+    Oscillating {
+        pivot: (Number, Number),
+        arm: Number,
+        #[serde(default)]
+        swing: Turning,
+        #[serde(default)]
+        face_offset: Number,
+    },
+}
+
+impl Default for Motion {
+    fn default() -> Self {
+        Motion::Translating {
+            offset: Number::ZERO,
+        }
+    }
+}
+
+/// A direction of turning about the cam's axis.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub(super) enum Turning {
+    #[default]
+    Counterclockwise,
+    Clockwise,
+}
+
+/// One segment of a motion program.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) enum LawSegment {
+    Dwell {
+        degrees: Number,
+    },
+    Rise {
+        law: LawName,
+        lift: Number,
+        degrees: Number,
+    },
+    Return {
+        law: LawName,
+        #[serde(default)]
+        lift: Number,
+        degrees: Number,
+    },
+}
+
+/// The standard motion laws.
+#[derive(Debug, Clone, Copy, Deserialize)]
+pub(super) enum LawName {
+    Cycloidal,
+    SimpleHarmonic,
+    Polynomial345,
+    Polynomial4567,
+    ModifiedTrapezoid,
+    ModifiedSine,
 }
 
 /// The cam plane; every field defaults to the ground frame's.

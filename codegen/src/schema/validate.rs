@@ -16,6 +16,8 @@ use std::cell::RefCell;
 use std::collections::{BTreeMap, HashMap};
 
 mod contacts;
+mod designs;
+mod tables;
 use contacts::contacts;
 
 /// The reserved parent name of the fixed base.
@@ -42,6 +44,8 @@ pub(super) struct Options<'o> {
     pub overrides: &'o [(String, f64)],
     /// Which parameters are read at run time.
     pub mode: ParameterMode,
+    /// Where the files the model names are read from.
+    pub files: super::Files<'o>,
 }
 
 /// Validates the whole file; `stem` is the file stem used as the default model name.
@@ -54,7 +58,13 @@ pub(super) fn validate(
     let name = model_name(file.name.as_deref(), stem, at)?;
     let parameters = parameters(file, options, at)?;
     let table = Table::new(&parameters, at);
-    let cx = Context { at, table: &table };
+    let read = RefCell::new(Vec::new());
+    let cx = Context {
+        at,
+        table: &table,
+        files: options.files,
+        read: &read,
+    };
     let gravity = cx.vector("gravity", &file.gravity, Some(Field::Gravity))?;
     let tree = BodyTree::new(&file.bodies, at)?;
     let mut bodies = tree.bodies(&file.bodies, &cx)?;
@@ -86,6 +96,7 @@ pub(super) fn validate(
         contacts,
         initial,
         simulation,
+        files: read.into_inner(),
     })
 }
 
@@ -390,10 +401,13 @@ impl<'a> Table<'a> {
     }
 }
 
-/// What field validation needs: the locator and the parameters.
+/// What field validation needs: the locator, the parameters, and where the files the model
+/// names are found (with those read so far).
 struct Context<'a> {
     at: &'a Locator<'a>,
     table: &'a Table<'a>,
+    files: super::Files<'a>,
+    read: &'a RefCell<Vec<crate::model::ModelFile>>,
 }
 
 impl Context<'_> {

@@ -122,6 +122,7 @@ pub fn paper_concave() -> Model {
             x_axis: [1.0, 0.0, 0.0],
             y_axis: [0.0, 1.0, 0.0],
             range: None,
+            design: None,
         }],
         initial: Initial {
             q: vec![-std::f64::consts::FRAC_PI_2 - 0.1, 0.0, 0.0, 0.0],
@@ -139,6 +140,7 @@ pub fn paper_concave() -> Model {
             atol: 1e-12,
             restitution: None,
         },
+        files: Vec::new(),
     }
 }
 
@@ -255,6 +257,7 @@ pub fn spatial_tree() -> Model {
             x_axis: [1.0, 0.0, 0.0],
             y_axis: [0.0, s, c],
             range: None,
+            design: None,
         }],
         initial: Initial {
             q: vec![0.0; 5],
@@ -272,5 +275,6 @@ pub fn spatial_tree() -> Model {
             atol: 1e-9,
             restitution: None,
         },
+        files: Vec::new(),
     }
 }

@@ -137,11 +137,16 @@ fn contact(
         ));
     }
     let (x_axis, y_axis) = cam_axes(cx, &format!("{path}.frame"), &c.frame)?;
-    let profile = profile(cx, &path, c, i)?;
     let follower = follower(cx, &path, &c.follower, i)?;
-    let range = contact_range(at, &path, c, &profile, &follower)?;
+    let name = c.name.clone().unwrap_or_else(|| c.marker.clone());
+    let Shaped {
+        profile,
+        covers,
+        design,
+    } = profile(cx, &path, c, i, &name, &follower)?;
+    let range = contact_range(at, &path, c, &profile, &follower, covers)?;
     Ok(Contact {
-        name: c.name.clone().unwrap_or_else(|| c.marker.clone()),
+        name,
         marker,
         follower,
         profile,
@@ -152,31 +157,84 @@ fn contact(
         x_axis,
         y_axis,
         range,
+        design,
     })
 }
 
-/// The profile: exactly one of `profile` (explicit), `polar` and `parametric`.
-fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Profile> {
+/// A profile with what its form brings: the interval a table covers, a law's design.
+struct Shaped {
+    profile: Profile,
+    covers: Option<(f64, f64)>,
+    design: Option<crate::design::CamDesign>,
+}
+
+impl From<Profile> for Shaped {
+    fn from(profile: Profile) -> Self {
+        Shaped {
+            profile,
+            covers: None,
+            design: None,
+        }
+    }
+}
+
+/// The profile: exactly one of `profile` (explicit), `polar`, `parametric`, `table` (through
+/// points) and `law` (designed from the follower's motion).
+fn profile(
+    cx: &Context,
+    path: &str,
+    c: &raw::Contact,
+    i: usize,
+    name: &str,
+    follower: &Follower,
+) -> Checked<Shaped> {
     let given = [
-        c.profile.is_some(),
-        c.polar.is_some(),
-        c.parametric.is_some(),
+        ("profile", c.profile.is_some()),
+        ("polar", c.polar.is_some()),
+        ("parametric", c.parametric.is_some()),
+        ("table", c.table.is_some()),
+        ("law", c.law.is_some()),
     ];
-    if given.iter().filter(|g| **g).count() != 1 {
-        let message = if given.contains(&true) {
-            "give only one of `profile`, `polar` and `parametric`"
-        } else {
-            "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
-             `polar: \"r(theta)\"` or `parametric: (x: \"x(s)\", y: \"y(s)\")`"
-        };
-        let field = if c.polar.is_some() && given[0] {
-            format!("{path}.polar")
-        } else if c.parametric.is_some() && given.iter().filter(|g| **g).count() > 1 {
-            format!("{path}.parametric")
-        } else {
-            format!("{path}.marker")
+    let named: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
+    if named.len() != 1 {
+        let (field, message) = match named.as_slice() {
+            [] => (
+                format!("{path}.marker"),
+                "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
+                 `polar: \"r(theta)\"`, `parametric: (x: \"x(s)\", y: \"y(s)\")`, `table: (…)` \
+                 (through points) or `law: (…)` (designed from the follower's motion)"
+                    .to_string(),
+            ),
+            [.., last] => (
+                format!("{path}.{last}"),
+                format!(
+                    "give only one of `profile`, `polar`, `parametric`, `table` and `law` (this \
+                     contact gives {})",
+                    named
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ),
         };
         return Err(cx.at.error(&field, message));
+    }
+    if let Some(table) = &c.table {
+        let (profile, covers) = super::tables::table_profile(cx, path, table, name)?;
+        return Ok(Shaped {
+            profile,
+            covers: Some(covers),
+            design: None,
+        });
+    }
+    if let Some(law) = &c.law {
+        let (profile, design) = super::designs::law_profile(cx, path, law, i, name, follower)?;
+        return Ok(Shaped {
+            profile,
+            covers: Some((0.0, std::f64::consts::TAU)),
+            design: Some(design),
+        });
     }
     if let Some(source) = &c.profile {
         let f = expression(
@@ -189,7 +247,8 @@ fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Prof
         return Ok(Profile::Explicit {
             source: source.clone(),
             f,
-        });
+        }
+        .into());
     }
     if let Some(source) = &c.polar {
         let r = expression(
@@ -202,7 +261,8 @@ fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Prof
         return Ok(Profile::Polar {
             source: source.clone(),
             r,
-        });
+        }
+        .into());
     }
     let p = c.parametric.as_ref().ok_or_else(|| {
         cx.at
@@ -227,7 +287,8 @@ fn profile(cx: &Context, path: &str, c: &raw::Contact, i: usize) -> Checked<Prof
         y_source: p.y.clone(),
         x,
         y,
-    })
+    }
+    .into())
 }
 
 fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
@@ -252,14 +313,16 @@ fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Fo
 }
 
 /// The profile interval a contact may touch: given (finite, increasing), or [0, 2π] for a
-/// polar profile; required where the contact point is searched for along the profile
-/// (a parametric profile) or undercutting is checked (a roller or a flat face).
+/// polar profile, or the interval a table or a law covers (`covers`); required where the
+/// contact point is searched for along the profile (a parametric profile) or undercutting
+/// is checked (a roller or a flat face).
 fn contact_range(
     at: &Locator,
     path: &str,
     c: &raw::Contact,
     profile: &Profile,
     follower: &Follower,
+    covers: Option<(f64, f64)>,
 ) -> Checked<Option<(f64, f64)>> {
     let field = format!("{path}.range");
     if let Some((a, b)) = c.range {
@@ -272,6 +335,9 @@ fn contact_range(
             ));
         }
         return Ok(Some((a, b)));
+    }
+    if covers.is_some() {
+        return Ok(covers);
     }
     let needs = match (profile, follower) {
         (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
@@ -316,13 +382,13 @@ fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
             let field = match place {
                 Place::Radius => format!("{path}.follower.radius"),
                 Place::Follower => format!("{path}.follower"),
-                Place::Profile => format!("{path}.{}", profile_field(&contact.profile)),
+                Place::Profile => format!("{path}.{}", profile_field(contact)),
             };
             at.error(&field, message)
         },
     )?;
     if let Profile::Polar { r, .. } = &contact.profile {
-        closes(at, &format!("{path}.polar"), r)?;
+        closes(at, &format!("{path}.{}", profile_field(contact)), r)?;
     }
     Ok(())
 }
@@ -347,7 +413,7 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
                 super::location(cx.at, &format!("{path}.follower")),
                 super::location(
                     cx.at,
-                    &format!("{path}.{}", profile_field(&contact.profile)),
+                    &format!("{path}.{}", profile_field(contact)),
                 ),
             ],
         ));
@@ -374,13 +440,24 @@ fn closes(at: &Locator, field: &str, r: &crate::profile::Scalar) -> Checked<()> 
     Ok(())
 }
 
-/// The field that holds a profile's expression.
-fn profile_field(profile: &Profile) -> &'static str {
-    match profile {
+/// The field that holds a contact's profile.
+fn profile_field(contact: &Contact) -> &'static str {
+    if contact.design.is_some() {
+        return "law";
+    }
+    match &contact.profile {
+        Profile::Explicit { f, .. } if is_table(f) => "table",
+        Profile::Polar { r, .. } if is_table(r) => "table",
+        Profile::Parametric { x, .. } if is_table(x) => "table",
         Profile::Explicit { .. } => "profile",
         Profile::Polar { .. } => "polar",
         Profile::Parametric { .. } => "parametric",
     }
+}
+
+/// True for a profile read from a table of points (its expression a tabulated leaf).
+fn is_table(e: &crate::profile::Scalar) -> bool {
+    matches!(e, crate::profile::Scalar::Table(..))
 }
 
 /// A flat face's normal stays in the cam plane only if the follower turns relative to the

@@ -1,0 +1,488 @@
+//! Cams designed from the follower's motion law: the pitch curve and the profile as exact
+//! expressions of the cam angle (the classical envelope construction), and the quantities a
+//! cam designer checks (docs/method.md §10).
+//!
+//! The design frame D is the cam frame when the cam angle θ is 0; the follower is fixed in
+//! it and the cam turns by σθ about its axis (σ = +1 counterclockwise, −1 clockwise), so a
+//! point X of D has the cam-frame coordinates R(−σθ) X. The motion law s(θ) (a
+//! [`MotionProgram`]) is the follower's lift above the base circle: a distance for a
+//! translating follower, the arm's angle for an oscillating one.
+//!
+//! - **Knife edge or roller** (radius ρ, 0 for a knife): the follower point P(θ) (the knife's
+//!   edge, the roller's centre) traces the pitch curve p = R(−σθ) P. Its tangent in D
+//!   components is T = P′ − σ J P (J a quarter turn counterclockwise), its outward normal
+//!   ν = σ J T/|T|, and the profile is the pitch curve moved in by ρ along ν:
+//!   c(θ) = R(−σθ)(P − ρ ν).
+//!   Translating (offset e, guide along D's y axis): P = (e, y₀ + s), y₀ = √((R_b + ρ)² − e²).
+//!   Oscillating (pivot A, arm a, the arm turning by κ = ±1 as the follower rises):
+//!   P = A + a u(φ), φ = φ₀ + κ s, φ₀ where |P| = R_b + ρ.
+//! - **Flat face**: the face is a line of D with unit normal n (from the cam into the
+//!   follower) at the support value d: n·X = d. Seen from the cam the line turns at the rate
+//!   ω = φ′ − σ, and the envelope of the lines (the contact point) is
+//!   Q = d n + (d′/ω) J n, in D components. Translating: n = (0, 1), d = R_b + s;
+//!   oscillating: n = κ J u(φ), d = n·A − f (the face at the distance f from the pivot's line
+//!   towards the cam).
+//!
+//! The profile's radius of curvature, in closed form: for a knife or roller the pitch
+//! curve's ρ_p = −σ|T|³/(T × T′ − σ|T|²) (positive where convex) less ρ; for a flat face
+//! d + (d′/ω)′/ω (R_b + s + s″ for a translating face). Undercutting is a radius that
+//! reaches zero; the pressure angle is the angle between the contact normal and the
+//! direction in which the follower point moves.
+//!
+//! The same formulas build the profile's expressions ([`Scalar`], exact, with the law a
+//! tabulated leaf) and its numbers (`f64`): one generic implementation over [`Number`].
+
+use crate::profile::{Func, Scalar, Tabulated};
+use camchain_runtime::motion_law::MotionProgram;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::sync::Arc;
+
+/// Samples of a turn for a design's checks and warnings (then refined around the worst).
+pub const DESIGN_SAMPLES: usize = 3600;
+
+/// The arithmetic the construction needs: `f64` for numbers, [`Scalar`] for expressions.
+pub trait Number:
+    Clone
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// A constant.
+    fn constant(value: f64) -> Self;
+    /// sin
+    fn sin(&self) -> Self;
+    /// cos
+    fn cos(&self) -> Self;
+    /// Square root.
+    fn sqrt(&self) -> Self;
+}
+
+impl Number for f64 {
+    fn constant(value: f64) -> Self {
+        value
+    }
+    fn sin(&self) -> Self {
+        f64::sin(*self)
+    }
+    fn cos(&self) -> Self {
+        f64::cos(*self)
+    }
+    fn sqrt(&self) -> Self {
+        f64::sqrt(*self)
+    }
+}
+
+impl Number for Scalar {
+    fn constant(value: f64) -> Self {
+        Scalar::Const(value)
+    }
+    fn sin(&self) -> Self {
+        self.clone().call(Func::Sin)
+    }
+    fn cos(&self) -> Self {
+        self.clone().call(Func::Cos)
+    }
+    fn sqrt(&self) -> Self {
+        self.clone().call(Func::Sqrt)
+    }
+}
+
+/// A plane vector.
+type V<N> = [N; 2];
+
+fn add<N: Number>(a: &V<N>, b: &V<N>) -> V<N> {
+    [a[0].clone() + b[0].clone(), a[1].clone() + b[1].clone()]
+}
+
+fn sub<N: Number>(a: &V<N>, b: &V<N>) -> V<N> {
+    [a[0].clone() - b[0].clone(), a[1].clone() - b[1].clone()]
+}
+
+fn scale<N: Number>(k: &N, a: &V<N>) -> V<N> {
+    [k.clone() * a[0].clone(), k.clone() * a[1].clone()]
+}
+
+fn dot<N: Number>(a: &V<N>, b: &V<N>) -> N {
+    a[0].clone() * b[0].clone() + a[1].clone() * b[1].clone()
+}
+
+fn cross<N: Number>(a: &V<N>, b: &V<N>) -> N {
+    a[0].clone() * b[1].clone() - a[1].clone() * b[0].clone()
+}
+
+/// J a: a turned a quarter turn counterclockwise.
+fn perp<N: Number>(a: &V<N>) -> V<N> {
+    [-a[1].clone(), a[0].clone()]
+}
+
+/// a turned by the angle whose cosine and sine are `cos`, `sin`.
+fn turn<N: Number>(a: &V<N>, cos: &N, sin: &N) -> V<N> {
+    [
+        cos.clone() * a[0].clone() - sin.clone() * a[1].clone(),
+        sin.clone() * a[0].clone() + cos.clone() * a[1].clone(),
+    ]
+}
+
+/// ±k as a number.
+fn signed<N: Number>(sign: f64, k: N) -> N {
+    if sign < 0.0 { -k } else { k }
+}
+
+/// How the designed follower moves, in the design frame D.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Motion<N> {
+    /// Along D's y axis, on the line x = `offset` (m).
+    Translating {
+        /// The guide's offset e from the cam's centre (m).
+        offset: N,
+    },
+    /// Turning about `pivot` (D, m), the follower point at `arm` (m) from it.
+    Oscillating {
+        /// The arm's pivot in D (m).
+        pivot: V<N>,
+        /// From the pivot to the follower point (m); a flat face ignores it.
+        arm: N,
+        /// A flat face's distance from the pivot's line, towards the cam (m).
+        face_offset: N,
+    },
+}
+
+/// The follower's shape, as the design sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    /// A point (or a roller: the same construction with its radius).
+    Point,
+    /// A flat face.
+    Flat,
+}
+
+/// The dimensions of a design: numbers, or expressions of the run-time parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Geometry<N> {
+    /// R_b: the base circle's radius (m), the cam's smallest radius.
+    pub base_radius: N,
+    /// ρ: the roller's radius (m); 0 for a knife edge or a flat face.
+    pub roller: N,
+    /// How the follower moves.
+    pub motion: Motion<N>,
+}
+
+/// The constants of a design that fix the shape of its expressions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Senses {
+    /// σ: +1 when the cam turns counterclockwise about its axis, −1 clockwise.
+    pub turning: f64,
+    /// κ: +1 when an oscillating follower's arm turns counterclockwise as it rises.
+    pub swing: f64,
+    /// Point (knife or roller) or flat face.
+    pub shape: Shape,
+}
+
+/// The follower at one cam angle, design-frame components.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Placed<N> {
+    /// The follower point: the knife edge, the roller's centre; for a flat face the contact
+    /// point.
+    pub pitch: V<N>,
+    /// The contact point on the profile.
+    pub contact: V<N>,
+    /// The unit normal at the contact, from the cam into the follower.
+    pub normal: V<N>,
+    /// The unit direction in which the follower moves the contact's follower point.
+    pub motion: V<N>,
+}
+
+/// The arm's direction at the base circle, u(φ₀), for an oscillating follower: the arm
+/// points from the pivot towards the cam's centre, turned by κγ (a knife or roller: |P| =
+/// R_b + ρ by the law of cosines) or by κ·asin((R_b + f)/|A|) (a flat face tangent to the
+/// base circle).
+fn base_direction<N: Number>(g: &Geometry<N>, senses: Senses) -> V<N> {
+    let Motion::Oscillating {
+        pivot,
+        arm,
+        face_offset,
+    } = &g.motion
+    else {
+        return [N::constant(1.0), N::constant(0.0)];
+    };
+    let d = dot(pivot, pivot).sqrt();
+    let inward = scale(&(N::constant(-1.0) / d.clone()), pivot);
+    let (cos, sin) = match senses.shape {
+        Shape::Point => {
+            let rp = g.base_radius.clone() + g.roller.clone();
+            let cos = (d.clone() * d.clone() + arm.clone() * arm.clone() - rp.clone() * rp)
+                / (N::constant(2.0) * d * arm.clone());
+            let sin = (N::constant(1.0) - cos.clone() * cos.clone()).sqrt();
+            (cos, sin)
+        }
+        Shape::Flat => {
+            let sin = (g.base_radius.clone() + face_offset.clone()) / d;
+            let cos = (N::constant(1.0) - sin.clone() * sin.clone()).sqrt();
+            (cos, sin)
+        }
+    };
+    turn(&inward, &cos, &signed(senses.swing, sin))
+}
+
+/// The follower at the lift `s` with `ds` = ds/dθ: where it touches the cam, in D.
+pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Placed<N> {
+    let sigma = senses.turning;
+    let kappa = senses.swing;
+    let one = N::constant(1.0);
+    let zero = N::constant(0.0);
+    match (senses.shape, &g.motion) {
+        (Shape::Point, _) => {
+            let (p, dp, motion) = match &g.motion {
+                Motion::Translating { offset } => {
+                    let rp = g.base_radius.clone() + g.roller.clone();
+                    let y0 = (rp.clone() * rp - offset.clone() * offset.clone()).sqrt();
+                    (
+                        [offset.clone(), y0 + s.clone()],
+                        [zero.clone(), ds.clone()],
+                        [zero, one],
+                    )
+                }
+                Motion::Oscillating { pivot, arm, .. } => {
+                    let u = arm_direction(g, senses, s);
+                    let ju = perp(&u);
+                    let p = add(pivot, &scale(arm, &u));
+                    let dp = scale(&signed(kappa, arm.clone() * ds.clone()), &ju);
+                    (p, dp, scale(&signed(kappa, one), &ju))
+                }
+            };
+            let tangent = sub(&dp, &scale(&N::constant(sigma), &perp(&p)));
+            let length = dot(&tangent, &tangent).sqrt();
+            let normal = scale(&(N::constant(sigma) / length), &perp(&tangent));
+            let contact = sub(&p, &scale(&g.roller, &normal));
+            Placed {
+                pitch: p,
+                contact,
+                normal,
+                motion,
+            }
+        }
+        (Shape::Flat, Motion::Translating { .. }) => {
+            // n = (0, 1), d = R_b + s, ω = −σ: Q = (σ s′, R_b + s).
+            let contact = [
+                signed(sigma, ds.clone()),
+                g.base_radius.clone() + s.clone(),
+            ];
+            Placed {
+                pitch: contact.clone(),
+                contact,
+                normal: [zero.clone(), one.clone()],
+                motion: [zero, one],
+            }
+        }
+        (Shape::Flat, Motion::Oscillating {
+            pivot, face_offset, ..
+        }) => {
+            let u = arm_direction(g, senses, s);
+            let n = signed(kappa, one.clone());
+            let normal = scale(&n, &perp(&u));
+            let jn = perp(&normal);
+            let d = dot(&normal, pivot) - face_offset.clone();
+            let rate = signed(kappa, ds.clone());
+            let dd = rate.clone() * dot(&jn, pivot);
+            let omega = rate - N::constant(sigma);
+            let contact = add(&scale(&d, &normal), &scale(&(dd / omega), &jn));
+            let arm = sub(&contact, pivot);
+            let reach = dot(&arm, &arm).sqrt();
+            let motion = scale(&signed(kappa, one / reach), &perp(&arm));
+            Placed {
+                pitch: contact.clone(),
+                contact,
+                normal,
+                motion,
+            }
+        }
+    }
+}
+
+/// u(φ) = u(φ₀) turned by κ s.
+fn arm_direction<N: Number>(g: &Geometry<N>, senses: Senses, s: &N) -> V<N> {
+    let u0 = base_direction(g, senses);
+    let angle = signed(senses.swing, s.clone());
+    turn(&u0, &angle.cos(), &angle.sin())
+}
+
+/// A point of D in the cam frame at the cam angle θ: R(−σθ) X, given cos(σθ) and sin(σθ).
+fn to_cam<N: Number>(x: &V<N>, cos: &N, sin: &N) -> V<N> {
+    turn(x, cos, &-sin.clone())
+}
+
+/// The profile of a design as a parametric curve (x(u), y(u)) of the cam frame, traced
+/// counterclockwise (the cam's material on its left, as parametric profiles are): the
+/// parameter u = −σθ, so the law is read at θ = −σu. Exact: the law is the tabulated leaf
+/// `law`, its slope the leaf's first derivative.
+pub fn profile_expressions(g: &Geometry<Scalar>, senses: Senses, law: &Arc<Tabulated>) -> [Scalar; 2] {
+    let theta = signed(-senses.turning, Scalar::Var);
+    let s = theta.clone().tabulated(law, 0);
+    let ds = theta.tabulated(law, 1);
+    let placed = place(g, senses, &s, &ds);
+    // R(−σθ) = R(u).
+    let (cos, sin) = (Scalar::Var.cos(), Scalar::Var.sin());
+    turn(&placed.contact, &cos, &sin)
+}
+
+/// A cam designed from a motion law, with its dimensions resolved to numbers: what the
+/// checks and the designer's outputs evaluate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CamDesign {
+    /// The follower's lift against the cam angle (m, or rad for an oscillating follower).
+    pub program: MotionProgram,
+    /// The same program as the tabulated function the profile's expressions read.
+    pub law: Arc<Tabulated>,
+    /// The dimensions.
+    pub geometry: Geometry<f64>,
+    /// Turning, swing and shape.
+    pub senses: Senses,
+    /// The largest pressure angle accepted without a warning (rad).
+    pub max_pressure_angle: f64,
+    /// The cam's nominal speed (rad/s), if the file gives it.
+    pub speed: Option<f64>,
+}
+
+/// Everything the designer reads at one cam angle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignPoint {
+    /// The cam angle θ (rad).
+    pub theta: f64,
+    /// s, ds/dθ, d²s/dθ², d³s/dθ³ (per rad^k): times ω^k the follower's displacement,
+    /// velocity, acceleration and jerk at the cam speed ω.
+    pub lift: [f64; 4],
+    /// The follower point (pitch curve) in the cam frame (m).
+    pub pitch: [f64; 2],
+    /// The contact point (the profile) in the cam frame (m).
+    pub contact: [f64; 2],
+    /// The pressure angle (rad): from the follower's direction of motion to the contact
+    /// normal, counterclockwise positive.
+    pub pressure_angle: f64,
+    /// The profile's radius of curvature (m), positive where it is convex; zero or negative
+    /// on a convex-turned cusp is undercutting.
+    pub radius_of_curvature: f64,
+    /// The pitch curve's radius of curvature (m), positive where convex (a knife or roller).
+    pub pitch_radius: f64,
+}
+
+impl CamDesign {
+    /// The design at the cam angle θ (rad), in closed form.
+    pub fn at(&self, theta: f64) -> DesignPoint {
+        let lift = self.program.eval(theta);
+        let (g, senses) = (&self.geometry, self.senses);
+        let placed = place(g, senses, &lift[0], &lift[1]);
+        let (cos, sin) = ((senses.turning * theta).cos(), (senses.turning * theta).sin());
+        let pressure = cross(&placed.motion, &placed.normal).atan2(dot(&placed.motion, &placed.normal));
+        let (radius, pitch_radius) = self.radii(&lift);
+        DesignPoint {
+            theta,
+            lift,
+            pitch: to_cam(&placed.pitch, &cos, &sin),
+            contact: to_cam(&placed.contact, &cos, &sin),
+            pressure_angle: pressure,
+            radius_of_curvature: radius,
+            pitch_radius,
+        }
+    }
+
+    /// (the profile's, the pitch curve's) radius of curvature for the lift and its
+    /// derivatives `l`, by the closed forms of the module's documentation.
+    fn radii(&self, l: &[f64; 4]) -> (f64, f64) {
+        let (g, sigma, kappa) = (&self.geometry, self.senses.turning, self.senses.swing);
+        match (self.senses.shape, &g.motion) {
+            (Shape::Point, motion) => {
+                let (p, dp, ddp) = match motion {
+                    Motion::Translating { offset } => {
+                        let rp = g.base_radius + g.roller;
+                        let y0 = (rp * rp - offset * offset).sqrt();
+                        ([*offset, y0 + l[0]], [0.0, l[1]], [0.0, l[2]])
+                    }
+                    Motion::Oscillating { pivot, arm, .. } => {
+                        let u = arm_direction(g, self.senses, &l[0]);
+                        let ju = perp(&u);
+                        let p = add(pivot, &scale(arm, &u));
+                        let dp = scale(&(kappa * arm * l[1]), &ju);
+                        let ddp = sub(&scale(&(kappa * arm * l[2]), &ju), &scale(&(arm * l[1] * l[1]), &u));
+                        (p, dp, ddp)
+                    }
+                };
+                let t = sub(&dp, &scale(&sigma, &perp(&p)));
+                let dt = sub(&ddp, &scale(&sigma, &perp(&dp)));
+                let speed2 = dot(&t, &t);
+                let pitch = -sigma * speed2 * speed2.sqrt() / (cross(&t, &dt) - sigma * speed2);
+                (pitch - g.roller, pitch)
+            }
+            (Shape::Flat, Motion::Translating { .. }) => {
+                let r = g.base_radius + l[0] + l[2];
+                (r, f64::NAN)
+            }
+            (Shape::Flat, Motion::Oscillating {
+                pivot, face_offset, ..
+            }) => {
+                let u = arm_direction(g, self.senses, &l[0]);
+                let n = scale(&kappa, &perp(&u));
+                let jn = perp(&n);
+                let (rate, acc) = (kappa * l[1], kappa * l[2]);
+                let d = dot(&n, pivot) - face_offset;
+                let dd = rate * dot(&jn, pivot);
+                let ddd = acc * dot(&jn, pivot) - rate * rate * dot(&n, pivot);
+                let omega = rate - sigma;
+                let r = d + (ddd / omega - dd * acc / (omega * omega)) / omega;
+                (r, f64::NAN)
+            }
+        }
+    }
+
+    /// `samples` + 1 evenly spaced design points over a turn, θ from 0 to 2π.
+    pub fn turn(&self, samples: usize) -> Vec<DesignPoint> {
+        (0..=samples)
+            .map(|k| self.at(std::f64::consts::TAU * k as f64 / samples.max(1) as f64))
+            .collect()
+    }
+
+    /// Where f is least over a turn: sampled at `samples` points and at every segment's
+    /// ends, then refined by golden-section search between the neighbours of the least
+    /// sample. Returns (θ, f(θ)).
+    pub fn least(&self, samples: usize, f: impl Fn(&DesignPoint) -> f64) -> (f64, f64) {
+        let tau = std::f64::consts::TAU;
+        let mut angles: Vec<f64> = (0..samples)
+            .map(|k| tau * k as f64 / samples.max(1) as f64)
+            .collect();
+        for &start in self.program.starts() {
+            angles.extend([start, (start + 1e-9).min(tau), (start - 1e-9).max(0.0)]);
+        }
+        angles.sort_by(f64::total_cmp);
+        let value = |theta: f64| f(&self.at(theta));
+        let (mut best, mut at) = (f64::INFINITY, 0usize);
+        for (k, &theta) in angles.iter().enumerate() {
+            let v = value(theta);
+            if v < best || (best.is_nan() && !v.is_nan()) {
+                best = v;
+                at = k;
+            }
+        }
+        let (mut a, mut b) = (
+            angles[at.saturating_sub(1)],
+            angles[(at + 1).min(angles.len() - 1)],
+        );
+        let ratio = (5f64.sqrt() - 1.0) / 2.0;
+        for _ in 0..60 {
+            let (c, d) = (b - ratio * (b - a), a + ratio * (b - a));
+            if value(c) < value(d) {
+                b = d;
+            } else {
+                a = c;
+            }
+        }
+        let mid = 0.5 * (a + b);
+        let refined = value(mid);
+        if refined < best {
+            (mid, refined)
+        } else {
+            (angles[at], best)
+        }
+    }
+}
+

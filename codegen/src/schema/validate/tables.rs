@@ -1,0 +1,334 @@
+//! Profiles through tables of points (`table:`): points written in the model file or read
+//! from a CSV file beside it, checked, and interpolated by a C² cubic spline
+//! (`camchain_runtime::spline`) that the profile's expressions read as a tabulated leaf.
+//!
+//! - explicit: x, y of y = f(x), x increasing; natural ends unless clamped (or periodic);
+//! - polar: θ, r of r(θ) over one turn, the last point repeating the first 2π later; always
+//!   periodic; θ in radians, or in degrees with `degrees: true`;
+//! - parametric: x, y of a curve in order along it, parametrised by the length of the
+//!   polygon through the points (chord length); closed (periodic) when the last point
+//!   repeats the first, and then turned counterclockwise if it was written clockwise (the cam's
+//!   material on the left, as for every parametric profile); natural ends when open.
+
+use super::{Checked, Context, Profile};
+use crate::error::ModelError;
+use crate::model::ModelFile;
+use crate::profile::{Scalar, Tabulated};
+use crate::schema::csv;
+use crate::schema::raw::{self, TableEnds, TableForm};
+use crate::schema::Files;
+use camchain_runtime::spline::{CLOSURE_TOLERANCE, Ends, Spline, SplineError};
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+/// Where one point of a table is written.
+#[derive(Debug, Clone)]
+enum At {
+    /// `points[k]` in the model file.
+    Inline(usize),
+    /// A line and column of a table file (shown as `file`).
+    File {
+        file: PathBuf,
+        line: usize,
+        column: usize,
+    },
+}
+
+/// The points of a table with where each is written.
+struct Points {
+    values: Vec<[f64; 2]>,
+    at: Vec<At>,
+    /// `file`'s path as the model writes it, for descriptions.
+    from: Option<String>,
+}
+
+/// The profile of `table` for contact `name` (path `path`), and the interval of its
+/// variable the table covers (the contact's default range).
+pub(super) fn table_profile(
+    cx: &Context,
+    path: &str,
+    table: &raw::Table,
+    name: &str,
+) -> Checked<(Profile, (f64, f64))> {
+    let field = format!("{path}.table");
+    let names = match table.form {
+        TableForm::Polar => ["theta", "r"],
+        TableForm::Explicit | TableForm::Parametric => ["x", "y"],
+    };
+    let points = points(cx, &field, table, names)?;
+    let ends = table.ends.map(ends_of);
+    let described = |what: &str| match &points.from {
+        Some(file) => format!("{what} through the {} points of {file}", points.values.len()),
+        None => format!("{what} through {} points", points.values.len()),
+    };
+    match table.form {
+        TableForm::Explicit => {
+            let (x, y) = columns(&points.values);
+            let spline = spline(cx, &field, &points, &x, &y, ends.unwrap_or(Ends::Natural))?;
+            let f = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
+            let range = (x[0], x[x.len() - 1]);
+            let source = described("a spline");
+            Ok((Profile::Explicit { source, f }, range))
+        }
+        TableForm::Polar => {
+            if let Some(other) = ends.filter(|e| *e != Ends::Periodic) {
+                return Err(cx.at.error(
+                    &format!("{field}.ends"),
+                    format!(
+                        "a polar table closes on itself: its ends are `Periodic`, not {other:?}"
+                    ),
+                ));
+            }
+            let scale = if table.degrees { TAU / 360.0 } else { 1.0 };
+            let (theta, r): (Vec<f64>, Vec<f64>) = points
+                .values
+                .iter()
+                .map(|p| (p[0] * scale, p[1]))
+                .unzip();
+            let spline = spline(cx, &field, &points, &theta, &r, Ends::Periodic)?;
+            one_turn(cx, &field, &points, &theta, table.degrees)?;
+            let r = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
+            let source = described("a periodic spline");
+            Ok((Profile::Polar { source, r }, (0.0, TAU)))
+        }
+        TableForm::Parametric => parametric(cx, &field, points, ends, name),
+    }
+}
+
+/// A parametric table: x(t) and y(t) splines of the chord length t.
+fn parametric(
+    cx: &Context,
+    field: &str,
+    mut points: Points,
+    ends: Option<Ends>,
+    name: &str,
+) -> Checked<(Profile, (f64, f64))> {
+    if let Some(Ends::Clamped { .. }) = ends {
+        return Err(cx.at.error(
+            &format!("{field}.ends"),
+            "a parametric table is open (`Natural`) or closed (`Periodic`); clamped ends take \
+             one slope each and a curve's ends need a direction",
+        ));
+    }
+    let n = points.values.len();
+    let meet = n > 1 && {
+        let (a, b) = (points.values[0], points.values[n - 1]);
+        let size = points
+            .values
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+        (a[0] - b[0]).hypot(a[1] - b[1]) <= CLOSURE_TOLERANCE * size.max(f64::MIN_POSITIVE)
+    };
+    let closed = match ends {
+        Some(e) => e == Ends::Periodic,
+        None => meet,
+    };
+    if closed && signed_area(&points.values) < 0.0 {
+        // Counterclockwise, so that the cam's material is on the left.
+        points.values.reverse();
+        points.at.reverse();
+    }
+    let mut t = Vec::with_capacity(n);
+    let mut length = 0.0;
+    for (k, p) in points.values.iter().enumerate() {
+        if k > 0 {
+            let q = points.values[k - 1];
+            let chord = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if chord == 0.0 {
+                return Err(point_error(
+                    cx,
+                    field,
+                    &points.at[k],
+                    format!(
+                        "point {k} repeats the point before it: a curve's points must differ \
+                         from their neighbours"
+                    ),
+                ));
+            }
+            length += chord;
+        }
+        t.push(length);
+    }
+    let ends = if closed { Ends::Periodic } else { Ends::Natural };
+    let (x, y) = columns(&points.values);
+    let sx = spline(cx, field, &points, &t, &x, ends)?;
+    let sy = spline(cx, field, &points, &t, &y, ends)?;
+    let what = if closed {
+        "a closed curve of chord-length splines"
+    } else {
+        "an open curve of chord-length splines"
+    };
+    let described = match &points.from {
+        Some(file) => format!("{what} through the {n} points of {file}"),
+        None => format!("{what} through {n} points"),
+    };
+    let profile = Profile::Parametric {
+        x_source: described.clone(),
+        y_source: described,
+        x: Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table_x"), sx), 0),
+        y: Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table_y"), sy), 0),
+    };
+    Ok((profile, (0.0, length)))
+}
+
+/// Twice the signed area of the closed polygon (positive counterclockwise).
+fn signed_area(p: &[[f64; 2]]) -> f64 {
+    (0..p.len())
+        .map(|k| {
+            let (a, b) = (p[k], p[(k + 1) % p.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum()
+}
+
+/// The spline's ends as the runtime names them.
+fn ends_of(ends: TableEnds) -> Ends {
+    match ends {
+        TableEnds::Natural => Ends::Natural,
+        TableEnds::Clamped { start, end } => Ends::Clamped { start, end },
+        TableEnds::Periodic => Ends::Periodic,
+    }
+}
+
+fn columns(values: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
+    values.iter().map(|p| (p[0], p[1])).unzip()
+}
+
+/// The spline through (x, y), its errors located at the point they concern.
+fn spline(
+    cx: &Context,
+    field: &str,
+    points: &Points,
+    x: &[f64],
+    y: &[f64],
+    ends: Ends,
+) -> Checked<Spline> {
+    Spline::new(x, y, ends).map_err(|e| {
+        let point = match &e {
+            SplineError::NotFinite { index, .. } | SplineError::NotIncreasing { index, .. } => {
+                Some(*index)
+            }
+            SplineError::EndsDoNotMeet { .. } => Some(x.len() - 1),
+            SplineError::TooFewPoints { .. } | SplineError::LengthMismatch { .. } => None,
+        };
+        match point.and_then(|k| points.at.get(k)) {
+            Some(at) => point_error(cx, field, at, e.to_string()),
+            None => cx.at.error(field, e.to_string()),
+        }
+    })
+}
+
+/// A polar table covers exactly one turn.
+fn one_turn(cx: &Context, field: &str, points: &Points, theta: &[f64], degrees: bool) -> Checked<()> {
+    let span = theta[theta.len() - 1] - theta[0];
+    if (span - TAU).abs() <= CLOSURE_TOLERANCE * TAU {
+        return Ok(());
+    }
+    let (shown, turn) = if degrees {
+        (span.to_degrees(), "360°")
+    } else {
+        (span, "2π rad")
+    };
+    let last = points.at.len() - 1;
+    Err(point_error(
+        cx,
+        field,
+        &points.at[last],
+        format!(
+            "a polar table covers one turn, its last point repeating the first {turn} later, \
+             but its angles span {shown}{}",
+            if degrees { "°" } else { " rad" }
+        ),
+    ))
+}
+
+/// The table's points, from the model file or from its CSV file.
+fn points(cx: &Context, field: &str, table: &raw::Table, names: [&str; 2]) -> Checked<Points> {
+    match (&table.points, &table.file) {
+        (Some(points), None) => Ok(Points {
+            values: points.iter().map(|&(a, b)| [a, b]).collect(),
+            at: (0..points.len()).map(At::Inline).collect(),
+            from: None,
+        }),
+        (None, Some(written)) => {
+            let (text, shown) = read_file(cx, &format!("{field}.file"), written)?;
+            let rows = csv::read(&text, names).map_err(|e| ModelError {
+                file: shown.clone(),
+                line: e.line,
+                column: e.column,
+                field: format!("{field}.file"),
+                message: e.message,
+            })?;
+            Ok(Points {
+                values: rows.iter().map(|r| r.values).collect(),
+                at: rows
+                    .iter()
+                    .map(|r| At::File {
+                        file: shown.clone(),
+                        line: r.line,
+                        column: r.columns[0],
+                    })
+                    .collect(),
+                from: Some(written.clone()),
+            })
+        }
+        _ => Err(cx.at.error(
+            field,
+            "a table gives its points either in the file (`points: [(x, y), …]`) or in a CSV \
+             file (`file: \"cam.csv\"`, relative to the model file): exactly one of them",
+        )),
+    }
+}
+
+/// An error about one point of a table.
+fn point_error(cx: &Context, field: &str, at: &At, message: String) -> ModelError {
+    match at {
+        At::Inline(k) => cx.at.error(&format!("{field}.points[{k}]"), message),
+        At::File { file, line, column } => ModelError {
+            file: file.clone(),
+            line: *line,
+            column: *column,
+            field: format!("{field}.file"),
+            message,
+        },
+    }
+}
+
+/// The text of the file the model names `written`, and the path its messages show (beside
+/// the model file's); recorded among the files the model read.
+fn read_file(cx: &Context, field: &str, written: &str) -> Checked<(String, PathBuf)> {
+    let beside = cx.at.file.parent().unwrap_or(Path::new(""));
+    let shown = beside.join(written);
+    let (text, path) = match cx.files {
+        Files::BesideModel => (std::fs::read_to_string(&shown), shown.clone()),
+        Files::In(dir) => {
+            let path = dir.join(written);
+            (std::fs::read_to_string(&path), path)
+        }
+        Files::Embedded(list) => match list.iter().find(|(name, _)| *name == written) {
+            Some((_, text)) => (Ok((*text).to_string()), PathBuf::new()),
+            None => (
+                Err(std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    "not among the files embedded with the model",
+                )),
+                PathBuf::new(),
+            ),
+        },
+    };
+    let text = text.map_err(|e| {
+        cx.at.error(
+            field,
+            format!(
+                "cannot read the table file `{written}` ({}): {e}",
+                shown.display()
+            ),
+        )
+    })?;
+    cx.read.borrow_mut().push(ModelFile {
+        written: written.to_string(),
+        path,
+        text: text.clone(),
+    });
+    Ok((text, shown))
+}
