@@ -265,10 +265,7 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
         }
         (Shape::Flat, Motion::Translating { .. }) => {
             // n = (0, 1), d = R_b + s, ω = −σ: Q = (σ s′, R_b + s).
-            let contact = [
-                signed(sigma, ds.clone()),
-                g.base_radius.clone() + s.clone(),
-            ];
+            let contact = [signed(sigma, ds.clone()), g.base_radius.clone() + s.clone()];
             Placed {
                 pitch: contact.clone(),
                 contact,
@@ -276,9 +273,12 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
                 motion: [zero, one],
             }
         }
-        (Shape::Flat, Motion::Oscillating {
-            pivot, face_offset, ..
-        }) => {
+        (
+            Shape::Flat,
+            Motion::Oscillating {
+                pivot, face_offset, ..
+            },
+        ) => {
             let u = arm_direction(g, senses, s);
             let n = signed(kappa, one.clone());
             let normal = scale(&n, &perp(&u));
@@ -317,7 +317,11 @@ fn to_cam<N: Number>(x: &V<N>, cos: &N, sin: &N) -> V<N> {
 /// counterclockwise (the cam's material on its left, as parametric profiles are): the
 /// parameter u = −σθ, so the law is read at θ = −σu. Exact: the law is the tabulated leaf
 /// `law`, its slope the leaf's first derivative.
-pub fn profile_expressions(g: &Geometry<Scalar>, senses: Senses, law: &Arc<Tabulated>) -> [Scalar; 2] {
+pub fn profile_expressions(
+    g: &Geometry<Scalar>,
+    senses: Senses,
+    law: &Arc<Tabulated>,
+) -> [Scalar; 2] {
     let theta = signed(-senses.turning, Scalar::Var);
     let s = theta.clone().tabulated(law, 0);
     let ds = theta.tabulated(law, 1);
@@ -373,8 +377,12 @@ impl CamDesign {
         let lift = self.program.eval(theta);
         let (g, senses) = (&self.geometry, self.senses);
         let placed = place(g, senses, &lift[0], &lift[1]);
-        let (cos, sin) = ((senses.turning * theta).cos(), (senses.turning * theta).sin());
-        let pressure = cross(&placed.motion, &placed.normal).atan2(dot(&placed.motion, &placed.normal));
+        let (cos, sin) = (
+            (senses.turning * theta).cos(),
+            (senses.turning * theta).sin(),
+        );
+        let pressure =
+            cross(&placed.motion, &placed.normal).atan2(dot(&placed.motion, &placed.normal));
         let (radius, pitch_radius) = self.radii(&lift);
         DesignPoint {
             theta,
@@ -404,7 +412,10 @@ impl CamDesign {
                         let ju = perp(&u);
                         let p = add(pivot, &scale(arm, &u));
                         let dp = scale(&(kappa * arm * l[1]), &ju);
-                        let ddp = sub(&scale(&(kappa * arm * l[2]), &ju), &scale(&(arm * l[1] * l[1]), &u));
+                        let ddp = sub(
+                            &scale(&(kappa * arm * l[2]), &ju),
+                            &scale(&(arm * l[1] * l[1]), &u),
+                        );
                         (p, dp, ddp)
                     }
                 };
@@ -418,9 +429,12 @@ impl CamDesign {
                 let r = g.base_radius + l[0] + l[2];
                 (r, f64::NAN)
             }
-            (Shape::Flat, Motion::Oscillating {
-                pivot, face_offset, ..
-            }) => {
+            (
+                Shape::Flat,
+                Motion::Oscillating {
+                    pivot, face_offset, ..
+                },
+            ) => {
                 let u = arm_direction(g, self.senses, &l[0]);
                 let n = scale(&kappa, &perp(&u));
                 let jn = perp(&n);
@@ -485,4 +499,3 @@ impl CamDesign {
         }
     }
 }
-

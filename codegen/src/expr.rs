@@ -920,11 +920,18 @@ impl Graph {
 
     /// Evaluates the given roots with `vars[i]` the value of variable i (the interpreter).
     ///
-    /// Only nodes up to the largest root are computed, in id (= topological) order.
+    /// Only the nodes the roots depend on are computed, in id (= topological) order.
     pub fn eval(&self, roots: &[Id], vars: &[f64]) -> Vec<f64> {
         let last = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
+        // Only what the roots depend on: an implicit variable they do not need is not solved
+        // (its solve evaluates its own residual, which may hold earlier implicit variables).
+        let needed = self.reachable_until(roots, &HashSet::new());
         let mut values: Vec<f64> = Vec::with_capacity(last);
-        for node in &self.nodes[..last] {
+        for (index, node) in self.nodes[..last].iter().enumerate() {
+            if !needed[index] {
+                values.push(f64::NAN);
+                continue;
+            }
             let v = |id: &Id| values[id.index()];
             let value: f64 = match node {
                 Node::Const(bits) => f64::from_bits(*bits),

@@ -90,7 +90,10 @@ pub fn design_warnings(index: usize, name: &str, design: &CamDesign) -> Vec<Warn
         out.push(Warning {
             field: format!("contacts[{index}].law.segments[{}]", jump.segment),
             message: format!(
-                "contact `{name}`: the follower's acceleration jumps by {:.4e} per rad²{at_speed}                  where this segment starts (cam angle {:.3}°): an infinite jerk; laws that start                  and end at zero acceleration (cycloidal, 3-4-5, 4-5-6-7, modified trapezoid,                  modified sine) avoid it",
+                "contact `{name}`: the follower's acceleration jumps by {:.4e} per rad²{at_speed} \
+                 where this segment starts (cam angle {:.3}°): an infinite jerk; laws that start \
+                 and end at zero acceleration (cycloidal, 3-4-5, 4-5-6-7, modified trapezoid, \
+                 modified sine) avoid it",
                 jump.size,
                 jump.angle.to_degrees()
             ),
@@ -102,7 +105,9 @@ pub fn design_warnings(index: usize, name: &str, design: &CamDesign) -> Vec<Warn
         out.push(Warning {
             field: format!("contacts[{index}].law"),
             message: format!(
-                "contact `{name}`: the pressure angle reaches {:.2}° at cam angle {:.3}°, above                  the limit of {:.1}° (`max_pressure_angle`): the follower is pushed sideways                  more than along its motion; a larger base circle lowers it",
+                "contact `{name}`: the pressure angle reaches {:.2}° at cam angle {:.3}°, above \
+                 the limit of {:.1}° (`max_pressure_angle`): the follower is pushed sideways \
+                 more than along its motion; a larger base circle lowers it",
                 largest.to_degrees(),
                 theta.to_degrees(),
                 design.max_pressure_angle.to_degrees()

@@ -113,11 +113,7 @@ fn header(cells: &[(usize, &str)], names: [&str; 2], line: usize) -> Result<(), 
         message: format!(
             "the header names the columns `{}`, but this table's columns are `{}, {}` (or write \
              no header)",
-            cells
-                .iter()
-                .map(|(_, c)| *c)
-                .collect::<Vec<_>>()
-                .join(", "),
+            cells.iter().map(|(_, c)| *c).collect::<Vec<_>>().join(", "),
             names[0],
             names[1]
         ),

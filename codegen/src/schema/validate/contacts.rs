@@ -411,10 +411,7 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
             [
                 super::location(cx.at, &format!("{path}.follower.radius")),
                 super::location(cx.at, &format!("{path}.follower")),
-                super::location(
-                    cx.at,
-                    &format!("{path}.{}", profile_field(contact)),
-                ),
+                super::location(cx.at, &format!("{path}.{}", profile_field(contact))),
             ],
         ));
     }

@@ -162,7 +162,10 @@ fn program(cx: &Context, field: &str, segments: &[LawSegment]) -> Checked<Motion
                 format!("{field}.segments[{index}]")
             }
             LawError::DoesNotReturn { .. } => {
-                format!("{field}.segments[{}].lift", segments.len().saturating_sub(1))
+                format!(
+                    "{field}.segments[{}].lift",
+                    segments.len().saturating_sub(1)
+                )
             }
             LawError::Empty | LawError::NotATurn { .. } => format!("{field}.segments"),
         };

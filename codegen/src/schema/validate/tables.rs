@@ -14,9 +14,9 @@ use super::{Checked, Context, Profile};
 use crate::error::ModelError;
 use crate::model::ModelFile;
 use crate::profile::{Scalar, Tabulated};
+use crate::schema::Files;
 use crate::schema::csv;
 use crate::schema::raw::{self, TableEnds, TableForm};
-use crate::schema::Files;
 use camchain_runtime::spline::{CLOSURE_TOLERANCE, Ends, Spline, SplineError};
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
@@ -58,7 +58,10 @@ pub(super) fn table_profile(
     let points = points(cx, &field, table, names)?;
     let ends = table.ends.map(ends_of);
     let described = |what: &str| match &points.from {
-        Some(file) => format!("{what} through the {} points of {file}", points.values.len()),
+        Some(file) => format!(
+            "{what} through the {} points of {file}",
+            points.values.len()
+        ),
         None => format!("{what} through {} points", points.values.len()),
     };
     match table.form {
@@ -80,11 +83,8 @@ pub(super) fn table_profile(
                 ));
             }
             let scale = if table.degrees { TAU / 360.0 } else { 1.0 };
-            let (theta, r): (Vec<f64>, Vec<f64>) = points
-                .values
-                .iter()
-                .map(|p| (p[0] * scale, p[1]))
-                .unzip();
+            let (theta, r): (Vec<f64>, Vec<f64>) =
+                points.values.iter().map(|p| (p[0] * scale, p[1])).unzip();
             let spline = spline(cx, &field, &points, &theta, &r, Ends::Periodic)?;
             one_turn(cx, &field, &points, &theta, table.degrees)?;
             let r = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
@@ -149,7 +149,11 @@ fn parametric(
         }
         t.push(length);
     }
-    let ends = if closed { Ends::Periodic } else { Ends::Natural };
+    let ends = if closed {
+        Ends::Periodic
+    } else {
+        Ends::Natural
+    };
     let (x, y) = columns(&points.values);
     let sx = spline(cx, field, &points, &t, &x, ends)?;
     let sy = spline(cx, field, &points, &t, &y, ends)?;
@@ -219,7 +223,13 @@ fn spline(
 }
 
 /// A polar table covers exactly one turn.
-fn one_turn(cx: &Context, field: &str, points: &Points, theta: &[f64], degrees: bool) -> Checked<()> {
+fn one_turn(
+    cx: &Context,
+    field: &str,
+    points: &Points,
+    theta: &[f64],
+    degrees: bool,
+) -> Checked<()> {
     let span = theta[theta.len() - 1] - theta[0];
     if (span - TAU).abs() <= CLOSURE_TOLERANCE * TAU {
         return Ok(());
