@@ -225,8 +225,8 @@ impl Config {
 
     /// Also writes `<out dir>/<name>`, a file that declares one `pub mod` per compiled
     /// model, `ALL`, a table of every model by name, and `OP_COUNTS`, every model's
-    /// operation counts (and `SOURCES`, every model's text, with
-    /// [`Config::embed_model_source`]), for `include!` in one place:
+    /// operation counts (and `SOURCES`, every model's text, and `FILES`, the files each
+    /// names, with [`Config::embed_model_source`]), for `include!` in one place:
     /// `include!(concat!(env!("OUT_DIR"), "/camchain/models.rs"));`.
     pub fn include_file(&mut self, name: impl Into<PathBuf>) -> &mut Self {
         self.include_file = Some(name.into());
@@ -234,7 +234,8 @@ impl Config {
     }
 
     /// Embeds each model file's text in its module as `pub const MODEL_SOURCE: &str` (for a
-    /// program that also wants the description at run time). Off by default.
+    /// program that also wants the description at run time), and the files it names (its
+    /// tables of points) as `pub const MODEL_FILES: &[(&str, &str)]`. Off by default.
     pub fn embed_model_source(&mut self, embed: bool) -> &mut Self {
         self.embed_source = embed;
         self
@@ -413,8 +414,19 @@ impl Config {
         if self.embed_source {
             options.embedded_source = Some(text.clone());
         }
+        let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
+        options.files_dir = Some(dir.clone());
         let generated = generate_source(&text, shown, &options)?;
-        let model = camchain_codegen::schema::parse_model(&text, shown)?;
+        let model = camchain_codegen::schema::parse_model_from(
+            &text,
+            shown,
+            &[],
+            options.parameters,
+            camchain_codegen::schema::Files::In(&dir),
+        )?;
+        for named in &model.files {
+            self.rerun_if_changed(&named.path);
+        }
         let warnings = camchain_codegen::located_warnings(&model, &text, shown)
             .iter()
             .map(ToString::to_string)
@@ -561,6 +573,18 @@ fn index_file(compiled: &[CompiledModel], runtime_path: &str, sources: bool) -> 
         for model in compiled {
             text.push_str(&format!(
                 "    ({:?}, {}::MODEL_SOURCE),\n",
+                model.name, model.module
+            ));
+        }
+        text.push_str("];\n");
+        text.push_str(
+            "\n/// The files every model names (its tables of points) by model name: (the path \
+             the model writes, the text) (`Config::embed_model_source`).\n\
+             pub static FILES: &[(&str, &[(&str, &str)])] = &[\n",
+        );
+        for model in compiled {
+            text.push_str(&format!(
+                "    ({:?}, {}::MODEL_FILES),\n",
                 model.name, model.module
             ));
         }

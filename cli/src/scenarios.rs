@@ -94,7 +94,16 @@ pub fn short(x: f64) -> String {
 pub fn builtin_model(name: &str) -> Result<Model, String> {
     let source =
         camchain_models::source(name).ok_or_else(|| format!("no built-in model `{name}`"))?;
-    parse(source, &Path::new("models").join(format!("{name}.ron")))
+    let file = Path::new("models").join(format!("{name}.ron"));
+    let files = camchain_codegen::schema::Files::Embedded(camchain_models::files(name));
+    camchain_codegen::schema::parse_model_from(
+        source,
+        &file,
+        &[],
+        camchain_codegen::model::ParameterMode::AsDeclared,
+        files,
+    )
+    .map_err(|e| e.to_string().replace('\n', " "))
 }
 
 /// A two-link arm (1 m links) hanging from the origin with its tip on the flat cam

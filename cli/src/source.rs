@@ -9,7 +9,7 @@ use super::CliError;
 use super::kinematics::Geometry;
 use camchain_codegen::ParameterMode;
 use camchain_codegen::model::Model;
-use camchain_codegen::schema::{parse_model, parse_model_with};
+use camchain_codegen::schema::{Files, parse_model_from};
 use camchain_models as models;
 use camchain_reference::NumericModel;
 use camchain_runtime::Dynamics;
@@ -73,12 +73,26 @@ pub fn builtin_file(name: &str) -> PathBuf {
     Path::new("models").join(format!("{name}.ron"))
 }
 
+/// Where a built-in model's named files (its tables of points) are: compiled into the
+/// binary with its text.
+pub fn builtin_files(name: &str) -> Files<'static> {
+    Files::Embedded(models::files(name))
+}
+
 /// The validated description of a built-in model, parsed from the text compiled into the
 /// binary (for drawing it and for `--numeric`).
 pub fn builtin_description(name: &str) -> Result<Model, CliError> {
     let source =
         models::source(name).ok_or_else(|| CliError::Usage(format!("unknown model `{name}`")))?;
-    parse_model(source, &builtin_file(name)).map_err(|e| {
+    let (overrides, mode) = (&[], ParameterMode::AsDeclared);
+    parse_model_from(
+        source,
+        &builtin_file(name),
+        overrides,
+        mode,
+        builtin_files(name),
+    )
+    .map_err(|e| {
         let text = e.to_string().replace('\n', " ");
         CliError::Failed(format!("invalid built-in model: {text}"))
     })
@@ -125,20 +139,20 @@ pub fn load_with(
         loaded.geometry = described_with(arg, values).and_then(|m| Geometry::new(&m));
         return Ok(loaded);
     }
-    let (source, file) = if looks_like_path(arg) {
+    let (source, file, files) = if looks_like_path(arg) {
         let file = PathBuf::from(arg);
         let source = std::fs::read_to_string(&file).map_err(|e| {
             CliError::Failed(format!("cannot read model file {}: {e}", file.display()))
         })?;
-        (source, file)
+        (source, file, Files::BesideModel)
     } else {
         let source =
             models::source(arg).ok_or_else(|| CliError::Usage(format!("unknown model `{arg}`")))?;
-        (source.to_string(), builtin_file(arg))
+        (source.to_string(), builtin_file(arg), builtin_files(arg))
     };
     // The file as the build checks it first (its own values), then with the given ones.
     let mut loaded = load(arg, numeric)?;
-    let model = parse_model_with(&source, &file, values, ParameterMode::AllAtRunTime)
+    let model = parse_model_from(&source, &file, values, ParameterMode::AllAtRunTime, files)
         .map_err(|e| given(e.to_string().replace('\n', " ")))?;
     loaded.geometry = Geometry::new(&model);
     loaded.engine = Engine::Numeric(Box::new(NumericModel::new(model)));
@@ -148,11 +162,12 @@ pub fn load_with(
 /// A built-in model's description with other parameter values (for drawing it).
 fn described_with(name: &str, values: &[(String, f64)]) -> Result<Model, String> {
     let source = models::source(name).ok_or_else(|| format!("unknown model `{name}`"))?;
-    parse_model_with(
+    parse_model_from(
         source,
         &builtin_file(name),
         values,
         ParameterMode::AllAtRunTime,
+        builtin_files(name),
     )
     .map_err(|e| e.to_string())
 }

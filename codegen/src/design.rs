@@ -347,6 +347,9 @@ pub struct CamDesign {
     pub max_pressure_angle: f64,
     /// The cam's nominal speed (rad/s), if the file gives it.
     pub speed: Option<f64>,
+    /// The nominal speed as the file writes it: [`Scalar::Param`] `i` is the model's
+    /// parameter i (what sets the speed, for running the cam at another one).
+    pub speed_expression: Option<Scalar>,
 }
 
 /// Everything the designer reads at one cam angle.
@@ -447,6 +450,28 @@ impl CamDesign {
                 (r, f64::NAN)
             }
         }
+    }
+
+    /// The profile as a table of points for `table: (form: Parametric, file: …)` or a
+    /// machine: a CSV text with a header `x,y` (m, cam frame), `points` points at evenly
+    /// spaced cam angles and the first repeated at the end (a closed curve), each number in
+    /// Rust's shortest form that reads back to the same `f64`; `#` lines say what it is.
+    pub fn profile_table(&self, points: usize, what: &str) -> String {
+        let points = points.max(3);
+        let mut out = format!(
+            "# {what}\n# the cam profile in the cam frame (m), {points} points at cam angles \
+             k·360°/{points} and the first again at 360° (a closed curve)\nx,y\n"
+        );
+        let rows: Vec<[f64; 2]> = (0..points)
+            .map(|k| {
+                self.at(std::f64::consts::TAU * k as f64 / points as f64)
+                    .contact
+            })
+            .collect();
+        for p in rows.iter().chain(rows.first()) {
+            out.push_str(&format!("{:?},{:?}\n", p[0], p[1]));
+        }
+        out
     }
 
     /// `samples` + 1 evenly spaced design points over a turn, θ from 0 to 2π.

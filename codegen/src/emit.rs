@@ -94,6 +94,9 @@ pub struct EmitOptions {
     /// Which parameters the generated code reads at run time (the file's `constant:` flags
     /// by default).
     pub parameters: crate::model::ParameterMode,
+    /// The directory the files a model names (its tables of points) are read from: the model
+    /// file's own. `None`: the directory of the path messages show.
+    pub files_dir: Option<std::path::PathBuf>,
 }
 
 impl Default for EmitOptions {
@@ -103,6 +106,7 @@ impl Default for EmitOptions {
             entry_points: EntryPoints::Auto,
             embedded_source: None,
             parameters: crate::model::ParameterMode::AsDeclared,
+            files_dir: None,
         }
     }
 }
@@ -229,6 +233,19 @@ pub fn generate_with(
              {ALLOW_UNUSED}\n\
              pub const MODEL_SOURCE: &str = {};",
             raw_string(text)
+        );
+        let files: Vec<String> = model
+            .files
+            .iter()
+            .map(|f| format!("({:?}, {})", f.written, raw_string(&f.text)))
+            .collect();
+        let _ = writeln!(
+            file,
+            "/// The files the model file names (its tables of points), as read: (the path \
+             it writes, the text).\n\
+             {ALLOW_UNUSED}\n\
+             pub const MODEL_FILES: &[(&str, &str)] = &[{}];",
+            files.join(", ")
         );
     }
     file.push_str(&info_static(model));

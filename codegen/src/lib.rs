@@ -68,7 +68,16 @@ pub fn read_model_file(path: &Path, display: &Path) -> Result<String, ModelError
 /// file (`file:line:column: field: message`). The command line runs it on a model file before
 /// simulating it on the numeric reference, so that both report the same problems.
 pub fn check_source(source: &str, display: &Path) -> Result<Model, ModelError> {
-    let model = schema::parse_model(source, display)?;
+    check_source_in(source, display, schema::Files::BesideModel)
+}
+
+/// [`check_source`] reading the files the model names (its tables of points) from `files`.
+pub fn check_source_in(
+    source: &str,
+    display: &Path,
+    files: schema::Files,
+) -> Result<Model, ModelError> {
+    let model = schema::parse_model_from(source, display, &[], ParameterMode::AsDeclared, files)?;
     check_assembly(&model, source, display)?;
     Ok(model)
 }
@@ -99,7 +108,11 @@ pub fn generate_source(
     display: &Path,
     options: &EmitOptions,
 ) -> Result<Generated, ModelError> {
-    let model = schema::parse_model_with(source, display, &[], options.parameters)?;
+    let files = match &options.files_dir {
+        Some(dir) => schema::Files::In(dir),
+        None => schema::Files::BesideModel,
+    };
+    let model = schema::parse_model_from(source, display, &[], options.parameters, files)?;
     if !schema::is_identifier(&model.name) {
         return Err(schema::field_error(
             display,

@@ -29,6 +29,16 @@ pub fn source(name: &str) -> Option<&'static str> {
     SOURCES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
+/// The files a built-in model's file names (its tables of points), by model name: (the path
+/// the model writes, the text), for parsing its [`source`] with
+/// `camchain_codegen::schema::Files::Embedded`.
+pub fn files(name: &str) -> &'static [(&'static str, &'static str)] {
+    FILES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map_or(&[], |(_, f)| *f)
+}
+
 /// Random models of the property tests (`tests/random_models/`, written by
 /// `reference/tests/random_models.rs`), compiled like the built-in ones so that
 /// `tests/random_compiled.rs` checks the emitted Rust itself against the numeric reference.

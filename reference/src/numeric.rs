@@ -23,7 +23,7 @@ use camchain_codegen::ModelError;
 use camchain_codegen::model::{
     Body, Contact, Follower, IntegratorChoice, JointKind, Model, ParameterMode, Profile,
 };
-use camchain_codegen::schema::{load_model, parse_model_with};
+use camchain_codegen::schema::{Files, load_model, parse_model_from};
 use camchain_runtime::{
     ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
     Energy, FollowerKind, InitialGuess, IntegratorKind, ModelInfo, ParameterInfo, ProfileKind,
@@ -348,14 +348,27 @@ impl NumericModel {
         Self::from_source_with(&source, path, overrides, mode)
     }
 
-    /// [`NumericModel::load_with`] on the text of a model file (`file` names it in errors).
+    /// [`NumericModel::load_with`] on the text of a model file (`file` names it in errors;
+    /// the files it names are read beside it).
     pub fn from_source_with(
         source: &str,
         file: &Path,
         overrides: &[(String, f64)],
         mode: ParameterMode,
     ) -> Result<Self, ModelError> {
-        parse_model_with(source, file, overrides, mode).map(Self::new)
+        Self::from_source_in(source, file, overrides, mode, Files::BesideModel)
+    }
+
+    /// [`NumericModel::from_source_with`] reading the files the model names (its tables of
+    /// points) from `files` (a built-in model's, embedded in the program).
+    pub fn from_source_in(
+        source: &str,
+        file: &Path,
+        overrides: &[(String, f64)],
+        mode: ParameterMode,
+        files: Files,
+    ) -> Result<Self, ModelError> {
+        parse_model_from(source, file, overrides, mode, files).map(Self::new)
     }
 
     /// The model this reference evaluates.

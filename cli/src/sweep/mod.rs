@@ -21,8 +21,9 @@ use super::CliError;
 use super::args::{SweepArgs, integrator_name};
 use super::interrupt::Interrupt;
 use super::output;
-use super::source::{builtin_description, builtin_file, builtin_names};
+use super::source::{builtin_description, builtin_file, builtin_files, builtin_names};
 use camchain_codegen::ParameterMode;
+use camchain_codegen::schema::Files;
 use camchain_models as models;
 use camchain_reference::NumericModel;
 use camchain_runtime::{Dynamics, MetricsOptions, ParameterInfo, SimSettings, Simulate};
@@ -53,6 +54,8 @@ pub enum Factory {
         source: String,
         /// The file as messages name it.
         file: PathBuf,
+        /// Where the files it names are read from.
+        files: Files<'static>,
     },
 }
 
@@ -63,10 +66,15 @@ impl Factory {
             Factory::Generated { constructor, .. } => {
                 constructor(values).map_err(|e| e.to_string())
             }
-            Factory::Numeric { source, file } => {
+            Factory::Numeric {
+                source,
+                file,
+                files,
+            } => {
                 let owned: Vec<(String, f64)> =
                     values.iter().map(|(n, v)| (n.to_string(), *v)).collect();
-                NumericModel::from_source_with(source, file, &owned, ParameterMode::AllAtRunTime)
+                let mode = ParameterMode::AllAtRunTime;
+                NumericModel::from_source_in(source, file, &owned, mode, *files)
                     .map(|m| Box::new(m) as Box<dyn Dynamics + Send + Sync>)
                     .map_err(|e| e.to_string().replace('\n', " "))
             }
@@ -198,7 +206,8 @@ fn resolve_model(args: &SweepArgs) -> Result<Resolved, CliError> {
         if args.numeric {
             let source = models::source(arg).unwrap_or_default().to_string();
             let file = builtin_file(arg);
-            return numeric(arg.to_string(), format!("{arg}_numeric"), source, file);
+            let label = format!("{arg}_numeric");
+            return numeric(arg.to_string(), label, source, file, builtin_files(arg));
         }
         let constructor = models::WITH_PARAMETERS
             .iter()
@@ -228,7 +237,13 @@ fn resolve_model(args: &SweepArgs) -> Result<Resolved, CliError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "model".to_string());
-    numeric(label.clone(), label, source, path.to_path_buf())
+    numeric(
+        label.clone(),
+        label,
+        source,
+        path.to_path_buf(),
+        Files::BesideModel,
+    )
 }
 
 /// A model on the numeric reference: validated once now with its file's values.
@@ -237,10 +252,12 @@ fn numeric(
     label: String,
     source: String,
     file: PathBuf,
+    files: Files<'static>,
 ) -> Result<Resolved, CliError> {
-    let checked = camchain_codegen::check_source(&source, &file)
+    let checked = camchain_codegen::check_source_in(&source, &file, files)
         .map_err(|e| CliError::Failed(e.to_string().replace('\n', " ")))?;
-    let model = NumericModel::from_source_with(&source, &file, &[], ParameterMode::AllAtRunTime)
+    let mode = ParameterMode::AllAtRunTime;
+    let model = NumericModel::from_source_in(&source, &file, &[], mode, files)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let info = model.info();
     let structural = checked
@@ -258,7 +275,11 @@ fn numeric(
     Ok((
         name,
         label,
-        Factory::Numeric { source, file },
+        Factory::Numeric {
+            source,
+            file,
+            files,
+        },
         parameters,
         structural,
         defaults,

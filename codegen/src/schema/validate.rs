@@ -200,8 +200,8 @@ fn parameters(file: &raw::Model, options: &Options, at: &Locator) -> Checked<Vec
     Ok(out)
 }
 
-/// The parameters used by fields that must be constant (joint axes, cam plane axes): they
-/// stay folded in [`ParameterMode::AllAtRunTime`].
+/// The parameters used by fields that must be constant (joint axes, cam plane axes, a motion
+/// law's segments): they stay folded in [`ParameterMode::AllAtRunTime`].
 fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usize> {
     let names: Vec<&str> = parameters.iter().map(|p| p.name.as_str()).collect();
     let axes =
@@ -219,7 +219,19 @@ fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usi
                     .chain(c.frame.y_axis.iter())
                     .chain(face)
             }));
+    // A motion law's segments are data of the generated code (angles and lifts).
+    let segments = file
+        .contacts
+        .iter()
+        .filter_map(|c| c.law.as_ref())
+        .flat_map(|law| law.segments.iter())
+        .flat_map(|segment| match segment {
+            raw::LawSegment::Dwell { degrees } => vec![degrees],
+            raw::LawSegment::Rise { lift, degrees, .. }
+            | raw::LawSegment::Return { lift, degrees, .. } => vec![lift, degrees],
+        });
     let mut used: Vec<usize> = axes
+        .chain(segments)
         .filter_map(|n| match n {
             raw::Number::Expr(source) => parse_expression_with(source, None, &names).ok(),
             raw::Number::Value(_) => None,
@@ -321,6 +333,14 @@ impl<'a> Table<'a> {
         let folded = parsed.resolve(&self.values, &|i| self.constant[i]);
         let resolved = parsed.resolve_all(&self.values);
         Ok((folded, resolved))
+    }
+
+    /// An expression of the parameters as written, none folded (`Scalar::Param` `i` is
+    /// parameter i).
+    fn parsed(&self, field: &str, source: &str) -> Checked<Scalar> {
+        let names: Vec<&str> = self.names.iter().map(String::as_str).collect();
+        parse_expression_with(source, None, &names)
+            .map_err(|e| self.at.error_in_string(field, e.offset, e.message))
     }
 
     /// An applied joint load: an expression of `t`, the parameters, the coordinates (named

@@ -56,7 +56,16 @@ pub(super) fn law_profile(
     }
     .to_radians();
     let speed = match &law.speed {
-        Some(n) => Some(cx.positive_constant(&format!("{field}.speed"), n, "the cam's speed")?),
+        Some(n) => {
+            let at = format!("{field}.speed");
+            let (_, value) = cx.dimension(&at, n)?;
+            super::positive(cx.at, &at, "the cam's nominal speed", value)?;
+            let expression = match n {
+                raw::Number::Value(v) => Scalar::Const(*v),
+                raw::Number::Expr(source) => cx.table.parsed(&at, source)?,
+            };
+            Some((value, expression))
+        }
         None => None,
     };
     let tabulated = Tabulated::law(format!("{name}_law"), program.clone());
@@ -66,7 +75,8 @@ pub(super) fn law_profile(
         geometry: resolved,
         senses,
         max_pressure_angle,
-        speed,
+        speed: speed.as_ref().map(|s| s.0),
+        speed_expression: speed.map(|s| s.1),
     };
     can_be_made(cx, path, name, &design)?;
     let [x, y] = design::profile_expressions(&folded, senses, &tabulated);
