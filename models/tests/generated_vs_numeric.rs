@@ -23,23 +23,6 @@ use common::{Rng, compare_dynamics, max_rel_diff};
 /// is ~1e-4).
 const TOL: f64 = 1e-12;
 
-/// The agreement demanded of a model whose profile is a table of points: the generated code
-/// evaluates the runtime's spline (second derivatives at the knots by the Thomas algorithm)
-/// and the reference its own (slopes by a dense LU solve, the Hermite form). Their second
-/// derivatives carry the rounding of the table's values divided by the points' spacing
-/// squared, ε·|y|/(h²|S″|): for table_cam (|y| ≈ 0.05 m, h ≈ 0.35 mm, |S″| ≈ 18/m) about
-/// 5e-12 relative in the curvature; 1e-10 leaves a margin of 20.
-const TOL_TABLE: f64 = 1e-10;
-
-/// True when a contact's profile is a table of points.
-fn tabulated(model: &NumericModel) -> bool {
-    model
-        .model()
-        .contacts
-        .iter()
-        .any(|c| matches!(c.profile_expression(), camchain_codegen::profile::Scalar::Table(..)))
-}
-
 #[test]
 fn every_generated_model_agrees_with_the_numeric_recursion() {
     assert!(
@@ -50,7 +33,7 @@ fn every_generated_model_agrees_with_the_numeric_recursion() {
         let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
         let numeric = NumericModel::load(std::path::Path::new(&path))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let tol = if tabulated(&numeric) { TOL_TABLE } else { TOL };
+        let tol = common::for_tables(&numeric, TOL);
         let worst = compare_dynamics(name, *generated, &numeric, tol);
         println!("{name}: largest relative difference generated vs numeric {worst:.2e}");
     }

@@ -221,3 +221,20 @@ pub fn geometry_values(
     }
     v
 }
+
+/// The agreement demanded of a model whose profile is a table of points, instead of `tol`:
+/// the generated code evaluates the runtime's spline (second derivatives at the knots by the
+/// Thomas algorithm) and the reference its own (slopes by a dense LU solve, the Hermite
+/// form). Their second derivatives carry the rounding of the table's values divided by the
+/// points' spacing squared, ε·|y|/(h²|S″|): for table_cam (|y| ≈ 0.05 m, h ≈ 0.35 mm,
+/// |S″| ≈ 18/m) about 5e-12 relative in the curvature (measured 1.4e-11); 1e-10 leaves a
+/// margin of 7.
+pub fn for_tables(model: &camchain_reference::NumericModel, tol: f64) -> f64 {
+    let tabulated = model.model().contacts.iter().any(|c| {
+        matches!(
+            c.profile_expression(),
+            camchain_codegen::profile::Scalar::Table(..)
+        )
+    });
+    if tabulated { tol.max(1e-10) } else { tol }
+}
