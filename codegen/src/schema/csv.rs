@@ -17,7 +17,7 @@ pub(crate) struct Row {
     pub columns: [usize; 2],
 }
 
-/// A problem in a table file, at a 1-based line and column (column 0: the whole line).
+/// A problem in a table file, at a 1-based line and column.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct CsvError {
     pub line: usize,
@@ -49,7 +49,7 @@ pub(crate) fn read(text: &str, names: [&str; 2]) -> Result<Vec<Row>, CsvError> {
         if cells.len() != 2 {
             return Err(CsvError {
                 line: number,
-                column: 0,
+                column: cells.first().map_or(1, |(c, _)| *c),
                 message: format!(
                     "a row holds two numbers ({}, {}), this one has {} cell{}",
                     names[0],
