@@ -321,9 +321,33 @@ fn cyclic_thomas(a: &[f64], b: &[f64], c: &[f64], d: &[f64]) -> Vec<f64> {
     x.iter().zip(&z).map(|(xi, zi)| xi - factor * zi).collect()
 }
 
-/// The segment of `x` holding `s` (the first or last one beyond the table's ends).
+/// Most steps the look-up walks from its proportional guess before it bisects.
+const WALK: usize = 4;
+
+/// The segment of `x` holding `s` (the first or last one beyond the table's ends): the
+/// segment where s would be if the knots were evenly spaced, corrected by a short walk (the
+/// tables of profiles are sampled at nearly even steps, so the guess is the segment or its
+/// neighbour), and by bisection when the walk does not arrive.
 pub fn segment(x: &[f64], s: f64) -> usize {
     let last = x.len().saturating_sub(2);
+    let (first, end) = (x[0], x[x.len() - 1]);
+    if !(s > first) {
+        return 0;
+    }
+    if s >= x[last + 1] || end <= first {
+        return last;
+    }
+    let mut i = (((s - first) / (end - first)) * (last + 1) as f64) as usize;
+    i = i.min(last);
+    for _ in 0..WALK {
+        if x[i] > s {
+            i -= 1;
+        } else if x[i + 1] <= s {
+            i += 1;
+        } else {
+            return i;
+        }
+    }
     // The number of knots ≤ s, less one: bisection on the sorted abscissas.
     x.partition_point(|&k| k <= s).saturating_sub(1).min(last)
 }
@@ -333,23 +357,24 @@ pub fn segment(x: &[f64], s: f64) -> usize {
 /// ends continues its end cubics.
 pub fn evaluate(x: &[f64], y: &[f64], m: &[f64], periodic: bool, s: f64) -> [f64; 4] {
     let (first, last) = (x[0], x[x.len() - 1]);
-    let s = if periodic {
-        first + (s - first).rem_euclid(last - first)
+    let s = if periodic && !(first <= s && s < last) {
+        let period = last - first;
+        s - ((s - first) / period).floor() * period
     } else {
         s
     };
     let i = segment(x, s);
     let h = x[i + 1] - x[i];
+    let inverse = 1.0 / h;
     let (to_end, from_start) = (x[i + 1] - s, s - x[i]);
     let (a, b) = (m[i], m[i + 1]);
-    let (left, right) = (y[i] / h - a * h / 6.0, y[i + 1] / h - b * h / 6.0);
+    let (left, right) = (y[i] - a * h * h / 6.0, y[i + 1] - b * h * h / 6.0);
+    let (a2, b2) = (a * to_end * to_end, b * from_start * from_start);
     [
-        (a * to_end.powi(3) + b * from_start.powi(3)) / (6.0 * h)
-            + left * to_end
-            + right * from_start,
-        (b * from_start.powi(2) - a * to_end.powi(2)) / (2.0 * h) - left + right,
-        (a * to_end + b * from_start) / h,
-        (b - a) / h,
+        ((a2 * to_end + b2 * from_start) / 6.0 + left * to_end + right * from_start) * inverse,
+        ((b2 - a2) / 2.0 - left + right) * inverse,
+        (a * to_end + b * from_start) * inverse,
+        (b - a) * inverse,
     ]
 }
 
@@ -567,5 +592,22 @@ mod tests {
         assert_eq!(segment(&x, 3.9), 2);
         assert_eq!(segment(&x, 4.0), 2);
         assert_eq!(segment(&x, 9.0), 2);
+        assert_eq!(segment(&x, f64::NAN), 0);
+        // Against the definition (the last knot ≤ s), on uneven tables where the guess misses
+        // by more than the walk: knots crowded at one end.
+        for n in [2usize, 3, 7, 50] {
+            let x: Vec<f64> = (0..n)
+                .map(|i| (i as f64 / (n - 1) as f64).powi(4))
+                .collect();
+            for k in 0..=400 {
+                let s = -0.1 + 1.2 * k as f64 / 400.0;
+                let want = x
+                    .iter()
+                    .rposition(|&knot| knot <= s)
+                    .unwrap_or(0)
+                    .min(n - 2);
+                assert_eq!(segment(&x, s), want, "n = {n}, s = {s}");
+            }
+        }
     }
 }

@@ -123,7 +123,7 @@ pub fn run(quick: bool) -> Result<String, CliError> {
 }
 
 /// `STATES` consecutive states `ALONG_SPACING` apart, from 0.5 s into the model's run.
-fn consecutive_states(model: &dyn Dynamics) -> Result<Vec<State>, CliError> {
+pub(super) fn consecutive_states(model: &dyn Dynamics) -> Result<Vec<State>, CliError> {
     let failed = |e: String| CliError::Failed(format!("{}: {e}", model.info().name));
     let mut state = model.assemble(0.0).map_err(|e| failed(e.to_string()))?;
     model
@@ -143,7 +143,7 @@ fn consecutive_states(model: &dyn Dynamics) -> Result<Vec<State>, CliError> {
 /// along a run: its t, q and q̇ set to the next state's before each call, so that the sines
 /// and cosines are computed afresh while a contact parameter's Newton starts from the last
 /// call's solution, `ALONG_SPACING` away (from `STATES − 1` spacings back at the wrap).
-fn derivative_along<'a>(
+pub(super) fn derivative_along<'a>(
     model: &'a dyn Dynamics,
     states: &'a [State],
 ) -> Result<impl FnMut() + 'a, CliError> {

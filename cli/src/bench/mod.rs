@@ -7,7 +7,8 @@
 //!   side and one RK4 step, generated code against the numeric recursion, on the same states;
 //!   then (section `cams`) the reduced right-hand side of the cams on moving bodies against
 //!   the fixed-cam paper model's, and one full camshaft revolution at 1e-10 of the camshaft
-//!   models;
+//!   models; then (section `designs`) the reduced right-hand side of a cam given as a table of
+//!   points against the same cam given by its motion law, and revolutions of the designed cams;
 //! - `sweep`: the whole-run overhead of a metrics run, the throughput of `camchain sweep` with
 //!   1 and 2 workers, and its memory against the number of runs;
 //! - `scaling-figure`: the figure of the scaling study from the CSV of
@@ -17,6 +18,7 @@
 //! machine noise hits both alike. No timing is asserted anywhere (see the tests).
 
 mod cams;
+mod designs;
 mod evaluations;
 mod markdown;
 mod scaling;
@@ -45,6 +47,9 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         let section = cams::run(args.quick)?;
         markdown::replace_section(report, "cams", &section)?;
         println!("updated {} (section cams)", report.display());
+        let section = designs::run(args.quick)?;
+        markdown::replace_section(report, "designs", &section)?;
+        println!("updated {} (section designs)", report.display());
     }
     if let BenchWhat::ScalingFigure = args.what {
         let csv = args.scaling_csv.as_deref().ok_or_else(|| {
