@@ -2,8 +2,10 @@
 //! writes today, byte for byte, so that every change to the emitted code shows in a diff
 //! under review: `tests/golden/paper_concave.rs` as the file declares its parameters (seven
 //! read at run time) and `tests/golden/paper_concave_folded.rs` with every parameter folded
-//! (`ParameterMode::FoldAll`: the code as if the numbers were written in place). After an
-//! intended change, regenerate them:
+//! (`ParameterMode::FoldAll`: the code as if the numbers were written in place); and that of
+//! `cycloidal_roller`, `tests/golden/cycloidal_roller.rs`, a cam designed from a motion law
+//! (the law's segments as constants and their evaluation, the synthesised profile, a roller's
+//! contact parameter solved by Newton). After an intended change, regenerate them:
 //!
 //! ```sh
 //! CAMCHAIN_BLESS=1 cargo test -p camchain-build --test golden
@@ -21,8 +23,13 @@ fn golden_path(name: &str) -> PathBuf {
 /// The module `compile_models` writes for the built-in paper model, default options but
 /// the parameter mode.
 fn generated(test: &str, mode: ParameterMode) -> String {
+    generated_model("paper_concave", test, mode)
+}
+
+/// The module `compile_models` writes for the built-in model `name`.
+fn generated_model(name: &str, test: &str, mode: ParameterMode) -> String {
     let out = std::env::temp_dir().join(format!("camchain-golden-{test}-{}", std::process::id()));
-    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/paper_concave.ron");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../models/{name}.ron"));
     let compiled = camchain_build::Config::new()
         .out_dir(&out)
         .emit_rerun_if_changed(false)
@@ -47,6 +54,14 @@ fn the_folded_paper_model_generates_its_golden_source() {
     compare_with_golden(
         "paper_concave_folded",
         &generated("folded", ParameterMode::FoldAll),
+    );
+}
+
+#[test]
+fn the_cam_designed_from_a_law_generates_its_golden_source() {
+    compare_with_golden(
+        "cycloidal_roller",
+        &generated_model("cycloidal_roller", "law", ParameterMode::AsDeclared),
     );
 }
 

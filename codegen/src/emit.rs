@@ -282,7 +282,7 @@ pub fn generate_with(
     })
 }
 
-/// Every tabulated function of the graph as constants and a function `<name>(s)` returning
+/// Every tabulated function of the graph as constants and a function `eval_<name>(s)` returning
 /// its value and first three derivatives at s: a spline's table (abscissas, values and the
 /// second derivatives at the knots, computed at build time) for
 /// `camchain_runtime::spline::evaluate`, or a motion law's segments for
@@ -313,7 +313,7 @@ fn spline_helper(name: &str, spline: &camchain_runtime::spline::Spline) -> Strin
          const {upper}_M: [f64; {n}] = {};\n\
          /// {name}: the spline and its first three derivatives at s ({}).\n\
          #[inline]\n\
-         fn {name}(s: f64) -> [f64; 4] {{\n\
+         fn eval_{name}(s: f64) -> [f64; 4] {{\n\
          rt::spline::evaluate(&{upper}_X, &{upper}_Y, &{upper}_M, {}, s)\n}}\n",
         float_list(spline.abscissas()),
         float_list(spline.values()),
@@ -350,7 +350,7 @@ fn law_helper(name: &str, program: &camchain_runtime::motion_law::MotionProgram)
          /// {name}: the follower's displacement and its first three derivatives with respect \
          to the cam's angle at theta (repeats every turn).\n\
          #[inline]\n\
-         fn {name}(theta: f64) -> [f64; 4] {{\n\
+         fn eval_{name}(theta: f64) -> [f64; 4] {{\n\
          rt::motion_law::evaluate(&{upper}, theta)\n}}\n",
         segments.len(),
         segments.join(", "),
@@ -2312,7 +2312,8 @@ impl<'g> Emitter<'g> {
         )
     }
 
-    /// `let <name>_at = <name>(a);` the first time tabulated function `t` is read at `a`.
+    /// `let <name>_at = eval_<name>(a);` the first time tabulated function `t` is read at `a`
+    /// (the function's value is then bound as `<name>`, which must not hide the function).
     fn bind_table_call(&mut self, t: u32, a: Id, text: &mut String, taken: &mut HashSet<String>) {
         if self.table_calls.contains_key(&(t, a)) {
             return;
@@ -2323,7 +2324,7 @@ impl<'g> Emitter<'g> {
             .get(t as usize)
             .map_or("table", |t| t.name.as_str());
         let call = fresh(&format!("{name}_at"), taken);
-        let _ = writeln!(text, "let {call} = {name}({});", self.print(a, 0));
+        let _ = writeln!(text, "let {call} = eval_{name}({});", self.print(a, 0));
         self.table_calls.insert((t, a), call);
     }
 
@@ -2439,7 +2440,7 @@ impl<'g> Emitter<'g> {
                 Some(call) => (format!("{call}[{order}]"), 5),
                 None => {
                     let name = self.g.tables().get(t as usize).map_or("table", |t| &t.name);
-                    (format!("{name}({})[{order}]", self.print(a, 0)), 4)
+                    (format!("eval_{name}({})[{order}]", self.print(a, 0)), 4)
                 }
             },
         }
