@@ -1,4 +1,5 @@
-//! Command-line syntax (clap derive): `camchain [simulate [MODEL]... [OPTIONS] | list | ops [MODEL]...]`.
+//! Command-line syntax (clap derive): `camchain [simulate [MODEL]... [OPTIONS] | list | ops
+//! [MODEL]... | cam MODEL [OPTIONS] | …]`.
 //!
 //! Values are checked here, so a bad one is a usage error (exit code 2) before anything
 //! runs: times must be positive and finite, tolerances positive, the integrator one of the
@@ -120,6 +121,95 @@ pub enum Command {
                       camchain merge shards/*.csv --out results\n  \
                       camchain merge part-*.csv --csv sweep.csv --no-plots")]
     Merge(MergeArgs),
+    /// Analyse a cam designed from its follower's motion law (`law:` in a contact): the
+    /// design's peaks, pressure angle, curvature and joints; figures, a CSV and the profile
+    /// as a table; the jump speed the dynamics predict, checked by a one-sided run.
+    #[command(
+        long_about = "Analyse a cam designed from its follower's motion law (`law:` in a contact \
+                      of the model file) at its nominal speed ω (--speed, else the law's \
+                      `speed`).\n\n\
+                      Printed: the segments, base and prime circles, the follower and the \
+                      turning sense; the follower's peak velocity, acceleration and jerk at ω \
+                      (both signs, refined between samples by golden-section search, segment \
+                      joints included) with the cam angles where they occur; the largest \
+                      pressure angle either way against its limit; the smallest radius of \
+                      curvature where the profile is convex and where it is concave; the \
+                      undercut margin of a roller or the face width a flat face needs; the \
+                      joints where the acceleration or the jerk jumps.\n\n\
+                      Dynamics: with the camshaft driven and the follower held on the cam (no \
+                      degree of freedom in bilateral contact), the contact force is exactly \
+                      N(θ, ω) = A(θ) + B(θ) ω + C(θ) ω²; three bilateral runs of one turn (at \
+                      ω/2, ω and 2ω, set through the parameter the law's speed names) give A, B \
+                      and C at every sampled angle, and the jump speed is the smallest speed at \
+                      which the least force over a turn reaches zero. A one-sided run over \
+                      --turns turns at ω then shows where the follower really lifts off and \
+                      lands, or its smallest contact force.\n\n\
+                      Files, in DIR/<model>_cam/ (DIR/<model>_<contact>_cam/ when the model has \
+                      several designed cams): svaj, pressure_curvature, profile and force \
+                      (.png and .svg each) and design.csv (one row per sample: cam_angle_deg, \
+                      s, v, a, j at ω, pressure_angle_deg, radius_of_curvature, profile_x, \
+                      profile_y, pitch_x, pitch_y, normal_force of the bilateral run at ω; SI \
+                      units, rad for an oscillating follower's motion). --table FILE also \
+                      writes the profile as a CSV table of points that a model reads back \
+                      with `table: (form: Parametric, file: \"FILE\")`.\n\n\
+                      Exit codes: 0 success; 1 a model file invalid, a run failed, the speed \
+                      cannot be set, or a file could not be written; 2 a usage error (bad \
+                      option or value, unknown model or contact, a model without a designed \
+                      cam, no speed).",
+        after_help = "Examples:\n  \
+                      camchain cam cycloidal_roller                 # at the law's 50 rad/s, files in out/cycloidal_roller_cam/\n  \
+                      camchain cam cycloidal_roller --speed 70      # above the jump speed: the follower lifts off\n  \
+                      camchain cam polynomial_rocker --turns 5 --restitution 0.3\n  \
+                      camchain cam cycloidal_roller --table profile.csv --points 1440\n  \
+                      camchain cam my_cams.ron --contact intake --samples 7200 --out results"
+    )]
+    Cam(CamArgs),
+}
+
+/// Options of `cam`.
+#[derive(Debug, Clone, Args)]
+pub struct CamArgs {
+    /// A built-in model's name or a path to a .ron model file (which runs on the numeric
+    /// reference), with a contact designed from a motion law (`law:`)
+    #[arg(value_name = "MODEL")]
+    pub model: String,
+
+    /// The contact whose cam is analysed, by name (needed when the model has several
+    /// designed from a law) [default: the model's only one]
+    #[arg(long, value_name = "NAME")]
+    pub contact: Option<String>,
+
+    /// The cam's nominal speed ω in rad/s, positive [default: the law's `speed`]
+    #[arg(long, value_name = "RAD_PER_S", value_parser = positive_speed, allow_hyphen_values = true)]
+    pub speed: Option<f64>,
+
+    /// Samples over a turn: rows of design.csv and figures, output angles of the runs, the
+    /// grid the peaks are refined from
+    #[arg(long, value_name = "N", default_value_t = 3600, value_parser = at_least_one)]
+    pub samples: usize,
+
+    /// Turns of the camshaft in the one-sided run at ω
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = at_least_one)]
+    pub turns: usize,
+
+    /// Coefficient of restitution of the one-sided run (0 plastic … 1 elastic) [default:
+    /// the model file's `simulation.restitution`, else 0]
+    #[arg(long, value_name = "E", value_parser = restitution)]
+    pub restitution: Option<f64>,
+
+    /// Directory of the figures and design.csv, one subdirectory per cam
+    #[arg(long, value_name = "DIR", default_value = DEFAULT_OUT)]
+    pub out: PathBuf,
+
+    /// Also write the cam's profile as a CSV table of points (x,y in the cam frame, m) to
+    /// FILE, for `table: (form: Parametric, file: "FILE")`
+    #[arg(long, value_name = "FILE")]
+    pub table: Option<PathBuf>,
+
+    /// Points of the --table profile (at evenly spaced cam angles, the first repeated at
+    /// the end), at least 3
+    #[arg(long, value_name = "N", default_value_t = 720, value_parser = table_points, requires = "table")]
+    pub points: usize,
 }
 
 /// Options of `bench`.
@@ -530,6 +620,34 @@ fn absolute_tolerance(text: &str) -> Result<f64, String> {
 /// A positive, finite time in seconds.
 fn positive_time(text: &str) -> Result<f64, String> {
     positive(text, "a time in seconds")
+}
+
+/// A positive, finite speed in rad/s.
+fn positive_speed(text: &str) -> Result<f64, String> {
+    positive(text, "a speed in rad/s")
+}
+
+/// A whole number of at least `least`.
+fn count(text: &str, least: usize) -> Result<usize, String> {
+    let value: usize = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a whole number"))?;
+    if value >= least {
+        Ok(value)
+    } else {
+        Err(format!("{value} is too small: at least {least} is needed"))
+    }
+}
+
+/// A whole number, at least 1.
+fn at_least_one(text: &str) -> Result<usize, String> {
+    count(text, 1)
+}
+
+/// Points of a profile table: at least 3 (a closed curve).
+fn table_points(text: &str) -> Result<usize, String> {
+    count(text, 3)
 }
 
 #[cfg(test)]

@@ -15,7 +15,9 @@
 //!   scenarios of [`scenarios`];
 //! - `bench`: the `bench` command (the measurements of `BENCHMARKS.md`);
 //! - `sweep`: the `sweep` and `merge` commands (parameter studies, in parallel and in
-//!   shards).
+//!   shards);
+//! - `cam`: the `cam` command (a cam designed from a motion law: its design's checks and
+//!   figures, the jump speed its dynamics predict, a one-sided run).
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
 //! for a usage error (bad option or value, unknown model name), 130 for a run interrupted
@@ -25,6 +27,7 @@
 
 mod args;
 mod bench;
+mod cam;
 mod csv;
 mod figures;
 mod interrupt;
@@ -107,6 +110,7 @@ pub fn main() -> ExitCode {
         Some(Command::Stress(args)) => stress::run(&args),
         Some(Command::Sweep(args)) => sweep::run(&args),
         Some(Command::Merge(args)) => sweep::merge(&args),
+        Some(Command::Cam(args)) => cam::run(&args),
         Some(Command::List) => {
             // A closed pipe (`camchain list | head`) is not an error worth a panic.
             let _ = std::io::stdout().write_all(list::render().as_bytes());

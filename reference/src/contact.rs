@@ -23,9 +23,22 @@ type Vec3 = Vector3<f64>;
 /// Samples of the range compared before the golden-section refinement.
 const SCAN: usize = 512;
 
+/// The identity of the next contact built (so that a reused search is this contact's).
+static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// A search's result to reuse: ((contact, its inputs' bits), the parameter).
+type Search = ((u64, [u64; 2]), f64);
+
+thread_local! {
+    /// The last contact-parameter search on this thread.
+    static LAST_SEARCH: std::cell::Cell<Option<Search>> = const { std::cell::Cell::new(None) };
+}
+
 /// The constant data of one contact.
 #[derive(Debug, Clone)]
 pub(crate) struct ContactConst {
+    /// Unique among the contacts built by this process (the key of a reused search).
+    id: u64,
     /// The follower's body and its point (the marker) in that body's frame.
     body: usize,
     marker: Vec3,
@@ -102,6 +115,7 @@ impl ContactConst {
     pub(crate) fn new(model: &Model, contact: &Contact) -> Self {
         let marker = &model.markers[contact.marker];
         Self {
+            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             body: marker.body,
             marker: vec3(&marker.position),
             own_joint: model.bodies[marker.body].joint.kind,
@@ -241,8 +255,27 @@ impl ContactConst {
 
     /// The profile parameter minimising `objective` over the range: a scan, then
     /// golden-section search around the best sample, then Newton on `stationary` (its
-    /// value and derivative) while it improves.
+    /// value and derivative) while it improves. The objective depends on the state only
+    /// through `inputs` (the follower point, or the face's normal, in the cam frame): the
+    /// last search of this contact on this thread for the same inputs is reused (the
+    /// constraint, its Jacobian, its bias and the outputs of one configuration each ask).
     fn optimum(
+        &self,
+        inputs: [f64; 2],
+        objective: impl Fn(f64) -> f64,
+        stationary: impl Fn(f64) -> (f64, f64),
+    ) -> f64 {
+        let key = (self.id, inputs.map(f64::to_bits));
+        if let Some(s) = LAST_SEARCH.with(|last| last.get().filter(|(k, _)| *k == key)) {
+            return s.1;
+        }
+        let s = self.search(objective, stationary);
+        LAST_SEARCH.with(|last| last.set(Some((key, s))));
+        s
+    }
+
+    /// [`ContactConst::optimum`]'s search itself.
+    fn search(
         &self,
         objective: impl Fn(f64) -> f64,
         stationary: impl Fn(f64) -> (f64, f64),
@@ -317,6 +350,7 @@ impl ContactConst {
                     };
                     let p = seen.p;
                     let s = self.optimum(
+                        p,
                         |s| {
                             let d = sub(p, self.profile_point(s));
                             dot(d, d)
@@ -338,6 +372,7 @@ impl ContactConst {
                 (Follower::Flat { .. }, _) => {
                     let m = seen.m;
                     let s = self.optimum(
+                        m,
                         |s| -dot(m, self.profile_point(s)),
                         |s| {
                             let c = self.curve(s);

@@ -179,13 +179,16 @@ fn slopes(x: &[f64], y: &[f64], ends: Ends) -> Vec<f64> {
     }
 }
 
+/// A function, an argument's bits and the four values there.
+type LastEvaluation = (Arc<Tabulated>, u64, [f64; 4]);
+
 /// Most splines kept per thread; the cache starts again beyond it.
 const CACHED: usize = 64;
 
 thread_local! {
     /// The last evaluation: the function (held, so that its identity stays its own), the
     /// argument's bits and the four values.
-    static LAST: RefCell<Option<(Arc<Tabulated>, u64, [f64; 4])>> = const { RefCell::new(None) };
+    static LAST: RefCell<Option<LastEvaluation>> = const { RefCell::new(None) };
     static BUILT: RefCell<Vec<(Arc<Tabulated>, Arc<Hermite>)>> = const { RefCell::new(Vec::new()) };
 }
 

@@ -331,7 +331,7 @@ const WALK: usize = 4;
 pub fn segment(x: &[f64], s: f64) -> usize {
     let last = x.len().saturating_sub(2);
     let (first, end) = (x[0], x[x.len() - 1]);
-    if !(s > first) {
+    if s.is_nan() || s <= first {
         return 0;
     }
     if s >= x[last + 1] || end <= first {
