@@ -57,13 +57,19 @@ fn union(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
 }
 
 /// A range with a margin of 6 % each side; a flat or empty one is widened to stay drawable.
-fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
+fn padded(range: (f64, f64)) -> (f64, f64) {
+    padded_by(range, 0.06)
+}
+
+/// A range with a margin of `fraction` of its span each side; a flat or empty one is widened
+/// to stay drawable.
+pub(crate) fn padded_by((lo, hi): (f64, f64), fraction: f64) -> (f64, f64) {
     if !(lo.is_finite() && hi.is_finite()) {
         return (-1.0, 1.0);
     }
     let span = hi - lo;
     let pad = if span > 1e-9 * lo.abs().max(hi.abs()) && span > 0.0 {
-        0.06 * span
+        fraction * span
     } else {
         (0.01 * lo.abs().max(hi.abs())).max(1e-15)
     };

@@ -321,35 +321,26 @@ fn cyclic_thomas(a: &[f64], b: &[f64], c: &[f64], d: &[f64]) -> Vec<f64> {
     x.iter().zip(&z).map(|(xi, zi)| xi - factor * zi).collect()
 }
 
-/// Most steps the look-up walks from its proportional guess before it bisects.
-const WALK: usize = 4;
-
-/// The segment of `x` holding `s` (the first or last one beyond the table's ends): the
-/// segment where s would be if the knots were evenly spaced, corrected by a short walk (the
-/// tables of profiles are sampled at nearly even steps, so the guess is the segment or its
-/// neighbour), and by bisection when the walk does not arrive.
+/// The segment of `x` holding `s` (the first or last one beyond the table's ends): the last
+/// knot at or below s, by bisection written without branches on the comparisons (each halving
+/// a conditional move: about twice as fast as a branching search on a table of a few hundred
+/// points, where the comparisons cannot be predicted).
 pub fn segment(x: &[f64], s: f64) -> usize {
     let last = x.len().saturating_sub(2);
-    let (first, end) = (x[0], x[x.len() - 1]);
-    if s.is_nan() || s <= first {
+    if s.is_nan() || s <= x[0] {
         return 0;
     }
-    if s >= x[last + 1] || end <= first {
+    if s >= x[last + 1] {
         return last;
     }
-    let mut i = (((s - first) / (end - first)) * (last + 1) as f64) as usize;
-    i = i.min(last);
-    for _ in 0..WALK {
-        if x[i] > s {
-            i -= 1;
-        } else if x[i + 1] <= s {
-            i += 1;
-        } else {
-            return i;
-        }
+    let (mut base, mut size) = (0, x.len());
+    while size > 1 {
+        let half = size / 2;
+        let middle = base + half;
+        base = if x[middle] <= s { middle } else { base };
+        size -= half;
     }
-    // The number of knots ≤ s, less one: bisection on the sorted abscissas.
-    x.partition_point(|&k| k <= s).saturating_sub(1).min(last)
+    base.min(last)
 }
 
 /// [S, S′, S″, S‴] at `s` for the table `x`, `y` with knot second derivatives `m`. A periodic

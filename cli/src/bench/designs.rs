@@ -218,8 +218,8 @@ fn render(m: &Measured, calls: usize, batches: usize) -> String {
          | new state | {:.0} | {:.0} | {} |\n\
          | along a run | {:.0} | {:.0} | {} |\n\n\
          The look-ups alone, at 64 cam angles in turn (median of {batches} batches): the spline \
-         `rt::spline::evaluate` on the {}-point table (a bisection and a cubic with its three \
-         derivatives) {:.1} ns, the law `rt::motion_law::evaluate` (a walk over 4 segments and \
+         `rt::spline::evaluate` on the {}-point table (a branchless bisection for the segment and a cubic with its \
+         three derivatives) {:.1} ns, the law `rt::motion_law::evaluate` (a walk over 4 segments and \
          a cycloid's sine and cosine) {:.1} ns.",
         m.points,
         m.new_state.0,

@@ -52,17 +52,8 @@ fn data_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// A range with 8 % of margin each side (room for the marks), widened when flat or empty.
-fn padded((lo, hi): (f64, f64)) -> (f64, f64) {
-    if !(lo.is_finite() && hi.is_finite()) {
-        return (-1.0, 1.0);
-    }
-    let span = hi - lo;
-    let pad = if span > 1e-12 * lo.abs().max(hi.abs()) && span > 0.0 {
-        0.08 * span
-    } else {
-        (0.01 * lo.abs().max(hi.abs())).max(1e-12)
-    };
-    (lo - pad, hi + pad)
+fn padded(range: (f64, f64)) -> (f64, f64) {
+    crate::figures::padded_by(range, 0.08)
 }
 
 /// A small diamond around (x, y) on axes of the given spans, labelled: how a point is
