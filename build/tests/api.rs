@@ -260,3 +260,58 @@ fn a_value_that_looks_like_degrees_is_a_located_warning_not_an_error() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A model whose profile is a table in a CSV file beside it: the build reads the file from the
+/// model's own directory (not from where the build runs, nor from the path messages show),
+/// writes the table's points into the module, embeds the file's text beside the model's with
+/// `embed_model_source`, and a bad cell stops the build at the CSV's line and column.
+#[test]
+fn a_table_beside_the_model_is_read_from_the_models_directory_and_embedded() {
+    let dir = scratch("table", &["table_cam"]);
+    let tables = dir.join("models/tables");
+    std::fs::create_dir_all(&tables).expect("a tables directory");
+    let csv =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/tables/cycloidal_roller_profile.csv");
+    std::fs::copy(&csv, tables.join("cycloidal_roller_profile.csv")).expect("the table");
+    let out = dir.join("out");
+    let compiled = config(&out)
+        .embed_model_source(true)
+        .compile_models(&[dir.join("models/table_cam.ron")])
+        .unwrap_or_else(|e| panic!("{e}"));
+    let code = std::fs::read_to_string(&compiled[0].output).expect("written");
+    // The table's constants (721 points, one of them written out) and its evaluation.
+    assert!(
+        code.contains("const ROLLER_TABLE_X_X: [f64; 721]"),
+        "the x table"
+    );
+    assert!(code.contains("fn eval_roller_table_y("), "the y evaluation");
+    assert!(
+        code.contains("0.0003490614199349575"),
+        "a point of the file"
+    );
+    let files = code
+        .find("pub const MODEL_FILES")
+        .map(|at| &code[at..])
+        .expect("MODEL_FILES");
+    assert!(
+        files.contains("\"tables/cycloidal_roller_profile.csv\""),
+        "the file embedded by the path the model writes: {}",
+        &files[..files.len().min(200)]
+    );
+    // A cell that is not a number: located in the CSV.
+    let text = std::fs::read_to_string(tables.join("cycloidal_roller_profile.csv")).expect("it");
+    std::fs::write(
+        tables.join("cycloidal_roller_profile.csv"),
+        text.replacen("0.0003490614199349575", "0.000349x", 1),
+    )
+    .expect("the edit");
+    let error = config(&out)
+        .compile_models(&[dir.join("models/table_cam.ron")])
+        .expect_err("a bad cell")
+        .to_string();
+    assert!(
+        error.contains("cycloidal_roller_profile.csv:5:1: contacts[0].table.file: `0.000349x` is not a number (x)"),
+        "{error}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
