@@ -5,15 +5,17 @@
 //!   moving-frame formulas Ṗ = R_Cᵀ(ṙ − ω_C × r), P̈° = R_Cᵀ(r̈° − α_C° × r − 2ω_C × ṙ +
 //!   ω_C × (ω_C × r)); Jacobian columns from the motion at q̇ = e_j.
 //! - The profile: c(s), c′(s), c″(s) by forward-mode differentiation ([`crate::jet`]) of
-//!   the curve itself (a polar profile as r(θ)·cos θ in jet arithmetic).
+//!   the curve itself (a polar profile as r(θ)·cos θ in jet arithmetic), its expressions
+//!   evaluated as one tape ([`crate::tape`]).
 //! - Contact points: the nearest point, or the flat face's support point, by a scan of the
 //!   range refined by golden-section search and polished by Newton's method: the global
 //!   optimum, where the generated code tracks a local one from a guess.
 //! - A flat face's convective term from the general three-dimensional rotation of its
 //!   normal (the generator uses the planar form).
 
-use crate::jet::{Jet2, eval_on, eval_with};
+use crate::jet::Jet2;
 use crate::numeric::{Motion, Pose, vec3};
+use crate::tape::Tape;
 use camchain_codegen::model::{Contact, Follower, JointKind, Model, Profile};
 use camchain_runtime::{ContactGeometry, ContactKinematics};
 use nalgebra::Vector3;
@@ -51,6 +53,9 @@ pub(crate) struct ContactConst {
     y_axis: Vec3,
     follower: Follower,
     profile: Profile,
+    /// The profile's expressions (f, r, or x and y) as one tape, for the many evaluations of
+    /// the search.
+    tape: Tape,
     range: (f64, f64),
 }
 
@@ -125,6 +130,11 @@ impl ContactConst {
             y_axis: vec3(&contact.y_axis),
             follower: contact.follower,
             profile: contact.profile.clone(),
+            tape: match &contact.profile {
+                Profile::Explicit { f, .. } => Tape::new(&[f]),
+                Profile::Polar { r, .. } => Tape::new(&[r]),
+                Profile::Parametric { x, y, .. } => Tape::new(&[x, y]),
+            },
             range: contact.range.unwrap_or((0.0, std::f64::consts::TAU)),
         }
     }
@@ -207,13 +217,14 @@ impl ContactConst {
     /// c, c′, c″ of the profile at s, by jets of the curve.
     fn curve(&self, s: f64) -> CurvePoint {
         let at = Jet2::variable(s);
+        let values = self.tape.eval_jet(at);
         let [x, y] = match &self.profile {
-            Profile::Explicit { f, .. } => [at, eval_on(f, at)],
-            Profile::Polar { r, .. } => {
-                let r = eval_on(r, at);
+            Profile::Explicit { .. } => [at, values[0]],
+            Profile::Polar { .. } => {
+                let r = values[0];
                 [r * at.cos(), r * at.sin()]
             }
-            Profile::Parametric { x, y, .. } => [eval_on(x, at), eval_on(y, at)],
+            Profile::Parametric { .. } => [values[0], values[1]],
         };
         CurvePoint {
             c: [x.v, y.v],
@@ -224,13 +235,11 @@ impl ContactConst {
 
     /// c(s) alone, in plain arithmetic (what the search compares).
     fn profile_point(&self, s: f64) -> [f64; 2] {
+        let values = self.tape.eval(s);
         match &self.profile {
-            Profile::Explicit { f, .. } => [s, eval_with(f, s, &[])],
-            Profile::Polar { r, .. } => {
-                let r = eval_with(r, s, &[]);
-                [r * s.cos(), r * s.sin()]
-            }
-            Profile::Parametric { x, y, .. } => [eval_with(x, s, &[]), eval_with(y, s, &[])],
+            Profile::Explicit { .. } => [s, values[0]],
+            Profile::Polar { .. } => [values[0] * s.cos(), values[0] * s.sin()],
+            Profile::Parametric { .. } => [values[0], values[1]],
         }
     }
 

@@ -27,5 +27,6 @@ mod contact;
 pub mod jet;
 mod numeric;
 pub mod spline;
+pub mod tape;
 
 pub use numeric::{NumericModel, contact_info, model_info};
