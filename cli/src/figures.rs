@@ -168,17 +168,7 @@ fn position_panel(
 }
 
 fn single_column(title: String, panels: Vec<(u32, Panel)>) -> Figure {
-    Figure {
-        title,
-        width: COLUMN_WIDTH,
-        rows: panels
-            .into_iter()
-            .map(|(height, panel)| Row {
-                height,
-                panels: vec![panel],
-            })
-            .collect(),
-    }
+    Figure::column(title, COLUMN_WIDTH, panels)
 }
 
 /// Time histories of the coordinates `coords` (indices) and of every contact's position.

@@ -47,6 +47,23 @@ pub struct Figure {
     pub rows: Vec<Row>,
 }
 
+impl Figure {
+    /// A figure `width` pixels wide of one panel per row, each `(height, panel)`.
+    pub fn column(title: String, width: u32, panels: Vec<(u32, Panel)>) -> Figure {
+        Figure {
+            title,
+            width,
+            rows: panels
+                .into_iter()
+                .map(|(height, panel)| Row {
+                    height,
+                    panels: vec![panel],
+                })
+                .collect(),
+        }
+    }
+}
+
 /// A row of panels of equal width.
 pub struct Row {
     /// Height in pixels.

@@ -15,7 +15,7 @@ use super::analysis::{Analysis, Extreme};
 use super::dynamics::{JumpSpeed, OneSided, Prediction, Turn};
 use super::report::{degrees, turn_of, units};
 use crate::kinematics::CamPicture;
-use crate::plots::{Figure, Frame, LinePanel, MechanismPanel, Panel, Row, Series};
+use crate::plots::{Figure, Frame, LinePanel, MechanismPanel, Panel, Series};
 use crate::summary::number;
 use camchain_codegen::design::{self, CamDesign, Shape};
 use plotters::style::RGBColor;
@@ -99,17 +99,7 @@ fn angle_panel(title: String, y_label: String, y_range: (f64, f64), series: Vec<
 
 /// A figure of one panel per row.
 fn column(title: String, rows: Vec<(u32, Panel)>) -> Figure {
-    Figure {
-        title,
-        width: WIDTH,
-        rows: rows
-            .into_iter()
-            .map(|(height, panel)| Row {
-                height,
-                panels: vec![panel],
-            })
-            .collect(),
-    }
+    Figure::column(title, WIDTH, rows)
 }
 
 /// Displacement, velocity, acceleration and jerk at ω against the cam angle.
