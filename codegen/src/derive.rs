@@ -1,6 +1,7 @@
 //! The whole symbolic derivation of a model: kinematics, cam constraints, dynamics, energy
 //! and prescribed motions, all in one expression graph.
 
+use crate::closure::{ClosureTerms, closure_terms};
 use crate::contact::{ContactTerms, contact_terms, scalar_to_expr, value_and_derivatives};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::{Graph, Id};
@@ -42,6 +43,8 @@ pub struct Derivation {
     pub dynamics: DynamicsTerms,
     /// One entry per contact (1)–(8).
     pub contacts: Vec<ContactTerms>,
+    /// One entry per loop closure (docs/method.md §11).
+    pub loops: Vec<ClosureTerms>,
     /// Energy expressions.
     pub energy: EnergyTerms,
     /// Prescribed motions of driven joints.
@@ -97,6 +100,7 @@ impl Derivation {
         let symbols = Symbols::new(&mut g, model);
         let kin = forward(&mut g, model, &symbols);
         let contacts = contact_terms(&mut g, model, &kin, &symbols);
+        let loops = closure_terms(&mut g, model, &kin, &symbols);
         let dynamics = backward(&mut g, model, &symbols, &kin);
         let energy = energy(&mut g, model, &symbols, &kin);
         let drives = model
@@ -142,6 +146,7 @@ impl Derivation {
             symbols,
             dynamics,
             contacts,
+            loops,
             energy,
             drives,
             parameter_values: model.parameters.iter().map(|p| p.value).collect(),
@@ -232,10 +237,35 @@ impl Derivation {
             f(group + 1, &mut c.sliding);
             group += 2;
         }
+        for l in &mut self.loops {
+            for id in l.points.iter_mut().flatten() {
+                f(group, id);
+            }
+            for row in &mut l.rows {
+                f(group, &mut row.h);
+                row.jacobian.iter_mut().for_each(|id| f(group + 1, id));
+                f(group + 1, &mut row.bias);
+            }
+            group += 2;
+        }
         for d in &mut self.drives {
             d.motion.iter_mut().for_each(|id| f(group, id));
             group += 1;
         }
+    }
+
+    /// Every scalar constraint as (h, J, c): one per contact, then each loop's equations
+    /// (the order of the rows of h in the generated code and the runtime).
+    pub fn constraint_rows(&self) -> Vec<(Id, &[Id], Id)> {
+        let contacts = self
+            .contacts
+            .iter()
+            .map(|c| (c.h, c.jacobian.as_slice(), c.bias));
+        let loops = self
+            .loops
+            .iter()
+            .flat_map(|l| l.rows.iter().map(|r| (r.h, r.jacobian.as_slice(), r.bias)));
+        contacts.chain(loops).collect()
     }
 
     /// True when the model reads parameters at run time (the generated code has `Derived`).

@@ -645,6 +645,25 @@ fn info_static(model: &Model) -> String {
             )
         })
         .collect();
+    let loops: Vec<String> = model
+        .loops
+        .iter()
+        .map(|l| {
+            let kind = match l.kind {
+                crate::model::ClosureKind::Revolute => "Revolute",
+                crate::model::ClosureKind::Spherical => "Spherical",
+                crate::model::ClosureKind::Prismatic => "Prismatic",
+                crate::model::ClosureKind::PointOnLine => "PointOnLine",
+            };
+            let equations: Vec<String> =
+                l.equations().iter().map(|e| format!("{e:?}.to_string()")).collect();
+            format!(
+                "rt::LoopInfo {{ name: {:?}.to_string(), kind: rt::LoopKind::{kind}, equations: Vec::from([{}]) }}",
+                l.name,
+                equations.join(", ")
+            )
+        })
+        .collect();
     let s = &model.simulation;
     let integrator = match s.integrator {
         IntegratorChoice::Rk4 => "Rk4",
@@ -659,6 +678,7 @@ fn info_static(model: &Model) -> String {
          description: {desc:?}.to_string(),\n\
          coordinates: Vec::from([{coords}]),\n\
          contacts: Vec::from([{contacts}]),\n\
+         loops: Vec::from([{loops}]),\n\
          spatial: {spatial},\n\
          initial: rt::InitialGuess {{ q: Vec::from({q}), qd: Vec::from({qd}), hold: Vec::from({hold:?}), given_q: Vec::from({given_q:?}), given_qd: Vec::from({given_qd:?}) }},\n\
          defaults: rt::SimSettings {{ t_end: {t_end}, dt_out: {dt_out}, integrator: rt::IntegratorKind::{integrator}, dt: {dt}, rtol: {rtol}, atol: {atol} }},\n\
@@ -669,6 +689,7 @@ fn info_static(model: &Model) -> String {
         desc = model.description,
         coords = coords.join(", "),
         contacts = contacts.join(", "),
+        loops = loops.join(", "),
         spatial = !model.is_planar(),
         q = float_list(&model.initial.q),
         qd = float_list(&model.initial.qd),
@@ -749,28 +770,26 @@ fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionSpec> {
         .enumerate()
         .map(|(i, &e)| (format!("applied[{i}]"), e))
         .collect();
-    let h_outputs: Vec<(String, Id)> = d
-        .contacts
+    let rows = d.constraint_rows();
+    let h_outputs: Vec<(String, Id)> = rows
         .iter()
         .enumerate()
-        .map(|(k, c)| (format!("h[{k}]"), c.h))
+        .map(|(k, row)| (format!("h[{k}]"), row.0))
         .collect();
-    let j_outputs: Vec<(String, Id)> = d
-        .contacts
+    let j_outputs: Vec<(String, Id)> = rows
         .iter()
         .enumerate()
-        .flat_map(|(k, c)| {
-            c.jacobian
+        .flat_map(|(k, row)| {
+            row.1
                 .iter()
                 .enumerate()
                 .map(move |(i, &e)| (format!("j[{}]", k * n + i), e))
         })
         .collect();
-    let c_outputs: Vec<(String, Id)> = d
-        .contacts
+    let c_outputs: Vec<(String, Id)> = rows
         .iter()
         .enumerate()
-        .map(|(k, c)| (format!("c[{k}]"), c.bias))
+        .map(|(k, row)| (format!("c[{k}]"), row.2))
         .collect();
     let all = |parts: &[&Vec<(String, Id)>]| parts.iter().flat_map(|p| p.iter().cloned()).collect();
     let mut specs = vec![
@@ -878,6 +897,28 @@ fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionSpec> {
             ],
             ret: Some("f64"),
             outputs: vec![(RETURN.into(), d.energy.load_power)],
+            tail: String::new(),
+        });
+    }
+    if !d.loops.is_empty() {
+        let outputs = d
+            .loops
+            .iter()
+            .enumerate()
+            .flat_map(|(l, terms)| {
+                terms.points.iter().enumerate().flat_map(move |(side, p)| {
+                    p.iter()
+                        .enumerate()
+                        .map(move |(k, &e)| (format!("out[{}][{k}]", 2 * l + side), e))
+                })
+            })
+            .collect();
+        specs.push(FunctionSpec {
+            doc: "The points A and B of every loop closure, ground coordinates.".into(),
+            name: "loop_points".into(),
+            params: vec![param("q", "&[f64]"), param("out", "&mut [[f64; 3]]")],
+            ret: None,
+            outputs,
             tail: String::new(),
         });
     }
@@ -1127,11 +1168,12 @@ impl FusedTerms {
         let n = d.symbols.q.len();
         let dy = &d.dynamics;
         let mut position = Vec::new();
-        for (k, c) in d.contacts.iter().enumerate() {
-            position.push((format!("h[{k}]"), c.h));
+        let rows = d.constraint_rows();
+        for (k, row) in rows.iter().enumerate() {
+            position.push((format!("h[{k}]"), row.0));
         }
-        for (k, c) in d.contacts.iter().enumerate() {
-            for (i, &e) in c.jacobian.iter().enumerate() {
+        for (k, row) in rows.iter().enumerate() {
+            for (i, &e) in row.1.iter().enumerate() {
                 position.push((format!("j[{}]", k * n + i), e));
             }
         }
@@ -1147,9 +1189,10 @@ impl FusedTerms {
         for (i, &e) in dy.applied.iter().enumerate() {
             velocity.push((format!("out.applied[{i}]"), e));
         }
-        for (k, c) in d.contacts.iter().enumerate() {
-            velocity.push((format!("out.bias[{k}]"), c.bias));
+        for (k, row) in rows.iter().enumerate() {
+            velocity.push((format!("out.bias[{k}]"), row.2));
         }
+        drop(rows);
         let roots = |outputs: &[(String, Id)]| -> Vec<Id> { outputs.iter().map(|o| o.1).collect() };
         reuse_position_trigonometry(&mut d.graph, &roots(&position), &mut velocity);
         let g = &d.graph;
@@ -1297,7 +1340,7 @@ fn fused_count(d: &Derivation, spec: &FunctionSpec, given: &[(Id, String)]) -> u
 /// The body of `name` as a call of the fused pair, with stack scratch for the outputs it
 /// does not return; `None` for the functions that keep their own expressions.
 fn wrapper(model: &Model, fused: &FusedTerms, name: &str) -> Option<String> {
-    let (n, nc, cl) = (model.n(), model.contacts.len(), fused.cache_len());
+    let (n, nc, cl) = (model.n(), model.n_constraints(), fused.cache_len());
     let position = |h: &str, j: &str| {
         format!(
             "let mut cache = [0.0; {cl}];

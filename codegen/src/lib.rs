@@ -18,6 +18,7 @@
 //! - [`emit`]: the generated Rust module.
 
 pub mod assembly;
+pub mod closure;
 pub mod contact;
 pub mod derive;
 pub mod design;

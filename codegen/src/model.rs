@@ -241,6 +241,83 @@ impl Contact {
     }
 }
 
+/// The joint a loop is cut at (docs/model-format.md, "Loops"; docs/method.md §11): the tree
+/// is what remains of the mechanism once one joint per loop is removed, and the cut joint
+/// comes back as equations h(q) = 0 between a point A (`a`) of one body and a point B (`b`)
+/// of another.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ClosureKind {
+    /// A pin: A and B coincide (planar: 2 equations; spatial: 3, and the pin's axis carried
+    /// by A stays along the one carried by B, 2 more).
+    Revolute,
+    /// A ball joint: A and B coincide (3 equations; planar models use [`Self::Revolute`]).
+    Spherical,
+    /// A slider (planar only): A stays on the line through B along `axis` (B's frame) and
+    /// A's body does not turn relative to B's (2 equations).
+    Prismatic,
+    /// A pin in a slot: A stays on the line through B along `axis` (B's frame); planar: 1
+    /// equation, spatial: 2.
+    PointOnLine,
+}
+
+impl ClosureKind {
+    /// `revolute`, `spherical`, `prismatic` or `point_on_line`.
+    pub fn kind_name(self) -> &'static str {
+        match self {
+            ClosureKind::Revolute => "revolute",
+            ClosureKind::Spherical => "spherical",
+            ClosureKind::Prismatic => "prismatic",
+            ClosureKind::PointOnLine => "point_on_line",
+        }
+    }
+}
+
+/// A point fixed on a body, or on the ground, where a loop is cut.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClosurePoint {
+    /// The body (sorted index), `None` for the ground.
+    pub body: Option<usize>,
+    /// The point in that body's frame (m).
+    pub point: [f64; 3],
+}
+
+/// One loop-closure constraint: a cut joint between a point A of one body and a point B of
+/// another.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Closure {
+    /// Unique name among contacts and loops (CSV columns `loop_<name>_<equation>`).
+    pub name: String,
+    /// The cut joint's kind.
+    pub kind: ClosureKind,
+    /// A and B.
+    pub sides: [ClosurePoint; 2],
+    /// Unit vector in B's body frame: the pin's axis (spatial revolute), the line of a
+    /// slider or of a slot.
+    pub axis: [f64; 3],
+    /// Unit vector in A's body frame: the pin's axis carried by A (spatial revolute) or the
+    /// slider's direction carried by A (prismatic); equal to B's at assembly.
+    pub axis_a: [f64; 3],
+    /// True when the model is planar: a revolute cut is then 2 equations, not 5.
+    pub planar: bool,
+}
+
+impl Closure {
+    /// The names of its equations, in the order of its rows of h (CSV column suffixes):
+    /// `x`, `y`, `z` for the components of A − B in ground axes, `normal` (`normal_1`,
+    /// `normal_2`) for A − B across the line, `turn` for A's direction across B's line,
+    /// `tilt_1`, `tilt_2` for A's axis across B's.
+    pub fn equations(&self) -> &'static [&'static str] {
+        match (self.kind, self.planar) {
+            (ClosureKind::Revolute, true) => &["x", "y"],
+            (ClosureKind::Revolute, false) => &["x", "y", "z", "tilt_1", "tilt_2"],
+            (ClosureKind::Spherical, _) => &["x", "y", "z"],
+            (ClosureKind::Prismatic, _) => &["normal", "turn"],
+            (ClosureKind::PointOnLine, true) => &["normal"],
+            (ClosureKind::PointOnLine, false) => &["normal_1", "normal_2"],
+        }
+    }
+}
+
 /// Integrator named in the model's default settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum IntegratorChoice {
@@ -390,6 +467,8 @@ pub enum Field {
     Marker(usize, usize),
     /// Component k of contact c's cam-frame origin.
     Origin(usize, usize),
+    /// Component k of loop l's point on side s (0 for A, 1 for B).
+    LoopPoint(usize, usize, usize),
     /// The profile of contact c: f(x), r(θ), or x(s) of a parametric one.
     Profile(usize),
     /// y(s) of contact c's parametric profile.
@@ -414,6 +493,7 @@ impl Field {
                 | Field::Anchor(_, 2)
                 | Field::Marker(_, 2)
                 | Field::Origin(_, 2)
+                | Field::LoopPoint(_, _, 2)
         )
     }
 }
@@ -443,8 +523,10 @@ pub struct Model {
     pub bodies: Vec<Body>,
     /// Named points.
     pub markers: Vec<Marker>,
-    /// Cam contacts.
+    /// Cam contacts: the first rows of h.
     pub contacts: Vec<Contact>,
+    /// Loop closures: the rows of h after the contacts'.
+    pub loops: Vec<Closure>,
     /// Initial guess.
     pub initial: Initial,
     /// Default simulation settings.
@@ -468,6 +550,16 @@ impl Model {
     /// Number of generalised coordinates (= number of bodies = number of joints).
     pub fn n(&self) -> usize {
         self.bodies.len()
+    }
+
+    /// Number of scalar constraints: one per contact, then each loop's equations.
+    pub fn n_constraints(&self) -> usize {
+        self.contacts.len()
+            + self
+                .loops
+                .iter()
+                .map(|l| l.equations().len())
+                .sum::<usize>()
     }
 
     /// Coordinate names in order.
@@ -494,6 +586,7 @@ impl Model {
                 .all(|c| in_plane(&c.origin) && in_plane(&c.x_axis) && in_plane(&c.y_axis))
             && self.gravity[2] == 0.0
             && !self.symbolic.keys().any(|f| f.is_z())
+            && self.loops.iter().all(|l| l.planar)
     }
 
     /// Parses an expression of `variable` that may use the model's parameters, each

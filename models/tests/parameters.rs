@@ -112,7 +112,7 @@ fn check_against_reference(
         let n = m.info().n();
         let (mut mm, mut f, mut qa) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
         m.equations(1.3, &q, &qd, &mut mm, &mut f, &mut qa);
-        let mut h = vec![0.0; m.info().n_contacts()];
+        let mut h = vec![0.0; m.info().n_constraints()];
         m.constraint(&q, &mut h);
         let mut p = (q.clone(), qd.clone(), vec![0.0; n]);
         m.prescribed(1.3, &mut p.0, &mut p.1, &mut p.2);

@@ -30,7 +30,7 @@ fn max_abs(t: &Trajectory, f: impl Fn(&Sample) -> f64) -> f64 {
 /// loads τ on prescribed coordinates replaced by their known accelerations.
 fn full_system(model: &dyn Dynamics, s: &Sample) -> (Vec<f64>, Vec<f64>) {
     let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
+    let (n, nc) = (info.n(), info.n_constraints());
     let (mut m, mut f, mut qa) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
     model.equations(s.t, &s.q, &s.qd, &mut m, &mut f, &mut qa);
     let (mut j, mut c) = (vec![0.0; nc * n], vec![0.0; nc]);

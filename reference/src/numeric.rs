@@ -17,17 +17,19 @@
 //!   the joint axes, convective acceleration from the acceleration recursion with q̈ = 0,
 //!   profile derivatives from [`crate::jet`].
 
+use crate::closure::{ClosureConst, ClosureEval};
 use crate::contact::{ContactConst, Evaluated};
 use crate::jet::{eval_jet, eval_with};
 use camchain_codegen::ModelError;
 use camchain_codegen::model::{
-    Body, Contact, Follower, IntegratorChoice, JointKind, Model, ParameterMode, Profile,
+    Body, Closure, ClosureKind, Contact, Follower, IntegratorChoice, JointKind, Model,
+    ParameterMode, Profile,
 };
 use camchain_codegen::schema::{Files, load_model, parse_model_from};
 use camchain_runtime::{
     ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
-    Energy, FollowerKind, InitialGuess, IntegratorKind, ModelInfo, ParameterInfo, ProfileKind,
-    SimSettings,
+    Energy, FollowerKind, InitialGuess, IntegratorKind, LoopInfo, LoopKind, ModelInfo,
+    ParameterInfo, ProfileKind, SimSettings,
 };
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use std::path::Path;
@@ -47,6 +49,7 @@ pub fn model_info(model: &Model) -> ModelInfo {
             .iter()
             .map(|c| contact_info(model, c))
             .collect(),
+        loops: model.loops.iter().map(loop_info).collect(),
         spatial: !model.is_planar(),
         initial: InitialGuess {
             q: model.initial.q.clone(),
@@ -95,6 +98,20 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
         cam_coordinate: c
             .cam_body
             .filter(|&b| model.bodies[b].joint.kind == JointKind::Revolute),
+    }
+}
+
+/// The runtime's description of a loop closure.
+pub fn loop_info(closure: &Closure) -> LoopInfo {
+    LoopInfo {
+        name: closure.name.clone(),
+        kind: match closure.kind {
+            ClosureKind::Revolute => LoopKind::Revolute,
+            ClosureKind::Spherical => LoopKind::Spherical,
+            ClosureKind::Prismatic => LoopKind::Prismatic,
+            ClosureKind::PointOnLine => LoopKind::PointOnLine,
+        },
+        equations: closure.equations().iter().map(|e| e.to_string()).collect(),
     }
 }
 
@@ -303,6 +320,7 @@ pub struct NumericModel {
     values: Vec<f64>,
     bodies: Vec<BodyConst>,
     contacts: Vec<ContactConst>,
+    loops: Vec<ClosureConst>,
 }
 
 impl NumericModel {
@@ -318,12 +336,14 @@ impl NumericModel {
             .iter()
             .map(|c| ContactConst::new(&model, c))
             .collect();
+        let loops = model.loops.iter().map(ClosureConst::new).collect();
         Self {
             info: model_info(&model),
             values: model.runtime_parameters().map(|(_, p)| p.value).collect(),
             model,
             bodies,
             contacts,
+            loops,
         }
     }
 
@@ -476,6 +496,22 @@ impl NumericModel {
             .collect()
     }
 
+    /// Every loop evaluated at (q, q̇): h, J, c and its points ([`crate::closure`]).
+    fn loops_at(&self, q: &[f64], qd: &[f64]) -> Vec<ClosureEval> {
+        if self.loops.is_empty() {
+            return Vec::new();
+        }
+        let poses = self.poses(q);
+        let motions = self.motions(&poses, |i| qd[i], |_| 0.0);
+        let units: Vec<Vec<Motion>> = (0..self.n())
+            .map(|j| self.motions(&poses, |i| f64::from(u8::from(i == j)), |_| 0.0))
+            .collect();
+        self.loops
+            .iter()
+            .map(|l| l.evaluate(&poses, &motions, &units))
+            .collect()
+    }
+
     /// The applied joint loads τ(t, q, q̇) (zero where a joint has none).
     fn joint_loads_applied(&self, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
         let np = self.model.parameters.len();
@@ -540,22 +576,36 @@ impl Dynamics for NumericModel {
 
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
         let zero = vec![0.0; self.n()];
-        for (hk, e) in h.iter_mut().zip(self.contacts_at(q, &zero)) {
-            *hk = e.h;
+        let contacts = self.contacts_at(q, &zero).into_iter().map(|e| e.h);
+        let loops = self.loops_at(q, &zero).into_iter().flat_map(|l| l.h);
+        for (hk, value) in h.iter_mut().zip(contacts.chain(loops)) {
+            *hk = value;
         }
     }
 
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
         let n = self.n();
         let zero = vec![0.0; n];
-        for (k, e) in self.contacts_at(q, &zero).iter().enumerate() {
-            j[k * n..(k + 1) * n].copy_from_slice(&e.jacobian);
+        let contacts = self.contacts_at(q, &zero).into_iter().map(|e| e.jacobian);
+        let loops = self.loops_at(q, &zero).into_iter().flat_map(|l| l.jacobian);
+        for (k, row) in contacts.chain(loops).enumerate() {
+            j[k * n..(k + 1) * n].copy_from_slice(&row);
         }
     }
 
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
-        for (ck, e) in c.iter_mut().zip(self.contacts_at(q, qd)) {
-            *ck = e.bias;
+        let contacts = self.contacts_at(q, qd).into_iter().map(|e| e.bias);
+        let loops = self.loops_at(q, qd).into_iter().flat_map(|l| l.bias);
+        for (ck, value) in c.iter_mut().zip(contacts.chain(loops)) {
+            *ck = value;
+        }
+    }
+
+    fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
+        let zero = vec![0.0; self.n()];
+        let points = self.loops_at(q, &zero).into_iter().flat_map(|l| l.points);
+        for (o, p) in out.iter_mut().zip(points) {
+            *o = p;
         }
     }
 
@@ -682,6 +732,7 @@ mod tests {
             bodies,
             markers: Vec::new(),
             contacts: Vec::new(),
+            loops: Vec::new(),
             initial: Initial {
                 q: vec![0.0; n],
                 qd: vec![0.0; n],

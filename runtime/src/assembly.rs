@@ -13,7 +13,7 @@
 
 use crate::dynamics::{ContactGeometry, CoordinateKind, Dynamics};
 use crate::error::SimError;
-use crate::partition::{Partition, Workspace};
+use crate::partition::{Partition, Workspace, independent_rows};
 use crate::simulate::{State, invalid};
 use std::f64::consts::PI;
 
@@ -25,6 +25,10 @@ pub struct AssemblyReport {
     pub changes: Vec<AssemblyChange>,
     /// How the solved coordinates were found.
     pub root: RootChoice,
+    /// The constraint rows left out as redundant (implied by the others: a Bricard
+    /// mechanism, a parallelogram with a third bar), by name (`loop.equation`): their
+    /// multipliers are zero, the others carry the reactions (docs/method.md §11.3).
+    pub redundant: Vec<String>,
 }
 
 /// One value assembly changed.
@@ -97,14 +101,13 @@ pub(crate) fn assemble_from<D: Dynamics + ?Sized>(
     hold: &[bool],
 ) -> Result<(State, AssemblyReport), SimError> {
     let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
+    let (n, m) = (info.n(), info.n_constraints());
     let driven: Vec<bool> = info.coordinates.iter().map(|c| c.driven).collect();
     validate_model(model, &driven, t0)?;
     if q.len() != n || qd.len() != n || hold.len() != n {
         return Err(invalid(format!("{} needs {n} coordinates", info.name)));
     }
-    let nu = n - nc - driven.iter().filter(|d| **d).count();
-    let mut ws = Workspace::new(n, nc, nu);
+    let mut ws = workspace(n, &driven, m, &(0..m).collect::<Vec<_>>());
     ws.set_state(q, qd);
     model.prescribed(t0, &mut ws.q, &mut ws.qd, &mut ws.qdd);
     if ws.q().iter().chain(ws.qd()).any(|x| !x.is_finite()) {
@@ -119,11 +122,35 @@ pub(crate) fn assemble_from<D: Dynamics + ?Sized>(
         .choose_dependent(&eligible)
         .ok_or_else(|| ws.singular(t0))?;
     let partition = Partition::new(&driven, &dependent)?;
+    let redundant = (0..m)
+        .filter(|k| !ws.rows().contains(k))
+        .map(|k| info.constraint_name(k))
+        .collect();
     let report = AssemblyReport {
         changes: changes(model, (q, qd), (ws.q(), ws.qd()), &driven),
         root,
+        redundant,
     };
     Ok((State::new(t0, ws, partition), report))
+}
+
+/// A workspace solving `rows` of the model's m constraints.
+fn workspace(n: usize, driven: &[bool], m: usize, rows: &[usize]) -> Workspace {
+    let nc = rows.len();
+    let nu = n - nc - driven.iter().filter(|d| **d).count();
+    let mut ws = Workspace::new(n, nc, nu);
+    ws.select_rows(m, rows);
+    ws
+}
+
+/// `ws` re-made to solve `rows` only, with its state and length scale.
+fn restrict(ws: &Workspace, driven: &[bool], rows: &[usize]) -> Workspace {
+    let mut out = workspace(ws.n_coordinates(), driven, ws.m(), rows);
+    out.set_state(ws.q(), ws.qd());
+    out.q.copy_from_slice(ws.q());
+    out.qdd.copy_from_slice(&ws.qdd);
+    out.set_length_scale(ws.length_scale());
+    out
 }
 
 /// The values that differ between the guess and the assembled state (beyond a relative
@@ -181,7 +208,7 @@ fn validate_model<D: Dynamics + ?Sized>(
     t0: f64,
 ) -> Result<(), SimError> {
     let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
+    let (n, nc) = (info.n(), info.n_constraints());
     let initial = &info.initial;
     if !t0.is_finite() {
         return Err(invalid(format!("t0 = {t0} must be finite")));
@@ -198,7 +225,7 @@ fn validate_model<D: Dynamics + ?Sized>(
     let free = driven.iter().filter(|d| !**d).count();
     if free < nc {
         return Err(invalid(format!(
-            "{}: {nc} contacts but only {free} free coordinates",
+            "{}: {nc} constraint equations but only {free} free coordinates",
             info.name
         )));
     }
@@ -207,7 +234,10 @@ fn validate_model<D: Dynamics + ?Sized>(
 
 /// Chooses the coordinates to solve among those neither held nor driven (largest |J_i|)
 /// and solves h = 0 for them: for one contact at the root nearest the guess when a scan
-/// finds one, otherwise by Newton, then backtracking Newton.
+/// finds one, otherwise by Newton, then backtracking Newton. Rows of h that are redundant
+/// at the guess ([`independent_rows`]) are left out; at the solution the rank is checked
+/// again (a guess at a singular position looks redundant without being so) and the rows
+/// left out must hold there too.
 fn assemble_positions<D: Dynamics + ?Sized>(
     model: &D,
     ws: &mut Workspace,
@@ -216,24 +246,51 @@ fn assemble_positions<D: Dynamics + ?Sized>(
     t0: f64,
 ) -> Result<(Vec<usize>, RootChoice), SimError> {
     let info = model.info();
-    let (n, nc) = (info.n(), info.n_contacts());
-    if nc == 0 {
+    let (n, m) = (info.n(), info.n_constraints());
+    if m == 0 {
         return Ok((Vec::new(), RootChoice::NoContact));
     }
     let solvable: Vec<bool> = (0..n).map(|i| !driven[i] && !hold[i]).collect();
-    model.constraint_jacobian(&ws.q, &mut ws.jacobian);
-    if ws.jacobian.iter().any(|x| !x.is_finite()) {
-        return Err(ws.non_finite(t0, "J"));
+    let mut choice = None;
+    for _ in 0..3 {
+        ws.evaluate_constraints(model);
+        if ws.full_jacobian().iter().any(|x| !x.is_finite()) {
+            return Err(ws.non_finite(t0, "J"));
+        }
+        let (rows, _) = independent_rows(ws.full_jacobian(), m, n, &solvable);
+        if rows.is_empty() {
+            return Err(ws.singular(t0));
+        }
+        if choice.is_some() && rows.len() <= ws.rows().len() {
+            break;
+        }
+        if rows != ws.rows() {
+            *ws = restrict(ws, driven, &rows);
+            ws.evaluate_constraints(model);
+        }
+        choice = Some(solve_rows(model, ws, &solvable, t0)?);
     }
-    model.constraint(&ws.q, &mut ws.h);
+    let choice = choice.ok_or_else(|| ws.singular(t0))?;
+    check_left_out(model, ws, t0)?;
+    Ok(choice)
+}
+
+/// Newton on the rows the workspace solves, from its q (h and J evaluated there).
+fn solve_rows<D: Dynamics + ?Sized>(
+    model: &D,
+    ws: &mut Workspace,
+    solvable: &[bool],
+    t0: f64,
+) -> Result<(Vec<usize>, RootChoice), SimError> {
     let solved = ws
-        .choose_dependent(&solvable)
+        .choose_dependent(solvable)
         .ok_or_else(|| ws.singular(t0))?;
     let guess = ws.q().to_vec();
     let on_cam = ws.h.iter().all(|h| h.abs() <= ws.residual_tolerance());
+    let single_contact = model.info().n_constraints() == 1;
     let root = match solved.as_slice() {
         _ if on_cam => RootChoice::AtGuess,
-        [v] => match nearest_root(model, ws, *v) {
+        [v] if single_contact => match nearest_root(model, ws, *v) {
             Some((value, distance)) => {
                 ws.q[*v] = value;
                 RootChoice::Nearest { distance }
@@ -244,9 +301,80 @@ fn assemble_positions<D: Dynamics + ?Sized>(
     };
     if ws.solve_positions(model, &solved, t0).is_err() {
         ws.q.copy_from_slice(&guess);
-        ws.solve_positions_damped(model, &solved, t0)?;
+        if let Err(e) = ws.solve_positions_damped(model, &solved, t0) {
+            return Err(open_constraint(model, ws, t0, e));
+        }
     }
     Ok((solved, root))
+}
+
+/// The error of a failed assembly: with loops, the equation furthest from closing, named.
+fn open_constraint<D: Dynamics + ?Sized>(
+    model: &D,
+    ws: &mut Workspace,
+    t0: f64,
+    error: SimError,
+) -> SimError {
+    let info = model.info();
+    if info.loops.is_empty() {
+        return error;
+    }
+    ws.evaluate_constraints(model);
+    let (row, residual) = worst(ws.full_h(), 0..info.n_constraints());
+    SimError::CannotAssemble {
+        t: t0,
+        q: ws.q().to_vec(),
+        residual,
+        constraint: info.constraint_name(row),
+        why: "Newton from the initial guess, then with backtracking, did not converge: the \
+              guess is too far from an assembled configuration, or the dimensions do not \
+              allow the loop to close"
+            .into(),
+    }
+}
+
+/// The row of `rows` with the largest |h| and that value.
+fn worst(h: &[f64], rows: impl Iterator<Item = usize>) -> (usize, f64) {
+    rows.map(|k| (k, h[k].abs())).fold((0, 0.0), |best, x| {
+        if x.1 > best.1 || x.1.is_nan() {
+            x
+        } else {
+            best
+        }
+    })
+}
+
+/// The rows left out as redundant must hold at the assembled q: otherwise they were not
+/// implied by the others, and the mechanism cannot be assembled with all of them.
+fn check_left_out<D: Dynamics + ?Sized>(
+    model: &D,
+    ws: &mut Workspace,
+    t0: f64,
+) -> Result<(), SimError> {
+    let info = model.info();
+    let m = info.n_constraints();
+    if ws.rows().len() == m {
+        return Ok(());
+    }
+    ws.evaluate_constraints(model);
+    let left_out: Vec<usize> = (0..m).filter(|k| !ws.rows().contains(k)).collect();
+    let (row, residual) = worst(ws.full_h(), left_out.into_iter());
+    // The solved rows hold to Newton's tolerance; a left-out row implied by them holds to
+    // the same order (its gradient is a combination of theirs), so 1e3 times the tolerance
+    // separates round-off from an equation that is really violated.
+    if residual <= 1e3 * ws.residual_tolerance() {
+        return Ok(());
+    }
+    Err(SimError::CannotAssemble {
+        t: t0,
+        q: ws.q().to_vec(),
+        residual,
+        constraint: info.constraint_name(row),
+        why: "its Jacobian row is a combination of the other rows', so it was left out as \
+              redundant, but it does not hold where the others do: the loops contradict \
+              each other"
+            .into(),
+    })
 }
 
 /// The root of h (one contact) along coordinate `v` nearest its current value, and its

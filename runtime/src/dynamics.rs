@@ -130,6 +130,32 @@ impl ContactInfo {
     }
 }
 
+/// The kind of joint a loop is cut at (docs/method.md §11).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LoopKind {
+    /// A pin: the two points coincide (planar: 2 equations; spatial: 5 with the axes).
+    Revolute,
+    /// A ball joint: the two points coincide (3 equations).
+    Spherical,
+    /// A planar slider: a point on a line, no relative turn (2 equations).
+    Prismatic,
+    /// A pin in a slot: a point on a line (planar: 1 equation; spatial: 2).
+    PointOnLine,
+}
+
+/// Static description of one loop closure: its rows of h follow the contacts' and the
+/// loops listed before it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoopInfo {
+    /// Name from the model file.
+    pub name: String,
+    /// The cut joint's kind.
+    pub kind: LoopKind,
+    /// The names of its equations, one per row of h (`x`, `y`, `normal`, `tilt_1`, …):
+    /// the suffixes of its CSV columns.
+    pub equations: Vec<String>,
+}
+
 /// Static description of a model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelInfo {
@@ -139,8 +165,10 @@ pub struct ModelInfo {
     pub description: String,
     /// The generalised coordinates, in order.
     pub coordinates: Vec<CoordinateInfo>,
-    /// The contacts (one constraint each), in order.
+    /// The contacts (one constraint each, the first rows of h), in order.
     pub contacts: Vec<ContactInfo>,
+    /// The loop closures (their equations are the rows of h after the contacts'), in order.
+    pub loops: Vec<LoopInfo>,
     /// False for a planar model (contact z coordinates are always 0 and not reported).
     pub spatial: bool,
     /// Initial guess.
@@ -163,9 +191,37 @@ impl ModelInfo {
         self.coordinates.len()
     }
 
-    /// Number of cam contacts (= number of scalar constraints).
+    /// Number of cam contacts (the first [`Self::n_contacts`] rows of h).
     pub fn n_contacts(&self) -> usize {
         self.contacts.len()
+    }
+
+    /// Number of scalar constraints m: one per contact, then every loop's equations.
+    pub fn n_constraints(&self) -> usize {
+        self.contacts.len() + self.loops.iter().map(|l| l.equations.len()).sum::<usize>()
+    }
+
+    /// The first row of h of each loop, in order.
+    pub fn loop_rows(&self) -> impl Iterator<Item = (usize, &LoopInfo)> {
+        let mut row = self.contacts.len();
+        self.loops.iter().map(move |l| {
+            let first = row;
+            row += l.equations.len();
+            (first, l)
+        })
+    }
+
+    /// The name of constraint row k: the contact's name, or `<loop>.<equation>`.
+    pub fn constraint_name(&self, k: usize) -> String {
+        if let Some(c) = self.contacts.get(k) {
+            return c.name.clone();
+        }
+        for (first, l) in self.loop_rows() {
+            if let Some(e) = l.equations.get(k.wrapping_sub(first)) {
+                return format!("{}.{e}", l.name);
+            }
+        }
+        format!("row {k}")
     }
 
     /// Index of a coordinate by name.
@@ -319,7 +375,8 @@ impl Energy {
 /// Implemented by every generated model (the `Model` type of a module that `camchain-build`
 /// generated) and by the numeric reference (`camchain_reference::NumericModel`), so both run
 /// through the same integrators.
-/// Slices have the lengths given by [`ModelInfo`]: `n` coordinates, `nc` contacts.
+/// Slices have the lengths given by [`ModelInfo`]: `n` coordinates, `m` constraints
+/// ([`ModelInfo::n_constraints`]: `nc` contacts, then the loops' equations).
 pub trait Dynamics {
     /// Static description.
     fn info(&self) -> &ModelInfo;
@@ -340,15 +397,21 @@ pub trait Dynamics {
     /// `M q̈ + F + Q = joint drive loads` (so a spring contributes `+k (q − rest)`).
     fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
 
-    /// h(q), one entry per contact: positive when the follower is clear of the cam
+    /// The two points of every loop closure (A then B, ground coordinates) at q, into `out`
+    /// (length 2 × the number of loops): what figures draw. Does nothing without loops.
+    fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
+        let _ = (q, out);
+    }
+
+    /// h(q), one entry per contact then one per loop equation: for a contact positive when the follower is clear of the cam
     /// (h = f2 − f3(f1) for a knife edge on y = f(x), eq. 3; a distance for the other kinds).
     fn constraint(&self, q: &[f64], h: &mut [f64]);
 
-    /// J(q) = ∂h/∂q, eq. (5b): row-major nc×n into `j`.
+    /// J(q) = ∂h/∂q, eq. (5b): row-major m×n into `j`.
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]);
 
     /// c(q, q̇) = (J q̇)_q q̇, eqs. (7, 8), so that the acceleration-level constraint reads
-    /// `J q̈ + c = 0`. One entry per contact.
+    /// `J q̈ + c = 0`. One entry per constraint.
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]);
 
     /// Geometry of every contact at (q, q̇) (length nc). Entries of `out` hold the previous
@@ -438,7 +501,7 @@ pub trait Dynamics {
     }
 }
 
-/// Output buffers of [`Dynamics::velocity_terms`]: M (n×n, row-major), F, Q (n) and c (nc).
+/// Output buffers of [`Dynamics::velocity_terms`]: M (n×n, row-major), F, Q (n) and c (m).
 #[derive(Debug)]
 pub struct VelocityTerms<'a> {
     /// M(q), eq. (13).

@@ -46,6 +46,26 @@ pub enum SimError {
         on_cam: bool,
     },
 
+    /// Assembly found no configuration where every loop closes (or every constraint holds
+    /// together): Newton from the initial guess left `constraint` open by `residual`, or a
+    /// loop equation that is implied by the others to first order is not satisfied.
+    #[error(
+        "at t = {t} s the mechanism cannot be assembled: {constraint} is still {residual:.3e}          from closing ({why}); q = {}",
+        Compact(.q)
+    )]
+    CannotAssemble {
+        /// Time (s).
+        t: f64,
+        /// Coordinates at the last iterate.
+        q: Vec<f64>,
+        /// |h| of that constraint there.
+        residual: f64,
+        /// The constraint: a contact's name or `loop.equation`.
+        constraint: String,
+        /// What was tried.
+        why: String,
+    },
+
     /// The reduced mass matrix M* of eq. (18) is not positive definite (an invalid model:
     /// zero or negative inertia along some admissible motion).
     #[error(
@@ -119,6 +139,7 @@ impl SimError {
         match self {
             SimError::NewtonFailed { .. } => "NewtonFailed",
             SimError::SingularConstraint { .. } => "SingularConstraint",
+            SimError::CannotAssemble { .. } => "CannotAssemble",
             SimError::NotPositiveDefinite { .. } => "NotPositiveDefinite",
             SimError::NonFinite { .. } => "NonFinite",
             SimError::StepSizeTooSmall { .. } => "StepSizeTooSmall",
@@ -133,6 +154,7 @@ impl SimError {
         match self {
             SimError::NewtonFailed { t, .. }
             | SimError::SingularConstraint { t, .. }
+            | SimError::CannotAssemble { t, .. }
             | SimError::NotPositiveDefinite { t, .. }
             | SimError::NonFinite { t, .. }
             | SimError::StepSizeTooSmall { t, .. }

@@ -64,6 +64,51 @@ const DAMPED_MIN_FRACTION: f64 = 1e-10;
 /// coordinates: such a column would amplify round-off by more than 10¹².
 const NEGLIGIBLE_PIVOT: f64 = 1e-12;
 
+/// A pivot of J at or below this fraction of max |J_ij| marks its row as redundant: the
+/// equation is implied by the others ([`independent_rows`]). 1e-8 is far above the round-off
+/// of a consistent redundant set (~1e-15 relative) and far below any pivot of a mechanism away
+/// from a singular position; an initial guess this close to a singular position is reported
+/// rather than trusted (assembly checks the rank again at the solution).
+pub const REDUNDANT_PIVOT: f64 = 1e-8;
+
+/// The largest set of independent rows of the m×n Jacobian `j` and as many dependent columns
+/// among the `eligible` ones, by Gaussian elimination with complete pivoting: each pivot is
+/// the largest remaining entry; elimination stops when it is at most [`REDUNDANT_PIVOT`]
+/// times max |J_ij|. Returns (rows, columns), each in increasing order; rows left out are
+/// redundant (implied by the chosen ones to first order), and `rows.len()` is the rank.
+pub fn independent_rows(
+    j: &[f64],
+    m: usize,
+    n: usize,
+    eligible: &[bool],
+) -> (Vec<usize>, Vec<usize>) {
+    let scale = j.iter().fold(0.0_f64, |acc, x| acc.max(x.abs()));
+    let mut a = j.to_vec();
+    let mut row_done = vec![false; m];
+    let mut column_used = vec![false; n];
+    let (mut rows, mut columns) = (Vec::new(), Vec::new());
+    if !scale.is_finite() || scale == 0.0 {
+        return (rows, columns);
+    }
+    for _ in 0..m {
+        let Some((row, column, pivot)) = largest_entry(&a, n, &row_done, &column_used, eligible)
+        else {
+            break;
+        };
+        if pivot.abs() <= REDUNDANT_PIVOT * scale {
+            break;
+        }
+        eliminate_column(&mut a, n, row, column, &row_done);
+        row_done[row] = true;
+        column_used[column] = true;
+        rows.push(row);
+        columns.push(column);
+    }
+    rows.sort_unstable();
+    columns.sort_unstable();
+    (rows, columns)
+}
+
 /// Chooses the dependent coordinates: nc column indices of the row-major nc×n Jacobian `j`,
 /// among the `eligible` ones, such that J_v is well conditioned.
 ///
@@ -294,6 +339,15 @@ pub struct Workspace {
     n: usize,
     nc: usize,
     nu: usize,
+    /// The model's number of constraints m (≥ nc).
+    m: usize,
+    /// The rows of the model's h that are solved (nc of the m, increasing): all of them
+    /// unless some are redundant ([`independent_rows`]).
+    rows: Vec<usize>,
+    /// h, J and c of all m rows, when some are left out (empty otherwise).
+    full_h: Vec<f64>,
+    full_jacobian: Vec<f64>,
+    full_bias: Vec<f64>,
     pub(crate) q: Vec<f64>,
     pub(crate) qd: Vec<f64>,
     pub(crate) qdd: Vec<f64>,
@@ -332,6 +386,11 @@ impl Workspace {
             n,
             nc,
             nu,
+            m: nc,
+            rows: (0..nc).collect(),
+            full_h: Vec::new(),
+            full_jacobian: Vec::new(),
+            full_bias: Vec::new(),
             q: vec![0.0; n],
             qd: vec![0.0; n],
             qdd: vec![0.0; n],
@@ -357,6 +416,107 @@ impl Workspace {
             drive: vec![0.0; n],
             length_scale: 1.0,
             newton_slack: 0.0,
+        }
+    }
+
+    /// Solves only the rows `rows` (increasing, nc of them) of a model with `m` constraints:
+    /// the others are redundant. h, J and c are evaluated for all m rows and the chosen
+    /// ones gathered; the multipliers of the others are zero.
+    pub fn select_rows(&mut self, m: usize, rows: &[usize]) {
+        self.m = m;
+        self.rows = rows.to_vec();
+        if m == self.nc {
+            self.full_h.clear();
+            self.full_jacobian.clear();
+            self.full_bias.clear();
+        } else {
+            self.full_h.resize(m, 0.0);
+            self.full_jacobian.resize(m * self.n, 0.0);
+            self.full_bias.resize(m, 0.0);
+        }
+    }
+
+    /// The rows of h solved (all of them unless some are redundant).
+    pub fn rows(&self) -> &[usize] {
+        &self.rows
+    }
+
+    /// The number of coordinates n.
+    pub fn n_coordinates(&self) -> usize {
+        self.n
+    }
+
+    /// The model's number of constraints m.
+    pub fn m(&self) -> usize {
+        self.m
+    }
+
+    /// J of all m rows as last evaluated (the solved rows' J when none is left out).
+    pub fn full_jacobian(&self) -> &[f64] {
+        if self.m == self.nc {
+            &self.jacobian
+        } else {
+            &self.full_jacobian
+        }
+    }
+
+    /// h of all m rows as last evaluated.
+    pub fn full_h(&self) -> &[f64] {
+        if self.m == self.nc {
+            &self.h
+        } else {
+            &self.full_h
+        }
+    }
+
+    /// λ of all m rows: zero on the rows left out.
+    pub fn full_lambda(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.m];
+        for (&row, &l) in self.rows.iter().zip(&self.lambda) {
+            out[row] = l;
+        }
+        out
+    }
+
+    /// Copies the chosen rows of the full h, J into the solved ones.
+    fn gather_rows(&mut self) {
+        let n = self.n;
+        for (k, &row) in self.rows.iter().enumerate() {
+            self.h[k] = self.full_h[row];
+            self.jacobian[k * n..(k + 1) * n]
+                .copy_from_slice(&self.full_jacobian[row * n..(row + 1) * n]);
+        }
+    }
+
+    /// Re-chooses which rows are solved (same number), from the full J last evaluated.
+    pub fn reselect_rows(&mut self, rows: &[usize]) {
+        if self.m != self.nc && rows.len() == self.nc {
+            self.rows = rows.to_vec();
+            self.gather_rows();
+        }
+    }
+
+    /// h(q) of the solved rows into `self.h` (one `constraint` call).
+    fn evaluate_h<D: Dynamics + ?Sized>(&mut self, model: &D) {
+        if self.m == self.nc {
+            model.constraint(&self.q, &mut self.h);
+        } else {
+            model.constraint(&self.q, &mut self.full_h);
+            for (k, &row) in self.rows.iter().enumerate() {
+                self.h[k] = self.full_h[row];
+            }
+        }
+    }
+
+    /// h and J at q without the cache (assembly).
+    pub fn evaluate_constraints<D: Dynamics + ?Sized>(&mut self, model: &D) {
+        if self.m == self.nc {
+            model.constraint(&self.q, &mut self.h);
+            model.constraint_jacobian(&self.q, &mut self.jacobian);
+        } else {
+            model.constraint(&self.q, &mut self.full_h);
+            model.constraint_jacobian(&self.q, &mut self.full_jacobian);
+            self.gather_rows();
         }
     }
 
@@ -541,7 +701,7 @@ impl Workspace {
             for ((&saved, &dv), &v) in self.saved_v.iter().zip(&self.scratch).zip(dependent) {
                 self.q[v] = saved - fraction * dv;
             }
-            model.constraint(&self.q, &mut self.h);
+            self.evaluate_h(model);
             let trial = euclidean(&self.h);
             let small = max_abs(&self.h) <= self.residual_tolerance();
             if trial.is_finite() && (small || trial < (1.0 - 1e-4 * fraction) * norm) {
@@ -670,7 +830,17 @@ impl Workspace {
         if self.cache.len() != len {
             self.cache.resize(len, f64::NAN);
         }
-        model.position_terms(&self.q, &mut self.h, &mut self.jacobian, &mut self.cache);
+        if self.m == self.nc {
+            model.position_terms(&self.q, &mut self.h, &mut self.jacobian, &mut self.cache);
+        } else {
+            model.position_terms(
+                &self.q,
+                &mut self.full_h,
+                &mut self.full_jacobian,
+                &mut self.cache,
+            );
+            self.gather_rows();
+        }
     }
 
     /// Evaluates h and J(q) (5b) and factors J_v (the `dependent` columns).
@@ -757,13 +927,23 @@ impl Workspace {
     ) -> Result<(), SimError> {
         // One call: generated models share the kinematics between M, F, Q and c, and take
         // the sines and cosines from the position level.
+        let all_rows = self.m == self.nc;
         let out = VelocityTerms {
             mass: &mut self.mass,
             inertial: &mut self.inertial,
             applied: &mut self.applied,
-            bias: &mut self.bias,
+            bias: if all_rows {
+                &mut self.bias
+            } else {
+                &mut self.full_bias
+            },
         };
         model.velocity_terms(t, &self.q, &self.qd, &self.cache, out);
+        if !all_rows {
+            for (k, &row) in self.rows.iter().enumerate() {
+                self.bias[k] = self.full_bias[row];
+            }
+        }
         self.reduce_and_solve(partition, t)
     }
 

@@ -18,7 +18,7 @@ use crate::integrators::{Adaptive, Counters, Dop853, Dopri5, Rk4, Tolerances};
 use crate::metrics::{MetricsFailure, MetricsOptions, RunMetrics};
 use crate::partition::{
     NEWTON_SLACK_PER_RTOL, Partition, REPARTITION_RATIO, Workspace, choose_dependent, conditioning,
-    normal_force,
+    independent_rows, normal_force,
 };
 
 /// A step ending within this fraction of a step before an output time is stretched to land
@@ -520,7 +520,7 @@ fn setting_error(e: crate::settings::InvalidSetting) -> SimError {
 fn check_belongs<D: Dynamics + ?Sized>(model: &D, state: &State) -> Result<(), SimError> {
     let n = model.info().n();
     let fits = state.q.len() == n && state.qd.len() == n && state.partition.n() == n;
-    if fits && state.dependent().len() == model.info().n_contacts() {
+    if fits && state.dependent().len() <= model.info().n_constraints() {
         Ok(())
     } else {
         Err(invalid(format!(
@@ -877,10 +877,10 @@ impl Phase<'_, '_> {
             Watch::Forces { .. } => {
                 ws.solve_accelerations(model, partition, t)?;
                 ws.solve_multipliers(partition, t)?;
-                let mut contacts = vec![ContactGeometry::default(); partition.dependent().len()];
+                let mut contacts = vec![ContactGeometry::default(); model.info().n_contacts()];
                 model.contact_geometry(ws.q(), ws.qd(), &mut contacts);
                 Ok(ws
-                    .lambda()
+                    .full_lambda()
                     .iter()
                     .zip(&contacts)
                     .map(|(&l, g)| normal_force(l, g.force_scale))
@@ -1117,18 +1117,20 @@ fn complete_sample<D: Dynamics + ?Sized>(
     }
     ws.solve_accelerations(model, partition, t)?;
     ws.solve_multipliers(partition, t)?;
-    model.constraint(&ws.q, &mut ws.h);
-    let mut contacts = vec![ContactGeometry::default(); partition.dependent().len()];
+    let info = model.info();
+    let mut h = vec![0.0; info.n_constraints()];
+    model.constraint(&ws.q, &mut h);
+    let mut contacts = vec![ContactGeometry::default(); info.n_contacts()];
     model.contact_geometry(ws.q(), ws.qd(), &mut contacts);
-    sample.normal_force = ws
-        .lambda()
+    let lambda = ws.full_lambda();
+    sample.normal_force = lambda
         .iter()
         .zip(&contacts)
         .map(|(&l, g)| normal_force(l, g.force_scale))
         .collect();
     sample.qdd = ws.qdd().to_vec();
-    sample.lambda = ws.lambda().to_vec();
-    sample.h = ws.h.clone();
+    sample.lambda = lambda;
+    sample.h = h;
     sample.contacts = contacts;
     sample.drive = ws.drive().to_vec();
     sample.energy = model.energy(ws.q(), ws.qd());
@@ -1492,18 +1494,47 @@ pub(crate) fn finish_step<D: Dynamics + ?Sized>(
 /// Switches to the best-conditioned dependent set when the current one's conditioning is
 /// below [`REPARTITION_RATIO`] and the new one is better. Uses J at the current q.
 fn repartition_if_needed<D: Dynamics + ?Sized>(model: &D, state: &mut State) -> bool {
-    let (n, nc) = (model.info().n(), model.info().n_contacts());
-    let (jacobian, partition) = (&state.engine.ws.jacobian, &state.partition);
+    let n = model.info().n();
+    let ws = &state.engine.ws;
+    let nc = ws.rows().len();
+    let (jacobian, partition) = (&ws.jacobian, &state.partition);
     let eligible = partition.eligible();
     let current = conditioning(jacobian, nc, n, partition.dependent(), eligible);
     if current >= REPARTITION_RATIO {
         return false;
+    }
+    if ws.m() > nc {
+        return reselect_rows(state, current);
     }
     let Some(better) = choose_dependent(jacobian, nc, n, eligible) else {
         return false;
     };
     let improves = conditioning(jacobian, nc, n, &better, eligible) > current;
     improves && better != partition.dependent() && state.partition.set_dependent(&better).is_ok()
+}
+
+/// With redundant rows left out: re-chooses the solved rows and the dependent coordinates
+/// together from the full J (as many as before), when that improves the conditioning.
+fn reselect_rows(state: &mut State, current: f64) -> bool {
+    let ws = &state.engine.ws;
+    let (n, m, nc) = (ws.n_coordinates(), ws.m(), ws.rows().len());
+    let eligible = state.partition.eligible().to_vec();
+    let (rows, columns) = independent_rows(ws.full_jacobian(), m, n, &eligible);
+    if rows.len() != nc || (rows == ws.rows() && columns == state.partition.dependent()) {
+        return false;
+    }
+    let mut gathered = vec![0.0; nc * n];
+    for (k, &row) in rows.iter().enumerate() {
+        gathered[k * n..(k + 1) * n].copy_from_slice(&ws.full_jacobian()[row * n..(row + 1) * n]);
+    }
+    if conditioning(&gathered, nc, n, &columns, &eligible) <= current {
+        return false;
+    }
+    if state.partition.set_dependent(&columns).is_err() {
+        return false;
+    }
+    state.engine.ws.reselect_rows(&rows);
+    true
 }
 
 #[cfg(test)]
@@ -1570,6 +1601,7 @@ mod tests {
             contacts: (0..contacts)
                 .map(|k| crate::ContactInfo::knife(&format!("tip{k}")))
                 .collect(),
+            loops: Vec::new(),
             spatial: false,
             initial,
             defaults: settings(IntegratorKind::Dopri5, 1.0, 0.1, 1e-3, 1e-9),
@@ -1949,7 +1981,7 @@ mod tests {
         qd: &[f64],
     ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let info = model.info();
-        let (n, nc) = (info.n(), info.n_contacts());
+        let (n, nc) = (info.n(), info.n_constraints());
         let driven: Vec<usize> = (0..n).filter(|&i| info.coordinates[i].driven).collect();
         let (mut m, mut f, mut applied) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
         let (mut j, mut c) = (vec![0.0; nc * n], vec![0.0; nc]);

@@ -295,6 +295,13 @@ fn validate_unilateral<D: Dynamics + ?Sized>(
 ) -> Result<(), SimError> {
     validate_run(model, state, settings)?;
     let invalid = |message: String| Err(SimError::InvalidSettings { message });
+    if !model.info().loops.is_empty() {
+        return invalid(format!(
+            "unilateral contact is not available in a model with loop closures yet; {} has {}",
+            model.info().name,
+            model.info().loops.len()
+        ));
+    }
     if model.info().n_contacts() != 1 {
         return invalid(format!(
             "unilateral contact needs a model with exactly one cam contact; {} has {}",

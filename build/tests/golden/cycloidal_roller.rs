@@ -377,6 +377,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             cam_coordinate: Some(0),
         },
     ]),
+    loops: Vec::from([]),
     spatial: false,
     initial: rt::InitialGuess {
         q: Vec::from([0.0, 0.052500000000000005]),

@@ -489,6 +489,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             cam_coordinate: None,
         },
     ]),
+    loops: Vec::from([]),
     spatial: false,
     initial: rt::InitialGuess {
         q: Vec::from([-1.6707963267948966, 0.0, 0.0, 0.0]),

@@ -101,23 +101,24 @@ fn path_to_root(model: &Model, body: Option<usize>) -> Vec<usize> {
 }
 
 /// A point fixed on a body, moving relative to an ancestor taken as fixed.
-struct PointMotion {
+pub(crate) struct PointMotion {
     /// Ground position.
-    position: V3,
+    pub position: V3,
     /// ∂p/∂q_j (ground) for the joints that move it relative to the ancestor.
-    columns: Vec<Option<V3>>,
+    pub columns: Vec<Option<V3>>,
     /// Velocity-product part of its acceleration relative to the ancestor.
-    convective: V3,
+    pub convective: V3,
     /// The body's angular velocity relative to the ancestor.
-    omega: V3,
+    pub omega: V3,
     /// Velocity-product part of that angular velocity's rate.
-    alpha: V3,
+    pub alpha: V3,
 }
 
 /// What names the labels of a point's terms (`A` for the follower of contact A, `A_cam` for
 /// its cam's origin).
-struct Labels<'a> {
-    name: &'a str,
+pub(crate) struct Labels<'a> {
+    /// The prefix of the labels.
+    pub name: &'a str,
 }
 
 /// The motion of the point `local` of `body`, relative to the common ancestor: only the
@@ -125,7 +126,7 @@ struct Labels<'a> {
 /// `project` is called with each joint's column as soon as it is known (so that a fixed
 /// cam's projections are formed where the paper's were).
 #[allow(clippy::too_many_arguments)]
-fn point_motion(
+pub(crate) fn point_motion(
     g: &mut Graph,
     model: &Model,
     kin: &[BodyKinematics],

@@ -532,6 +532,7 @@ fn constant_value(model: &Model, field: Field) -> f64 {
         Field::Rest(b) => model.bodies[b].joint.spring.map_or(0.0, |s| s.rest),
         Field::Marker(m, k) => model.markers[m].position[k],
         Field::Origin(c, k) => model.contacts[c].origin[k],
+        Field::LoopPoint(l, side, k) => model.loops[l].sides[side].point[k],
         Field::InitialQ(i) => model.initial.q[i],
         Field::InitialQd(i) => model.initial.qd[i],
         Field::Radius(c) => match model.contacts[c].follower {

@@ -113,6 +113,8 @@ pub(super) struct Model {
     #[serde(default)]
     pub contacts: Vec<Contact>,
     #[serde(default)]
+    pub loops: Vec<Loop>,
+    #[serde(default)]
     pub initial: Initial,
     #[serde(default)]
     pub simulation: Simulation,
@@ -190,6 +192,40 @@ pub(super) struct Marker {
     pub body: String,
     #[serde(default)]
     pub position: Vec3,
+}
+
+/// A loop closure: the joint a loop is cut at, between two markers.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Loop {
+    pub name: String,
+    pub kind: LoopKind,
+    pub a: LoopSide,
+    pub b: LoopSide,
+    /// B's axis or line, B's body frame.
+    #[serde(default)]
+    pub axis: Option<Vec3>,
+    /// A's axis or direction, A's body frame (defaults to `axis`).
+    #[serde(default)]
+    pub axis_a: Option<Vec3>,
+}
+
+/// A point of a body (or of the ground) that a loop closes at.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LoopSide {
+    pub body: String,
+    #[serde(default)]
+    pub point: Vec3,
+}
+
+/// The kind of a cut joint.
+#[derive(Debug, Clone, Copy, Deserialize)]
+pub(super) enum LoopKind {
+    Revolute,
+    Spherical,
+    Prismatic,
+    PointOnLine,
 }
 
 /// A contact: a follower (a marker and its shape) on a cam profile carried by a body.

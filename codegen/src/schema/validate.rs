@@ -17,6 +17,7 @@ use std::collections::{BTreeMap, HashMap};
 
 mod contacts;
 mod designs;
+mod loops;
 mod tables;
 use contacts::contacts;
 
@@ -83,21 +84,35 @@ pub(super) fn validate(
             ),
         ));
     }
-    Ok(Model {
+    if simulation.restitution.is_some() && !file.loops.is_empty() {
+        return Err(at.error(
+            "simulation.restitution",
+            "one-sided contact (`restitution`) is not available in a model with loops yet: \
+             remove `restitution` to hold the follower on its cam",
+        ));
+    }
+    let mut model = Model {
         name,
         description: file.description.clone(),
         parameters,
-        symbolic: table.symbolic.into_inner(),
-        runtime_checks: table.checks.into_inner(),
+        symbolic: BTreeMap::new(),
+        runtime_checks: Vec::new(),
         parameters_at: location(at, "parameters"),
         gravity,
         bodies,
         markers,
         contacts,
+        loops: Vec::new(),
         initial,
         simulation,
-        files: read.into_inner(),
-    })
+        files: Vec::new(),
+    };
+    model.symbolic = table.symbolic.borrow().clone();
+    model.loops = loops::loops(&file.loops, &tree, &model, &cx)?;
+    model.symbolic = table.symbolic.into_inner();
+    model.runtime_checks = table.checks.into_inner();
+    model.files = read.into_inner();
+    Ok(model)
 }
 
 /// Where `field` is written.

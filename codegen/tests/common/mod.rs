@@ -124,6 +124,7 @@ pub fn paper_concave() -> Model {
             range: None,
             design: None,
         }],
+        loops: Vec::new(),
         initial: Initial {
             q: vec![-std::f64::consts::FRAC_PI_2 - 0.1, 0.0, 0.0, 0.0],
             qd: vec![0.0; 4],
@@ -259,6 +260,7 @@ pub fn spatial_tree() -> Model {
             range: None,
             design: None,
         }],
+        loops: Vec::new(),
         initial: Initial {
             q: vec![0.0; 5],
             qd: vec![0.0; 5],

@@ -92,7 +92,7 @@ pub fn compare_dynamics_at(
 ) -> f64 {
     let worst = Cell::new(0.0);
     let n = generated.info().n();
-    let nc = generated.info().n_contacts();
+    let nc = generated.info().n_constraints();
     assert_eq!(numeric.info().n(), n);
     for (q, qd, t) in states {
         let (q, qd, t) = (q.clone(), qd.clone(), *t);
@@ -165,7 +165,7 @@ pub fn compare_dynamics_at(
             &format!("{name}: position_terms then velocity_terms"),
             &worst,
         );
-        for k in 0..nc {
+        for k in 0..generated.info().n_contacts() {
             let (a, b) = both(&|m| {
                 let ck = m.contact_kinematics(&q, &qd, k);
                 let g = ck.geometry;
@@ -183,6 +183,13 @@ pub fn compare_dynamics_at(
                 &worst,
             );
         }
+        let loop_points = 2 * generated.info().loops.len();
+        let (a, b) = both(&|m| {
+            let mut points = vec![[0.0; 3]; loop_points];
+            m.loop_points(&q, &mut points);
+            points.concat()
+        });
+        assert_close_recorded(&a, &b, tol, &format!("{name}: loop points"), &worst);
         let (a, b) = both(&|m| {
             let e = m.energy(&q, &qd);
             vec![

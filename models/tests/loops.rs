@@ -1,0 +1,141 @@
+//! Closed loops (docs/method.md §11), checked against closed forms and by independent routes:
+//!
+//! - the loop terms h, J, c of the generated code against the numeric reference (its own pose
+//!   and motion recursions), and J and c against finite differences of h;
+//! - the slider-crank driven at constant crank speed: the piston at
+//!   x = r cos θ + √(l² − r² sin² θ) (the textbook kinematics of the in-line slider-crank);
+//! - the four-bar: energy balance (kinetic + potential − the motor's work constant);
+//! - generated and numeric trajectories of the loop models coincide.
+
+mod common;
+
+use camchain::runtime::{Dynamics, Simulate, Trajectory};
+use camchain_models as models;
+use camchain_reference::NumericModel;
+use std::path::Path;
+
+fn numeric(name: &str) -> NumericModel {
+    let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
+    NumericModel::load(Path::new(&path)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn run(model: &dyn Dynamics) -> Trajectory {
+    let state = model
+        .assemble(0.0)
+        .unwrap_or_else(|e| panic!("assembles: {e}"));
+    let settings = model.info().defaults.clone();
+    model
+        .simulate(state, &settings)
+        .unwrap_or_else(|f| panic!("{}", f.error))
+}
+
+const LOOP_MODELS: [&str; 2] = ["four_bar", "slider_crank"];
+
+/// h at q, for finite differences.
+fn h_at(model: &dyn Dynamics, q: &[f64]) -> Vec<f64> {
+    let mut h = vec![0.0; model.info().n_constraints()];
+    model.constraint(q, &mut h);
+    h
+}
+
+#[test]
+fn loop_jacobian_and_bias_match_finite_differences_of_h() {
+    // Central differences with step 1e-5 have truncation error ~ε²|h‴| ≈ 1e-10 and round-off
+    // ~1e-16/1e-5 = 1e-11 for lengths of order 0.1 m; the second difference for c (J q̇ along
+    // the path q + s q̇) has truncation ~1e-10 and round-off ~1e-16/1e-10 = 1e-6: 1e-6 on J
+    // and 1e-4 on c (relative to max(1, |value|)) leave a margin of 100.
+    for name in LOOP_MODELS {
+        let model = models::by_name(name).expect("built in");
+        let (n, m) = (model.info().n(), model.info().n_constraints());
+        let mut rng = common::Rng::new(41);
+        for _ in 0..20 {
+            let q = rng.vec(n, -1.5, 1.5);
+            let qd = rng.vec(n, -2.0, 2.0);
+            let mut j = vec![0.0; m * n];
+            model.constraint_jacobian(&q, &mut j);
+            let mut c = vec![0.0; m];
+            model.constraint_bias(&q, &qd, &mut c);
+            let eps = 1e-5;
+            for i in 0..n {
+                let (mut plus, mut minus) = (q.clone(), q.clone());
+                plus[i] += eps;
+                minus[i] -= eps;
+                let (hp, hm) = (h_at(model, &plus), h_at(model, &minus));
+                let column: Vec<f64> = (0..m).map(|k| (hp[k] - hm[k]) / (2.0 * eps)).collect();
+                let ours: Vec<f64> = (0..m).map(|k| j[k * n + i]).collect();
+                common::assert_close(&ours, &column, 1e-6, &format!("{name}: J column {i}"));
+            }
+            // c = d²h/ds² along q + s q̇ at s = 0.
+            let s = 1e-4;
+            let along = |k: f64| -> Vec<f64> {
+                let p: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + k * s * b).collect();
+                h_at(model, &p)
+            };
+            let (hp, h0, hm) = (along(1.0), along(0.0), along(-1.0));
+            let second: Vec<f64> = (0..m)
+                .map(|k| (hp[k] - 2.0 * h0[k] + hm[k]) / (s * s))
+                .collect();
+            common::assert_close(&c, &second, 1e-4, &format!("{name}: c"));
+        }
+    }
+}
+
+#[test]
+fn loop_models_agree_with_the_numeric_reference() {
+    // Both evaluate the same formulas by different recursions: round-off only (1e-12
+    // relative is ~10⁴ ε).
+    for name in LOOP_MODELS {
+        let generated = models::by_name(name).expect("built in");
+        let worst = common::compare_dynamics(name, generated, &numeric(name), 1e-12);
+        println!("{name}: generated vs numeric {worst:.2e}");
+    }
+}
+
+#[test]
+fn slider_crank_piston_follows_the_closed_form() {
+    // Newton (15) leaves |h| ≤ 1e-12 m before its polishing step and the integration has no
+    // free coordinate to drift: every sample's piston is where the kinematics put it. 1e-10 m
+    // is the bound, 100 times the solve's tolerance.
+    let model = models::by_name("slider_crank").expect("built in");
+    let trajectory = run(model);
+    let (r, l) = (0.05_f64, 0.2_f64);
+    let mut worst: f64 = 0.0;
+    for s in &trajectory.samples {
+        let theta = s.q[0];
+        let x = r * theta.cos() + (l * l - (r * theta.sin()).powi(2)).sqrt();
+        worst = worst.max((s.q[2] - x).abs());
+    }
+    println!("slider_crank: piston against r cos θ + √(l² − r² sin² θ): {worst:.2e} m");
+    assert!(worst < 1e-10, "piston off the closed form by {worst:e} m");
+    assert!(trajectory.samples.len() > 200);
+}
+
+#[test]
+fn four_bar_energy_balances_the_motor_work() {
+    // No damper: kinetic + potential − work of the motor torque is constant. DOP853 at
+    // rtol 1e-10 over ~10³ steps accumulates ~1e-9 of the energy exchanged (the motor's
+    // ~400 J over 2 s): 1e-8 of it leaves a margin of 10.
+    let model = models::by_name("four_bar").expect("built in");
+    let trajectory = run(model);
+    let first = &trajectory.samples[0];
+    let balance = |s: &camchain::runtime::Sample| s.energy.total() - s.driven_work;
+    let mut worst: f64 = 0.0;
+    for s in &trajectory.samples {
+        worst = worst.max((balance(s) - balance(first)).abs());
+        assert!(
+            s.h.iter().all(|h| h.abs() < 1e-10),
+            "loop open at t = {}",
+            s.t
+        );
+    }
+    let last = trajectory.samples.last().expect("samples");
+    println!(
+        "four_bar: energy balance drift {worst:.2e} J, motor work {:.3} J, {} re-partitions",
+        last.driven_work, trajectory.stats.repartitions
+    );
+    let scale = last.driven_work.abs() + balance(first).abs();
+    assert!(
+        worst < 1e-8 * scale,
+        "energy balance drifts by {worst:e} J of {scale} J"
+    );
+}
