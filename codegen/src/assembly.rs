@@ -15,8 +15,121 @@ const TOLERANCE: f64 = 1e-10;
 /// Newton iterations before giving up.
 const MAX_ITERATIONS: usize = 50;
 
-/// Solves the free coordinates so every contact holds; returns the assembled q.
+/// Solves the free coordinates so every contact holds; returns the assembled q. A model with
+/// loops goes through [`assemble_with_loops`] (the message then names the loop furthest from
+/// closing; [`assemble_located`] also gives its field).
 pub fn assemble(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
+    assemble_located(model, d).map_err(|(_, message)| message)
+}
+
+/// [`assemble`] with the field the problem is located at: `initial`, or `loops[k]`.
+pub fn assemble_located(model: &Model, d: &Derivation) -> Result<Vec<f64>, (String, String)> {
+    if model.loops.is_empty() {
+        assemble_contacts(model, d).map_err(|m| ("initial".to_string(), m))
+    } else {
+        assemble_with_loops(model, d)
+    }
+}
+
+/// A model with loops: Gauss–Newton on every row of h (contacts and loops) over the
+/// coordinates neither held nor driven, each step the least-norm solution through the
+/// singular value decomposition with the singular values below 1e-10 of the largest left
+/// out, so that redundant loop equations (a Bricard mechanism, a parallelogram with a third
+/// bar) and more coordinates than equations are both handled. Fails with the loop (or
+/// contact) furthest from closing, located at its field.
+fn assemble_with_loops(model: &Model, d: &Derivation) -> Result<Vec<f64>, (String, String)> {
+    let n = model.n();
+    let mut q = model.initial.q.clone();
+    let qd = vec![0.0; n];
+    for drive in &d.drives {
+        q[drive.coordinate] = d.eval(&drive.motion[..1], 0.0, &q, &qd)[0];
+    }
+    let rows = d.constraint_rows();
+    let h_ids: Vec<_> = rows.iter().map(|r| r.0).collect();
+    let j_ids: Vec<_> = rows.iter().flat_map(|r| r.1.iter().copied()).collect();
+    let m = h_ids.len();
+    let free: Vec<usize> = (0..n)
+        .filter(|&i| !model.initial.hold[i] && model.bodies[i].joint.prescribed.is_none())
+        .collect();
+    let mut h = d.eval(&h_ids, 0.0, &q, &qd);
+    for _ in 0..MAX_ITERATIONS {
+        let residual = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if residual <= TOLERANCE {
+            return Ok(q);
+        }
+        let j = d.eval(&j_ids, 0.0, &q, &qd);
+        let a = DMatrix::from_fn(m, free.len(), |r, c| j[r * n + free[c]]);
+        if free.is_empty() || !a.iter().all(|v| v.is_finite()) {
+            break;
+        }
+        let svd = a.svd(true, true);
+        let cut = 1e-10 * svd.singular_values.max();
+        let Ok(step) = svd.solve(&DVector::from_column_slice(&h), cut) else {
+            break;
+        };
+        // Backtracking on |h|: a full step from far off can overshoot onto the other branch.
+        let before: f64 = h.iter().map(|x| x * x).sum();
+        let mut fraction = 1.0;
+        let start = q.clone();
+        loop {
+            for (k, &i) in free.iter().enumerate() {
+                q[i] = start[i] - fraction * step[k];
+            }
+            h = d.eval(&h_ids, 0.0, &q, &qd);
+            let after: f64 = h.iter().map(|x| x * x).sum();
+            if after.is_finite() && (after < before || fraction < 1e-6) {
+                break;
+            }
+            fraction *= 0.5;
+        }
+    }
+    let (row, residual) = h
+        .iter()
+        .enumerate()
+        .map(|(k, v)| (k, v.abs()))
+        .fold(
+            (0, 0.0),
+            |b, x| if x.1 > b.1 || x.1.is_nan() { x } else { b },
+        );
+    let nc = model.contacts.len();
+    let (field, what) = if row < nc {
+        (
+            "initial".to_string(),
+            format!("contact {}", model.contacts[row].name),
+        )
+    } else {
+        let mut first = nc;
+        let mut located = ("loops".to_string(), String::from("a loop"));
+        for (l, closure) in model.loops.iter().enumerate() {
+            let count = closure.equations().len();
+            if row < first + count {
+                located = (
+                    format!("loops[{l}]"),
+                    format!(
+                        "loop `{}` (equation {})",
+                        closure.name,
+                        closure.equations()[row - first]
+                    ),
+                );
+                break;
+            }
+            first += count;
+        }
+        located
+    };
+    Err((
+        field,
+        format!(
+            "the mechanism cannot be assembled: {what} is still {residual:.3e} from closing after \
+             {MAX_ITERATIONS} Gauss-Newton iterations from the initial guess q = {q:?}; the \
+             lengths do not let the loop close, or the guess is too far from a closed \
+             configuration: check the loop's points and lengths, or change initial.q"
+        ),
+    ))
+}
+
+/// [`assemble`] for a model without loops.
+fn assemble_contacts(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
     let n = model.n();
     let nc = d.contacts.len();
     let mut q = model.initial.q.clone();

@@ -95,9 +95,9 @@ pub fn located_warnings(model: &Model, source: &str, display: &Path) -> Vec<Mode
 /// The initial state of a validated model assembles onto its cams (located at `initial`).
 fn check_assembly(model: &Model, source: &str, display: &Path) -> Result<(), ModelError> {
     let derivation = Derivation::new(model);
-    assembly::assemble(model, &derivation)
+    assembly::assemble_located(model, &derivation)
         .map(|_| ())
-        .map_err(|message| schema::field_error(display, source, "initial", message))
+        .map_err(|(field, message)| schema::field_error(display, source, &field, message))
 }
 
 /// Validates and checks the text of a model file and generates its Rust module: parsing and

@@ -975,6 +975,57 @@ const CASES: &[Case] = &[
         "contacts[0].law.segments",
         "at least one segment",
     ),
+    // Loops (from models/four_bar.ron).
+    // The slot's axis `(0.0, 0.0, 1.0)`.
+    case(
+        "loop_axis_out_of_plane.ron",
+        48,
+        114,
+        "loops[1].axis",
+        "must be in the x-y plane",
+    ),
+    // The loop `pin` itself: its coupler is too short to reach the rocker.
+    Case {
+        file: "loop_cannot_close.ron",
+        line: 47,
+        column: 9,
+        field: "loops[0]",
+        phrase: "cannot be assembled",
+        reference: Reference::Assemble,
+        located: None,
+    },
+    // `"coupler"` as the loop's second body.
+    case(
+        "loop_joins_a_body_to_itself.ron",
+        47,
+        95,
+        "loops[0].b.body",
+        "joins `coupler` to itself",
+    ),
+    // The second loop's name `"pin"`.
+    case(
+        "loop_name_taken.ron",
+        48,
+        16,
+        "loops[1].name",
+        "already used by loops[0]",
+    ),
+    // The second loop, `(name: "stop", …)`.
+    case(
+        "loop_too_many_equations.ron",
+        48,
+        9,
+        "loops[1]",
+        "more constraint equations than free coordinates",
+    ),
+    // `"rocket"`.
+    case(
+        "loop_unknown_body.ron",
+        47,
+        95,
+        "loops[0].b.body",
+        "unknown body `rocket`",
+    ),
 ];
 
 fn corpus() -> PathBuf {
