@@ -8,7 +8,11 @@
 //! the follower), `C_pressure_angle` (rad, between the contact normal and the direction in
 //! which the follower's own joint moves the follower point), `C_sliding_speed` (m/s, the
 //! follower's tangential speed over the cam at the contact point), `C_h` (the constraint
-//! residual, m; in flight the gap); for each driven coordinate, `<name>_drive` (the force or
+//! residual, m; in flight the gap); for each equation E of each loop L, `L_E_h` (its
+//! residual: m for the gap's components `x`, `y`, `z` and `normal`, dimensionless for `turn`
+//! and `tilt`) and `L_E_reaction` (−λ: for `x`, `y`, `z` the force that B's body exerts on
+//! A's at the cut, ground axes, N; for `normal` the force across the line, N; for `turn`
+//! and `tilt` the moment that keeps the directions aligned, N m); for each driven coordinate, `<name>_drive` (the force or
 //! torque of its drive); then `energy` (kinetic + potential of gravity and springs),
 //! `dissipated` (work done by the dampers so far) and `driven_work` (work done by the drives
 //! and the applied joint loads so far), so that `energy + dissipated − driven_work` stays
@@ -41,6 +45,12 @@ pub fn header(info: &ModelInfo) -> Vec<String> {
                 .map(|a| format!("{contact}_{a}")),
         );
     }
+    for (_, l) in info.loop_rows() {
+        for e in &l.equations {
+            columns.push(format!("{}_{e}_h", l.name));
+            columns.push(format!("{}_{e}_reaction", l.name));
+        }
+    }
     columns.extend(
         info.coordinates
             .iter()
@@ -69,6 +79,11 @@ pub fn row(info: &ModelInfo, sample: &Sample) -> Vec<f64> {
             contact.sliding_speed,
             sample.h[k],
         ]);
+    }
+    // Each loop equation's residual and its reaction −λ (docs/model-format.md, "Loops").
+    for k in info.n_contacts()..info.n_constraints() {
+        values.push(sample.h.get(k).copied().unwrap_or(f64::NAN));
+        values.push(-sample.lambda.get(k).copied().unwrap_or(f64::NAN));
     }
     values.extend(
         info.coordinates

@@ -424,11 +424,18 @@ fn frame(geometry: &Geometry, sample: &Sample, color: RGBColor, x_ranges: &[(f64
             coms.push(project(com));
         }
     }
+    // The loops' cut points are pins too.
+    let mut joints = origins;
+    joints.extend(
+        pose.markers[geometry.loop_points_from..]
+            .iter()
+            .map(project),
+    );
     Frame {
         label: format!("t = {} s", round_time(sample.t)),
         color,
         links,
-        joints: origins,
+        joints,
         bases,
         tips: sample
             .contacts

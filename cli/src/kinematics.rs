@@ -61,8 +61,11 @@ impl Plane {
 #[derive(Debug, Clone)]
 pub struct Geometry {
     joints: Vec<JointFrame>,
-    /// (body, position in the body frame) of every marker.
+    /// (body, position in the body frame) of every marker, then of every loop's cut point
+    /// on a body (drawn as a link from the body's joint and a pin).
     markers: Vec<(usize, Vec3)>,
+    /// Index in `markers` of the first loop point.
+    pub loop_points_from: usize,
     /// Body names, in coordinate order.
     pub body_names: Vec<String>,
     /// The drawing plane: the first cam's, or the ground x–y plane.
@@ -228,11 +231,17 @@ impl Geometry {
                 com: Vec3::from(b.com),
             })
             .collect();
-        let markers = model
+        let mut markers: Vec<(usize, Vec3)> = model
             .markers
             .iter()
             .map(|m| (m.body, Vec3::from(m.position)))
             .collect();
+        let loop_points_from = markers.len();
+        markers.extend(model.loops.iter().flat_map(|l| {
+            l.sides
+                .iter()
+                .filter_map(|side| side.body.map(|b| (b, Vec3::from(side.point))))
+        }));
         let values: Vec<f64> = model.parameters.iter().map(|p| p.value).collect();
         let cams = model
             .contacts
@@ -248,6 +257,7 @@ impl Geometry {
         let mut geometry = Geometry {
             joints,
             markers,
+            loop_points_from,
             body_names: model.bodies.iter().map(|b| b.name.clone()).collect(),
             plane: Plane::ground(),
             profile,

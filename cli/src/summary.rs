@@ -149,6 +149,19 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
         let (lo, hi) = range(samples, |s| s.contacts[k].sliding_speed);
         rows.push((format!("{name}_sliding_speed [m/s]"), lo, hi));
     }
+    for (first, l) in info.loop_rows() {
+        for (e, equation) in l.equations.iter().enumerate() {
+            let unit = if equation.starts_with("turn") || equation.starts_with("tilt") {
+                "N m"
+            } else {
+                "N"
+            };
+            let (lo, hi) = range(samples, |s| {
+                -s.lambda.get(first + e).copied().unwrap_or(f64::NAN)
+            });
+            rows.push((format!("{}_{equation}_reaction [{unit}]", l.name), lo, hi));
+        }
+    }
     for (i, c) in info.coordinates.iter().enumerate() {
         if c.driven {
             let (lo, hi) = range(samples, |s| s.drive[i]);
@@ -288,6 +301,13 @@ pub fn render(report: &RunReport) -> String {
                 .fold(0.0, f64::max);
             checks.push(format!("max |{name}_h| {max_h:.2e} m"));
         }
+        for (first, l) in info.loop_rows() {
+            let max_h = samples
+                .iter()
+                .flat_map(|s| s.h.iter().skip(first).take(l.equations.len()))
+                .fold(0.0_f64, |m, h| m.max(h.abs()));
+            checks.push(format!("max |{}_h| {max_h:.2e}", l.name));
+        }
         let (drift, scale) = (energy_drift(samples), energy_scale(samples));
         let relative = if scale > 0.0 {
             format!(
@@ -312,6 +332,7 @@ pub fn render(report: &RunReport) -> String {
         stats.repartitions,
         wall_time(*wall)
     );
+    text.push_str(&render_repartitions(info, samples));
     if !events.is_empty() || settings.integrator.is_adaptive() {
         text.push_str(&render_events(info, events));
         return text;
@@ -336,6 +357,48 @@ pub fn render(report: &RunReport) -> String {
             }
             None => {}
         }
+    }
+    text
+}
+
+/// The changes of the dependent coordinates seen between consecutive samples, one line each
+/// (the first [`LISTED_EVENTS`], then a count): `between t = a and b s: {q2, q3} → {q1, q3}`.
+/// Empty when the partition never changed between outputs.
+pub fn render_repartitions(info: &ModelInfo, samples: &[Sample]) -> String {
+    let names = |d: &[usize]| -> String {
+        let list: Vec<&str> = d
+            .iter()
+            .map(|&i| info.coordinates[i].name.as_str())
+            .collect();
+        format!("{{{}}}", list.join(", "))
+    };
+    let changes: Vec<(f64, f64, String, String)> = samples
+        .windows(2)
+        .filter(|w| w[0].dependent != w[1].dependent)
+        .map(|w| {
+            (
+                w[0].t,
+                w[1].t,
+                names(&w[0].dependent),
+                names(&w[1].dependent),
+            )
+        })
+        .collect();
+    let mut text = String::new();
+    for (a, b, from, to) in changes.iter().take(LISTED_EVENTS) {
+        let _ = writeln!(
+            text,
+            "  re-partitioned between t = {} and {} s: dependent {from} → {to}",
+            number(*a),
+            number(*b)
+        );
+    }
+    if changes.len() > LISTED_EVENTS {
+        let _ = writeln!(
+            text,
+            "  … and {} more re-partitions between outputs",
+            changes.len() - LISTED_EVENTS
+        );
     }
     text
 }
@@ -401,8 +464,17 @@ fn wall_time(wall: Duration) -> String {
 /// `assembled: q3 0 → −0.07747 (the root of h nearest the guess); q1_dot …` (empty when it
 /// changed nothing).
 pub fn assembly(info: &ModelInfo, report: &AssemblyReport) -> String {
+    let redundant = if report.redundant.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "redundant constraint equations left out (implied by the others; their reactions \
+             are carried by the rest): {}\n",
+            report.redundant.join(", ")
+        )
+    };
     if report.changes.is_empty() {
-        return String::new();
+        return redundant;
     }
     let parts: Vec<String> = report
         .changes
@@ -429,7 +501,7 @@ pub fn assembly(info: &ModelInfo, report: &AssemblyReport) -> String {
             format!("{name} {} → {}{how}", number(c.from), number(c.to))
         })
         .collect();
-    format!("assembled: {}\n", parts.join("; "))
+    format!("{redundant}assembled: {}\n", parts.join("; "))
 }
 
 /// A solved angle that moved this far from a value the model file gave (rad) is reported.

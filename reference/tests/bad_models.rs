@@ -2,7 +2,7 @@
 //! named in its first comment line; its second says which model it derives from:
 //! `models/paper_concave.ron`, `driven_concave.ron`, `spatial_arm.ron`, or one of the models
 //! of cams on moving bodies, `eccentric_roller.ron`, `eccentric_flat.ron`, `rocker_roller.ron`,
-//! `camshaft_flywheel.ron` and `paper_rotating.ron` (a defect that needs two contacts adds a
+//! `camshaft_flywheel.ron` and `paper_rotating.ron`, or `four_bar.ron` for loops (a defect that needs two contacts adds a
 //! second roller under the cam of `eccentric_roller` or `camshaft_flywheel`, otherwise valid).
 //! The loader the build uses
 //! (`camchain_codegen::generate_file`) must reject each with an error that names the file,
