@@ -37,12 +37,6 @@ fn d1(f: impl Fn(f64) -> f64, h: f64) -> f64 {
     (4.0 * plain(h) - plain(2.0 * h)) / 3.0
 }
 
-/// Central second difference, Richardson-extrapolated like [`d1`].
-fn d2(f: impl Fn(f64) -> f64, h: f64) -> f64 {
-    let plain = |h: f64| (f(h) - 2.0 * f(0.0) + f(-h)) / (h * h);
-    (4.0 * plain(h) - plain(2.0 * h)) / 3.0
-}
-
 fn mass(d: &Derivation, q: &[f64]) -> Vec<Vec<f64>> {
     let n = q.len();
     let roots: Vec<_> = d.dynamics.mass.iter().flatten().copied().collect();
@@ -82,6 +76,7 @@ fn check_against_finite_differences(model: &Model, seed: u64) {
         let q = rng.vec(n, -1.5, 1.5);
         let qd = rng.vec(n, -2.0, 2.0);
         check_contacts(&d, &q, &qd);
+        check_loops(&d, &q, &qd);
         check_mass_matrix(&d, &q, &qd);
         check_inertial_forces(&d, &q, &qd);
         check_gravity(&d, &q);
@@ -109,20 +104,58 @@ fn check_contacts(d: &Derivation, q: &[f64], qd: &[f64]) {
                 );
             }
         }
-        // Along the straight path q + s q̇ (q̈ = 0): d²f/ds² is the convective term.
+        // Along the straight path q + s q̇ (q̈ = 0) the convective term is d/ds (J q̇) (and
+        // d²f/ds²). The first difference of the (already checked) J q̇ with step 1e-6 has
+        // truncation ~1e-12 and rounding ~ε|J q̇|/1e-6 ≈ 1e-8 relative; across a knot of a
+        // C² table, where f‴ jumps, its error stays ≤ h·|jump|/4 (a second difference of f
+        // would be off by ~s·|jump|, 1e-4 of it at s = 1e-4): tolerance 1e-6 relative.
         let r = &c.relative;
-        for (conv, f) in [
-            (r.convective[0], r.xy[0]),
-            (r.convective[1], r.xy[1]),
-            (c.bias, c.h),
+        let j1: Vec<_> = r.columns.iter().map(|c| c[0]).collect();
+        let j2: Vec<_> = r.columns.iter().map(|c| c[1]).collect();
+        for (conv, row) in [
+            (r.convective[0], &j1),
+            (r.convective[1], &j2),
+            (c.bias, &c.jacobian),
         ] {
-            let fd = d2(|s| at(&[f], &shifted(q, qd, s))[0], 1e-4);
+            let rate = |s: f64| -> f64 {
+                let j = at(row, &shifted(q, qd, s));
+                j.iter().zip(qd).map(|(a, b)| a * b).sum()
+            };
+            let fd = d1(rate, 1e-6);
             let sym = at(&[conv], q)[0];
             assert!(
-                (sym - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                (sym - fd).abs() < 1e-6 * (1.0 + fd.abs()),
                 "convective: {sym} vs {fd}"
             );
         }
+    }
+}
+
+/// Every loop equation's J against central differences of h (step 1e-5, tolerance 1e-8
+/// relative as for the contacts) and its c against the first difference of J q̇ along
+/// q + s q̇ (step 1e-6, tolerance 1e-6 relative).
+fn check_loops(d: &Derivation, q: &[f64], qd: &[f64]) {
+    let n = q.len();
+    let at = |ids: &[camchain_codegen::expr::Id], q: &[f64]| d.eval(ids, 0.0, q, qd);
+    for row in d.loops.iter().flat_map(|l| &l.rows) {
+        for k in 0..n {
+            let fd = d1(|s| at(&[row.h], &shifted(q, &unit(n, k), s))[0], 1e-5);
+            let sym = at(&[row.jacobian[k]], q)[0];
+            assert!(
+                (sym - fd).abs() < 1e-8 * (1.0 + fd.abs()),
+                "loop ∂h/∂q{k}: {sym} vs {fd}"
+            );
+        }
+        let rate = |s: f64| -> f64 {
+            let j = at(&row.jacobian, &shifted(q, qd, s));
+            j.iter().zip(qd).map(|(a, b)| a * b).sum()
+        };
+        let fd = d1(rate, 1e-6);
+        let sym = at(&[row.bias], q)[0];
+        assert!(
+            (sym - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+            "loop convective: {sym} vs {fd}"
+        );
     }
 }
 
