@@ -149,7 +149,25 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
         let (lo, hi) = range(samples, |s| s.contacts[k].sliding_speed);
         rows.push((format!("{name}_sliding_speed [m/s]"), lo, hi));
     }
-    for (first, l) in info.loop_rows() {
+    // Each loop's reactions, unless there are too many loops to list (an N-four-bar): then
+    // the largest reaction over all of them.
+    if info.loops.len() > LISTED_LOOPS {
+        let (lo, hi) = range(samples, |s| {
+            s.lambda
+                .iter()
+                .skip(info.n_contacts())
+                .fold(0.0_f64, |m, l| m.max(l.abs()))
+        });
+        rows.push((
+            format!("largest loop reaction, {} loops [N]", info.loops.len()),
+            lo,
+            hi,
+        ));
+    }
+    for (first, l) in info
+        .loop_rows()
+        .take_while(|_| info.loops.len() <= LISTED_LOOPS)
+    {
         for (e, equation) in l.equations.iter().enumerate() {
             let unit = if equation.starts_with("turn") || equation.starts_with("tilt") {
                 "N m"
@@ -301,7 +319,20 @@ pub fn render(report: &RunReport) -> String {
                 .fold(0.0, f64::max);
             checks.push(format!("max |{name}_h| {max_h:.2e} m"));
         }
-        for (first, l) in info.loop_rows() {
+        if info.loops.len() > LISTED_LOOPS {
+            let max_h = samples
+                .iter()
+                .flat_map(|s| s.h.iter().skip(info.n_contacts()))
+                .fold(0.0_f64, |m, h| m.max(h.abs()));
+            checks.push(format!(
+                "max |h| of the {} loops {max_h:.2e}",
+                info.loops.len()
+            ));
+        }
+        for (first, l) in info
+            .loop_rows()
+            .take_while(|_| info.loops.len() <= LISTED_LOOPS)
+        {
             let max_h = samples
                 .iter()
                 .flat_map(|s| s.h.iter().skip(first).take(l.equations.len()))
@@ -365,30 +396,29 @@ pub fn render(report: &RunReport) -> String {
 /// (the first [`LISTED_EVENTS`], then a count): `between t = a and b s: {q2, q3} → {q1, q3}`.
 /// Empty when the partition never changed between outputs.
 pub fn render_repartitions(info: &ModelInfo, samples: &[Sample]) -> String {
-    let names = |d: &[usize]| -> String {
-        let list: Vec<&str> = d
+    // What left the dependent set and what joined it (the whole sets of an 80-equation
+    // model would fill the screen).
+    let names = |from: &[usize], to: &[usize]| -> String {
+        let list: Vec<&str> = from
             .iter()
+            .filter(|i| !to.contains(i))
             .map(|&i| info.coordinates[i].name.as_str())
             .collect();
-        format!("{{{}}}", list.join(", "))
+        list.join(", ")
     };
     let changes: Vec<(f64, f64, String, String)> = samples
         .windows(2)
         .filter(|w| w[0].dependent != w[1].dependent)
         .map(|w| {
-            (
-                w[0].t,
-                w[1].t,
-                names(&w[0].dependent),
-                names(&w[1].dependent),
-            )
+            let (a, b) = (&w[0].dependent, &w[1].dependent);
+            (w[0].t, w[1].t, names(a, b), names(b, a))
         })
         .collect();
     let mut text = String::new();
-    for (a, b, from, to) in changes.iter().take(LISTED_EVENTS) {
+    for (a, b, left, joined) in changes.iter().take(LISTED_EVENTS) {
         let _ = writeln!(
             text,
-            "  re-partitioned between t = {} and {} s: dependent {from} → {to}",
+            "  re-partitioned between t = {} and {} s: {left} now independent, {joined} dependent",
             number(*a),
             number(*b)
         );
@@ -402,6 +432,9 @@ pub fn render_repartitions(info: &ModelInfo, samples: &[Sample]) -> String {
     }
     text
 }
+
+/// Most loops whose reactions and residuals the summary lists one by one.
+const LISTED_LOOPS: usize = 6;
 
 /// Most events listed one by one in the summary.
 const LISTED_EVENTS: usize = 8;

@@ -1852,7 +1852,14 @@ fn emit_function_full(
     text.push_str(prelude);
     text.push_str(&bindings);
     let mut fields = String::new();
+    let filled = zero_filled_arrays(g, &spec.outputs);
+    for array in &filled {
+        let _ = writeln!(text, "{array}.fill(0.0);");
+    }
     for (target, id) in &spec.outputs {
+        if g.is_zero(*id) && array_of(target).is_some_and(|a| filled.contains(&a)) {
+            continue;
+        }
         if target == RETURN {
             let _ = writeln!(text, "{}", body.print(*id, 0));
         } else if let Some(field) = target.strip_prefix(FIELD) {
@@ -1869,6 +1876,40 @@ fn emit_function_full(
     text.push_str(&spec.tail.replace(FIELDS, &fields));
     text.push_str("\n}\n");
     (text, count)
+}
+
+/// Outputs that are zero, per array, from which the array is cleared with one `fill(0.0)`
+/// instead of one assignment each: a sparse M or J of a long chain (an N-four-bar's 81×81 M
+/// is 98 % zeros) would otherwise be mostly `m[k] = 0.0;` lines. Below it, the assignments
+/// are kept (and the small models' code stays as it was).
+const ZERO_FILL_THRESHOLD: usize = 64;
+
+/// The array of an output target `name[index]` (`m`, `out.mass`), if it is one.
+fn array_of(target: &str) -> Option<&str> {
+    let (array, rest) = target.split_once('[')?;
+    (rest.ends_with(']') && !rest.contains('[')).then_some(array)
+}
+
+/// The arrays with at least [`ZERO_FILL_THRESHOLD`] zero outputs, in order of appearance.
+fn zero_filled_arrays<'t>(g: &Graph, outputs: &'t [(String, Id)]) -> Vec<&'t str> {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for (target, id) in outputs {
+        let Some(array) = array_of(target) else {
+            continue;
+        };
+        if !g.is_zero(*id) {
+            continue;
+        }
+        match counts.iter_mut().find(|(a, _)| *a == array) {
+            Some((_, count)) => *count += 1,
+            None => counts.push((array, 1)),
+        }
+    }
+    counts
+        .into_iter()
+        .filter(|(_, count)| *count >= ZERO_FILL_THRESHOLD)
+        .map(|(array, _)| array)
+        .collect()
 }
 
 /// Output target prefix `field:name`: the value becomes `name: value,` in the place of

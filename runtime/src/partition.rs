@@ -171,30 +171,40 @@ fn eliminate_column(a: &mut [f64], n: usize, pivot_row: usize, column: usize, ro
     }
 }
 
-/// Conditioning of a partition, in [0, 1]: for one contact |J_v| / ‖J_eligible‖₂; for
-/// several the Hadamard ratio |det J_v| / Π_k ‖(row k of J)_eligible‖₂. 1 means J_v carries
-/// the whole constraint gradient; 0 means J_v is singular. Returns 1 without contacts.
+/// Conditioning of a partition, in [0, 1]: for one constraint |J_v| / ‖J_eligible‖₂; for m
+/// constraints the m-th root of the Hadamard ratio |det J_v| / Π_k ‖(row k of J)_eligible‖₂,
+/// the geometric mean of what each row keeps, so that one threshold
+/// ([`REPARTITION_RATIO`]) means the same for 1 and for 80 equations (the ratio itself is a
+/// product over the rows and shrinks with their number: a well-chosen partition of an
+/// N-four-bar's 80 equations has a ratio far below 0.2 everywhere). Invariant under the
+/// scaling of a row, as a singular configuration that shrinks whole rows (an N-four-bar
+/// passing its horizontal position) does. 1 means J_v carries the whole constraint
+/// gradient; 0 means J_v is singular. Returns 1 without constraints.
 pub fn conditioning(j: &[f64], nc: usize, n: usize, dependent: &[usize], eligible: &[bool]) -> f64 {
     if nc == 0 {
         return 1.0;
     }
-    let mut row_norms = 1.0;
+    if nc == 1 {
+        let squares: f64 = (0..n).filter(|&i| eligible[i]).map(|i| j[i] * j[i]).sum();
+        let ratio = j[dependent[0]].abs() / squares.sqrt();
+        return if ratio.is_finite() { ratio } else { 0.0 };
+    }
+    // In logarithms: for tens of rows the product of the row norms and det J_v leave the
+    // range of f64.
+    let mut log_norms = 0.0;
     for row in (0..nc).map(|k| &j[k * n..(k + 1) * n]) {
         let squares: f64 = (0..n)
             .filter(|&i| eligible[i])
             .map(|i| row[i] * row[i])
             .sum();
-        row_norms *= squares.sqrt();
+        log_norms += 0.5 * squares.ln();
     }
-    let ratio = dependent_determinant(j, nc, n, dependent).abs() / row_norms;
+    let ratio = ((dependent_log_determinant(j, nc, n, dependent) - log_norms) / nc as f64).exp();
     if ratio.is_finite() { ratio } else { 0.0 }
 }
 
-/// det J_v (nc ≤ 4 without allocating).
-fn dependent_determinant(j: &[f64], nc: usize, n: usize, dependent: &[usize]) -> f64 {
-    if nc == 1 {
-        return j[dependent[0]];
-    }
+/// ln |det J_v| (nc ≤ 4 without allocating); −∞ when J_v is singular.
+fn dependent_log_determinant(j: &[f64], nc: usize, n: usize, dependent: &[usize]) -> f64 {
     let mut stack = [0.0; 16];
     let mut pivots_stack = [0; 4];
     let mut heap = Vec::new();
@@ -208,9 +218,9 @@ fn dependent_determinant(j: &[f64], nc: usize, n: usize, dependent: &[usize]) ->
     };
     gather_columns(j, n, dependent, a);
     if lu_factor(a, pivots, nc, 0.0) {
-        lu_determinant(a, pivots, nc)
+        (0..nc).map(|k| a[k * nc + k].abs().ln()).sum()
     } else {
-        0.0
+        f64::NEG_INFINITY
     }
 }
 
@@ -638,16 +648,24 @@ impl Workspace {
         t: f64,
     ) -> Result<usize, SimError> {
         let mut iterations = 0;
+        let mut last = f64::INFINITY;
         loop {
             let residual = self.constraint_residual(model, t)?;
             self.factor_jacobian_for_newton(model, dependent, t, residual, iterations)?;
             let next = self.pending_correction(dependent);
             let scale = 1.0 + self.v_size(dependent);
-            let strict =
-                residual <= self.residual_tolerance() && next <= NEWTON_STEP_TOLERANCE * scale;
-            if strict || next <= self.newton_slack * scale {
+            let small = residual <= self.residual_tolerance();
+            let strict = small && next <= NEWTON_STEP_TOLERANCE * scale;
+            // Near a singular position (an N-four-bar almost horizontal: J_v ~ sin θ) the
+            // round-off of h, amplified by J_v⁻¹ along a chain of loops, puts a floor under
+            // the corrections above the step tolerance. With h already at its tolerance, a
+            // correction that no longer shrinks by half is that floor: stop (Newton's own
+            // convergence would have it shrink quadratically).
+            let stalled = small && iterations > 0 && next >= 0.5 * last;
+            if strict || stalled || next <= self.newton_slack * scale {
                 return Ok(iterations);
             }
+            last = next;
             if iterations == NEWTON_MAX_ITERATIONS {
                 return Err(self.newton_failure(t, residual, iterations));
             }
@@ -1354,7 +1372,8 @@ fn lu_solve_transposed(lu: &[f64], pivots: &[usize], n: usize, x: &mut [f64]) {
     }
 }
 
-/// det A from its LU factors.
+/// det of the LU-factored matrix (tests: the factorisation against nalgebra's determinant).
+#[cfg(test)]
 fn lu_determinant(lu: &[f64], pivots: &[usize], n: usize) -> f64 {
     let swaps = (0..n).filter(|&k| pivots[k] != k).count();
     let product: f64 = (0..n).map(|k| lu[k * n + k]).product();
