@@ -29,7 +29,13 @@ fn run(model: &dyn Dynamics) -> Trajectory {
         .unwrap_or_else(|f| panic!("{}", f.error))
 }
 
-const LOOP_MODELS: [&str; 4] = ["four_bar", "slider_crank", "andrews_squeezer", "bricard"];
+const LOOP_MODELS: [&str; 5] = [
+    "four_bar",
+    "slider_crank",
+    "andrews_squeezer",
+    "bricard",
+    "cam_rocker_linkage",
+];
 
 /// h at q, for finite differences.
 fn h_at(model: &dyn Dynamics, q: &[f64]) -> Vec<f64> {
@@ -346,4 +352,49 @@ fn bricard_keeps_its_energy_and_its_redundant_loop_closed() {
         report.redundant[0], last.q[p3]
     );
     assert!(drift < 1e-7, "energy drifts by {drift:e} J");
+}
+
+#[test]
+fn the_cam_driven_four_bar_closes_where_the_circles_meet() {
+    // cam_rocker_linkage: the contact sets the rocker's swing, the loop the lever's angle.
+    // Independently of the solver: from each sample's swing the coupler pin P is on the
+    // rocker's crank, and the lever's tip is where the circles |B − P| = coupler and
+    // |B − Q| = lever meet (the one right of Q). Newton leaves the pin within 1e-12 m,
+    // 1.3e-11 rad over the lever's 80 mm: 1e-10 rad leaves a margin of 8.
+    let model = models::by_name("cam_rocker_linkage").expect("built in");
+    let trajectory = run(model);
+    let info = model.info();
+    let (swing, lever) = (
+        info.coordinate_index("swing").expect("swing"),
+        info.coordinate_index("lever_angle").expect("lever"),
+    );
+    let (pivot, q_pivot) = ([0.09, 0.045], [0.06, -0.075]);
+    let (crank, coupler, lever_length) = (0.05_f64, 0.12_f64, 0.08_f64);
+    let mut worst: f64 = 0.0;
+    for s in &trajectory.samples {
+        let p = [
+            pivot[0] + crank * s.q[swing].cos(),
+            pivot[1] + crank * s.q[swing].sin(),
+        ];
+        let (dx, dy) = (q_pivot[0] - p[0], q_pivot[1] - p[1]);
+        let d = dx.hypot(dy);
+        let along = (coupler * coupler - lever_length * lever_length + d * d) / (2.0 * d);
+        let across = (coupler * coupler - along * along).sqrt();
+        let base = [p[0] + along * dx / d, p[1] + along * dy / d];
+        // The two meeting points; the lever's tip is the one on the right of Q.
+        let candidates = [1.0, -1.0].map(|side: f64| {
+            [
+                base[0] - side * across * dy / d,
+                base[1] + side * across * dx / d,
+            ]
+        });
+        let tip = candidates
+            .into_iter()
+            .max_by(|a, b| a[0].total_cmp(&b[0]))
+            .expect("two points");
+        let angle = (tip[1] - q_pivot[1]).atan2(tip[0] - q_pivot[0]);
+        worst = worst.max((angle - s.q[lever]).abs());
+    }
+    println!("cam_rocker_linkage: lever angle against the circles' intersection {worst:.2e} rad");
+    assert!(worst < 1e-10, "the lever is off by {worst:e} rad");
 }
