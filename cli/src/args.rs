@@ -243,6 +243,9 @@ pub enum BenchWhat {
     /// right-hand side of the cams on moving bodies against the fixed-cam paper model, and one
     /// camshaft revolution at 1e-10.
     Evaluations,
+    /// Closed loops alone: the loop models' right-hand sides, Andrews' squeezer's work
+    /// against precision, the IFToMM benchmarks A02 and A04 (also part of `evaluations`).
+    Loops,
     /// Whole-run overhead, sweep throughput with 1 and 2 workers, sweep memory.
     Sweep,
     /// Draw the scaling figure from the scaling example's CSV (--scaling-csv).

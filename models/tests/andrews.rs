@@ -8,6 +8,9 @@
 //! deTestSet (Soetaert, Cash, Mazzia), file `src/Ex_andrews.f`, subroutines `andfunc` and
 //! `andsoln`.
 
+// The reference values are written with every digit the test set prints, not rounded to f64.
+#![allow(clippy::excessive_precision)]
+
 use camchain::runtime::{Dynamics, Sample, Simulate};
 use camchain_models as models;
 use camchain_reference::NumericModel;

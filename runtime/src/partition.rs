@@ -47,6 +47,12 @@ pub const NEWTON_STEP_TOLERANCE: f64 = 1e-12;
 /// ([`Workspace::jacobian_floor`]).
 const JACOBIAN_FLOOR: f64 = 1e-12;
 
+/// Newton (15) also stops, |h| being at its tolerance, when its corrections no longer shrink
+/// (round-off near a singular position, docs/method.md §11.4) and are at most this times
+/// (1 + ‖v‖∞): 1e-8, far above the 1e-12 of [`NEWTON_STEP_TOLERANCE`] that such a floor can
+/// exceed, and far below the corrections at a dead point, where J_v itself vanishes.
+pub const NEWTON_STALL_TOLERANCE: f64 = 1e-8;
+
 /// In an adaptive run at relative tolerance rtol, Newton (15) also stops when the next
 /// correction is at most this times rtol·(1 + ‖v‖∞) ([`Workspace::set_newton_slack`]).
 pub const NEWTON_SLACK_PER_RTOL: f64 = 1e-2;
@@ -660,8 +666,13 @@ impl Workspace {
             // round-off of h, amplified by J_v⁻¹ along a chain of loops, puts a floor under
             // the corrections above the step tolerance. With h already at its tolerance, a
             // correction that no longer shrinks by half is that floor: stop (Newton's own
-            // convergence would have it shrink quadratically).
-            let stalled = small && iterations > 0 && next >= 0.5 * last;
+            // convergence would have it shrink quadratically), provided that floor is below
+            // NEWTON_STALL_TOLERANCE: at a dead point, where J_v itself vanishes, the
+            // corrections stall far above it and Newton fails as before.
+            let stalled = small
+                && iterations > 0
+                && next >= 0.5 * last
+                && next <= NEWTON_STALL_TOLERANCE * scale;
             if strict || stalled || next <= self.newton_slack * scale {
                 return Ok(iterations);
             }

@@ -181,7 +181,10 @@ pub(super) fn states_along_a_run(model: &dyn Dynamics) -> Result<Vec<State>, Cli
 }
 
 /// The same (t, q, q̇) as `states`, as states of the numeric model.
-fn numeric_states(numeric: &NumericModel, states: &[State]) -> Result<Vec<State>, CliError> {
+pub(super) fn numeric_states(
+    numeric: &NumericModel,
+    states: &[State],
+) -> Result<Vec<State>, CliError> {
     let base = numeric
         .assemble(0.0)
         .map_err(|e| CliError::Failed(e.to_string()))?;

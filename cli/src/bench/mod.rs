@@ -9,6 +9,8 @@
 //!   the fixed-cam paper model's, and one full camshaft revolution at 1e-10 of the camshaft
 //!   models; then (section `designs`) the reduced right-hand side of a cam given as a table of
 //!   points against the same cam given by its motion law, and revolutions of the designed cams;
+//!   then (section `loops`) the reduced right-hand side of loop models, Andrews' squeezer's
+//!   work against precision, and the IFToMM benchmarks A02 and A04;
 //! - `sweep`: the whole-run overhead of a metrics run, the throughput of `camchain sweep` with
 //!   1 and 2 workers, and its memory against the number of runs;
 //! - `scaling-figure`: the figure of the scaling study from the CSV of
@@ -20,6 +22,7 @@
 mod cams;
 mod designs;
 mod evaluations;
+mod loops;
 mod markdown;
 mod scaling;
 mod sweep;
@@ -50,6 +53,14 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         let section = designs::run(args.quick)?;
         markdown::replace_section(report, "designs", &section)?;
         println!("updated {} (section designs)", report.display());
+    }
+    if matches!(
+        args.what,
+        BenchWhat::Evaluations | BenchWhat::Loops | BenchWhat::All
+    ) {
+        let section = loops::run(args.quick)?;
+        markdown::replace_section(report, "loops", &section)?;
+        println!("updated {} (section loops)", report.display());
     }
     if let BenchWhat::ScalingFigure = args.what {
         let csv = args.scaling_csv.as_deref().ok_or_else(|| {

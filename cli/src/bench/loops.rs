@@ -1,0 +1,307 @@
+//! Closed loops, side by side in one run:
+//!
+//! - the reduced right-hand side of `four_bar`, `andrews_squeezer` and `cam_rocker_linkage`,
+//!   generated code against the numeric recursion, at the same consistent states;
+//! - Andrews' squeezing mechanism to t = 0.03 s at a ladder of tolerances, DOP853 and
+//!   Dopri5: median run time against the largest error of the seven angles from the Test
+//!   Set for IVP Solvers' reference solution (its `andrews.f`, subroutine `solut`);
+//! - the IFToMM benchmarks A02 (`n_four_bar`, N = 40, 20 s) and A04 (`bricard`, 10 s) at
+//!   their model files' tolerances: CPU time, energy drift, constraint violation and the
+//!   reported point at the end.
+
+use super::evaluations::{derivative, numeric_states, states_along_a_run};
+use super::timing::side_by_side;
+use crate::CliError;
+use crate::source::builtin_description;
+use camchain_models as models;
+use camchain_reference::NumericModel;
+use camchain_runtime::{Dynamics, IntegratorKind, SimSettings, Simulate, Trajectory};
+use std::fmt::Write;
+use std::time::Instant;
+
+/// The models whose right-hand side is timed.
+const RHS_MODELS: [&str; 3] = ["four_bar", "andrews_squeezer", "cam_rocker_linkage"];
+
+/// The Test Set's angles (β, Θ, γ, Φ, δ, Ω, ε) by the model's coordinate names, and their
+/// reference values at t = 0.03 s (`andrews.f`, `solut`: PSIDE, rtol = atol = 1e-14).
+const ANGLES: [&str; 7] = ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"];
+const Q_REF: [f64; 7] = [
+    0.1581077119629904e2,
+    -0.1575637105984298e2,
+    0.4082224013073101e-1,
+    -0.5347301163226948e0,
+    0.5244099658805304e0,
+    0.5347301163226948e0,
+    0.1048080741042263e1,
+];
+
+/// One rung of the Andrews ladder.
+struct Rung {
+    integrator: &'static str,
+    rtol: f64,
+    seconds: f64,
+    error: f64,
+    steps: usize,
+    rhs: usize,
+}
+
+/// One IFToMM run.
+struct Benchmark {
+    name: &'static str,
+    seconds: f64,
+    drift: f64,
+    energy: f64,
+    max_h: f64,
+    point: String,
+    steps: usize,
+    repartitions: usize,
+}
+
+/// Measures and returns the report section.
+pub fn run(quick: bool) -> Result<String, CliError> {
+    let (calls, batches) = if quick { (200, 5) } else { (5_000, 21) };
+    let mut rhs = Vec::new();
+    for name in RHS_MODELS {
+        eprintln!("loops: right-hand side of {name}");
+        let generated = builtin(name)?;
+        let numeric = NumericModel::new(builtin_description(name)?);
+        let states = states_along_a_run(generated)?;
+        let numeric_states = numeric_states(&numeric, &states)?;
+        let (g, n) = side_by_side(
+            derivative(generated, &states)?,
+            derivative(&numeric, &numeric_states)?,
+            calls,
+            batches,
+        );
+        rhs.push((name, g, n));
+    }
+    eprintln!("loops: Andrews' squeezer at a ladder of tolerances");
+    let rungs = andrews_ladder(quick)?;
+    let mut benchmarks = Vec::new();
+    for name in ["n_four_bar", "bricard"] {
+        eprintln!("loops: {name}");
+        benchmarks.push(iftomm(name, if quick { 1 } else { 3 })?);
+    }
+    Ok(render(&rhs, &rungs, &benchmarks, calls, batches))
+}
+
+fn builtin(name: &str) -> Result<&'static dyn Dynamics, CliError> {
+    models::by_name(name)
+        .map(|m| m as &dyn Dynamics)
+        .ok_or_else(|| CliError::Failed(format!("{name} is not built in")))
+}
+
+/// A run of `model` with `settings`, and its wall time.
+fn timed_run(model: &dyn Dynamics, settings: &SimSettings) -> Result<(Trajectory, f64), CliError> {
+    let failed = |e: String| CliError::Failed(format!("{}: {e}", model.info().name));
+    let start = Instant::now();
+    let state = model.assemble(0.0).map_err(|e| failed(e.to_string()))?;
+    let run = model
+        .simulate(state, settings)
+        .map_err(|f| failed(f.error.to_string()))?;
+    Ok((run, start.elapsed().as_secs_f64()))
+}
+
+/// The median of `repeats` wall times of the same run, and the run.
+fn median_run(
+    model: &dyn Dynamics,
+    settings: &SimSettings,
+    repeats: usize,
+) -> Result<(Trajectory, f64), CliError> {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..repeats.max(1) {
+        let (run, seconds) = timed_run(model, settings)?;
+        times.push(seconds);
+        last = Some(run);
+    }
+    times.sort_by(f64::total_cmp);
+    let run = last.ok_or_else(|| CliError::Failed("no run".into()))?;
+    Ok((run, times[times.len() / 2]))
+}
+
+fn andrews_ladder(quick: bool) -> Result<Vec<Rung>, CliError> {
+    let model = builtin("andrews_squeezer")?;
+    let info = model.info();
+    let index: Vec<usize> = ANGLES
+        .iter()
+        .map(|a| info.coordinate_index(a))
+        .collect::<Option<_>>()
+        .ok_or_else(|| CliError::Failed("andrews_squeezer: an angle is missing".into()))?;
+    let exponents: &[i32] = if quick {
+        &[-6, -10]
+    } else {
+        &[-4, -5, -6, -7, -8, -9, -10, -11, -12, -13]
+    };
+    let mut rungs = Vec::new();
+    for (integrator, kind) in [
+        ("dop853", IntegratorKind::Dop853),
+        ("dopri5", IntegratorKind::Dopri5),
+    ] {
+        for &e in exponents {
+            let rtol = 10f64.powi(e);
+            if kind == IntegratorKind::Dopri5 && e < -11 {
+                continue;
+            }
+            let mut settings = info.defaults.clone();
+            (
+                settings.integrator,
+                settings.rtol,
+                settings.atol,
+                settings.dt_out,
+            ) = (kind, rtol, rtol * 1e-2, 0.03);
+            settings.dt = 1e-6;
+            let (run, seconds) = median_run(model, &settings, if quick { 1 } else { 5 })?;
+            let last = run
+                .samples
+                .last()
+                .ok_or_else(|| CliError::Failed("no sample".into()))?;
+            let error = index
+                .iter()
+                .zip(Q_REF)
+                .map(|(&i, r)| (last.q[i] - r).abs())
+                .fold(0.0, f64::max);
+            rungs.push(Rung {
+                integrator,
+                rtol,
+                seconds,
+                error,
+                steps: run.stats.steps,
+                rhs: run.stats.rhs_evaluations,
+            });
+        }
+    }
+    Ok(rungs)
+}
+
+fn iftomm(name: &'static str, repeats: usize) -> Result<Benchmark, CliError> {
+    let model = builtin(name)?;
+    let settings = model.info().defaults.clone();
+    let (run, seconds) = median_run(model, &settings, repeats)?;
+    let first = run
+        .samples
+        .first()
+        .ok_or_else(|| CliError::Failed("no sample".into()))?;
+    let last = run
+        .samples
+        .last()
+        .ok_or_else(|| CliError::Failed("no sample".into()))?;
+    let total = |s: &camchain_runtime::Sample| s.energy.total() + s.dissipated - s.driven_work;
+    let drift = run
+        .samples
+        .iter()
+        .map(|s| (total(s) - total(first)).abs())
+        .fold(0.0, f64::max);
+    let max_h = run
+        .samples
+        .iter()
+        .flat_map(|s| s.h.iter())
+        .fold(0.0_f64, |m, h| m.max(h.abs()));
+    let point = match name {
+        // B0, the tip of the first crank (1 m long, from the origin).
+        "n_four_bar" => format!(
+            "B0 = ({:.6}, {:.6}) m at t = {} s",
+            last.q[0].cos(),
+            last.q[0].sin(),
+            last.t
+        ),
+        _ => {
+            let mut p = [[0.0; 3]; 2];
+            model.loop_points(&last.q, &mut p);
+            format!(
+                "F on the last rod = ({:.6}, {:.6}, {:.6}) m at t = {} s",
+                p[0][0], p[0][1], p[0][2], last.t
+            )
+        }
+    };
+    Ok(Benchmark {
+        name,
+        seconds,
+        drift,
+        energy: first.energy.kinetic.abs() + first.energy.gravity.abs(),
+        max_h,
+        point,
+        steps: run.stats.steps,
+        repartitions: run.stats.repartitions,
+    })
+}
+
+fn render(
+    rhs: &[(&str, f64, f64)],
+    rungs: &[Rung],
+    benchmarks: &[Benchmark],
+    calls: usize,
+    batches: usize,
+) -> String {
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "Reduced right-hand side (Newton (15), velocities (16), reduced equations (18)) at the \
+         same consistent states, generated code and numeric recursion interleaved; medians of \
+         {batches} batches of up to {calls} calls.\n"
+    );
+    let _ = writeln!(
+        text,
+        "| model | generated | numeric | numeric / generated |"
+    );
+    let _ = writeln!(text, "|---|---:|---:|---:|");
+    for (name, g, n) in rhs {
+        let _ = writeln!(
+            text,
+            "| `{name}` | {:.2} µs | {:.1} µs | {:.0}× |",
+            g * 1e6,
+            n * 1e6,
+            n / g
+        );
+    }
+    let _ = writeln!(
+        text,
+        "\nAndrews' squeezing mechanism, generated code, from the test set's consistent initial \
+         state to t = 0.03 s at rtol (atol = rtol/100): the largest error of the seven angles \
+         against the test set's reference solution (`andrews.f`, `solut`), median wall time \
+         of 5 runs.\n"
+    );
+    let _ = writeln!(
+        text,
+        "| integrator | rtol | error (rad) | wall time | steps | right-hand sides |"
+    );
+    let _ = writeln!(text, "|---|---:|---:|---:|---:|---:|");
+    for r in rungs {
+        let _ = writeln!(
+            text,
+            "| {} | {:.0e} | {:.2e} | {:.2} ms | {} | {} |",
+            r.integrator,
+            r.rtol,
+            r.error,
+            r.seconds * 1e3,
+            r.steps,
+            r.rhs
+        );
+    }
+    let _ = writeln!(
+        text,
+        "\nIFToMM benchmark problems at their model files' settings (median wall time of the \
+         runs, assembly included):\n"
+    );
+    let _ = writeln!(
+        text,
+        "| problem | wall time | steps | re-partitions | energy drift | max |h| | at the end |"
+    );
+    let _ = writeln!(text, "|---|---:|---:|---:|---:|---:|---|");
+    for b in benchmarks {
+        let _ = writeln!(
+            text,
+            "| `{}` | {:.3} s | {} | {} | {:.1e} J ({:.1e} of {:.1} J) | {:.1e} | {} |",
+            b.name,
+            b.seconds,
+            b.steps,
+            b.repartitions,
+            b.drift,
+            b.drift / b.energy,
+            b.energy,
+            b.max_h,
+            b.point
+        );
+    }
+    text
+}
