@@ -5,7 +5,9 @@
 //! (`ParameterMode::FoldAll`: the code as if the numbers were written in place); and that of
 //! `cycloidal_roller`, `tests/golden/cycloidal_roller.rs`, a cam designed from a motion law
 //! (the law's segments as constants and their evaluation, the synthesised profile, a roller's
-//! contact parameter solved by Newton). After an intended change, regenerate them:
+//! contact parameter solved by Newton); and that of `four_bar`, `tests/golden/four_bar.rs`, a
+//! closed loop (the cut pin's two equations as rows of h, J and c, and the loop's points).
+//! After an intended change, regenerate them:
 //!
 //! ```sh
 //! CAMCHAIN_BLESS=1 cargo test -p camchain-build --test golden
@@ -62,6 +64,14 @@ fn the_cam_designed_from_a_law_generates_its_golden_source() {
     compare_with_golden(
         "cycloidal_roller",
         &generated_model("cycloidal_roller", "law", ParameterMode::AsDeclared),
+    );
+}
+
+#[test]
+fn the_four_bar_generates_its_golden_source() {
+    compare_with_golden(
+        "four_bar",
+        &generated_model("four_bar", "loop", ParameterMode::AsDeclared),
     );
 }
 

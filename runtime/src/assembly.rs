@@ -257,7 +257,8 @@ fn assemble_positions<D: Dynamics + ?Sized>(
         if ws.full_jacobian().iter().any(|x| !x.is_finite()) {
             return Err(ws.non_finite(t0, "J"));
         }
-        let (rows, _) = independent_rows(ws.full_jacobian(), m, n, &solvable);
+        let floor = ws.jacobian_floor();
+        let (rows, _) = independent_rows(ws.full_jacobian(), m, n, &solvable, floor);
         if rows.is_empty() {
             return Err(ws.singular(t0));
         }

@@ -49,9 +49,14 @@ const JACOBIAN_FLOOR: f64 = 1e-12;
 
 /// Newton (15) also stops, |h| being at its tolerance, when its corrections no longer shrink
 /// (round-off near a singular position, docs/method.md §11.4) and are at most this times
-/// (1 + ‖v‖∞): 1e-8, far above the 1e-12 of [`NEWTON_STEP_TOLERANCE`] that such a floor can
-/// exceed, and far below the corrections at a dead point, where J_v itself vanishes.
+/// (1 + ‖v‖∞) and the partition's conditioning is not degenerate ([`STALL_CONDITIONING`]):
+/// 1e-8, far above the 1e-12 of [`NEWTON_STEP_TOLERANCE`] that such a floor can exceed.
 pub const NEWTON_STALL_TOLERANCE: f64 = 1e-8;
+
+/// A stalled Newton (15) is accepted only where the partition's conditioning is at least
+/// this: at a dead point J_v vanishes alone and the conditioning goes to 0, so Newton fails
+/// there as it should, naming the dead point.
+const STALL_CONDITIONING: f64 = 0.05;
 
 /// In an adaptive run at relative tolerance rtol, Newton (15) also stops when the next
 /// correction is at most this times rtol·(1 + ‖v‖∞) ([`Workspace::set_newton_slack`]).
@@ -80,13 +85,16 @@ pub const REDUNDANT_PIVOT: f64 = 1e-8;
 /// The largest set of independent rows of the m×n Jacobian `j` and as many dependent columns
 /// among the `eligible` ones, by Gaussian elimination with complete pivoting: each pivot is
 /// the largest remaining entry; elimination stops when it is at most [`REDUNDANT_PIVOT`]
-/// times max |J_ij|. Returns (rows, columns), each in increasing order; rows left out are
-/// redundant (implied by the chosen ones to first order), and `rows.len()` is the rank.
+/// times max |J_ij| or at most `floor` (entries that small are round-off, not a lever arm:
+/// [`Workspace::jacobian_floor`]). Returns (rows, columns), each in increasing order; rows
+/// left out are redundant (implied by the chosen ones to first order), and `rows.len()` is
+/// the rank.
 pub fn independent_rows(
     j: &[f64],
     m: usize,
     n: usize,
     eligible: &[bool],
+    floor: f64,
 ) -> (Vec<usize>, Vec<usize>) {
     let scale = j.iter().fold(0.0_f64, |acc, x| acc.max(x.abs()));
     let mut a = j.to_vec();
@@ -101,7 +109,7 @@ pub fn independent_rows(
         else {
             break;
         };
-        if pivot.abs() <= REDUNDANT_PIVOT * scale {
+        if pivot.abs() <= (REDUNDANT_PIVOT * scale).max(floor) {
             break;
         }
         eliminate_column(&mut a, n, row, column, &row_done);
@@ -672,7 +680,8 @@ impl Workspace {
             let stalled = small
                 && iterations > 0
                 && next >= 0.5 * last
-                && next <= NEWTON_STALL_TOLERANCE * scale;
+                && next <= NEWTON_STALL_TOLERANCE * scale
+                && self.well_conditioned(dependent);
             if strict || stalled || next <= self.newton_slack * scale {
                 return Ok(iterations);
             }
@@ -683,6 +692,14 @@ impl Workspace {
             self.apply_correction(dependent);
             iterations += 1;
         }
+    }
+
+    /// True when J_v of the J last evaluated keeps at least [`STALL_CONDITIONING`] of J's
+    /// rows (the conditioning of [`conditioning`], every column counted): a singular position
+    /// that shrinks whole rows keeps it, a dead point, where J_v alone vanishes, does not.
+    fn well_conditioned(&self, dependent: &[usize]) -> bool {
+        let all = vec![true; self.n];
+        conditioning(&self.jacobian, self.nc, self.n, dependent, &all) >= STALL_CONDITIONING
     }
 
     /// Assembly fallback for (15): Newton with backtracking on ‖h‖₂ (Armijo condition),
@@ -1587,6 +1604,32 @@ mod tests {
     /// Round-off bound for the dense solves below on well-conditioned data of order 1
     /// (κ ≲ 10², n ≤ 6): κ·n·ε ≈ 1e-13; 1e-11 leaves a margin of 100.
     const SOLVE_TOLERANCE: f64 = 1e-11;
+
+    #[test]
+    fn independent_rows_find_the_rank_and_leave_a_combination_out() {
+        // Row 2 = row 0 + row 1: rank 2; the pivots are the largest entries (row 2's 4.0
+        // in column 1, then row 0's 1.0 after elimination), row 1 left out.
+        let j = [1.0, 1.0, 0.0, 0.0, 3.0, 1.0, 1.0, 4.0, 1.0];
+        let (rows, columns) = independent_rows(&j, 3, 3, &[true; 3], 0.0);
+        assert_eq!(rows.len(), 2);
+        assert_eq!(columns.len(), 2);
+        // Full rank: every row kept.
+        let identity = [1.0, 0.0, 0.0, 1.0];
+        assert_eq!(
+            independent_rows(&identity, 2, 2, &[true; 2], 0.0).0,
+            vec![0, 1]
+        );
+        // A row of round-off below the floor counts as zero, whatever the scale.
+        let tiny = [1e-17, 0.0, 0.0, 2e-17];
+        assert!(
+            independent_rows(&tiny, 2, 2, &[true; 2], 1e-12)
+                .0
+                .is_empty()
+        );
+        // Only eligible columns are pivots.
+        let (_, columns) = independent_rows(&[5.0, 1.0], 1, 2, &[false, true], 0.0);
+        assert_eq!(columns, vec![1]);
+    }
 
     #[test]
     fn one_contact_picks_the_largest_eligible_entry() {

@@ -1519,7 +1519,8 @@ fn reselect_rows(state: &mut State, current: f64) -> bool {
     let ws = &state.engine.ws;
     let (n, m, nc) = (ws.n_coordinates(), ws.m(), ws.rows().len());
     let eligible = state.partition.eligible().to_vec();
-    let (rows, columns) = independent_rows(ws.full_jacobian(), m, n, &eligible);
+    let (rows, columns) =
+        independent_rows(ws.full_jacobian(), m, n, &eligible, ws.jacobian_floor());
     if rows.len() != nc || (rows == ws.rows() && columns == state.partition.dependent()) {
         return false;
     }
