@@ -259,7 +259,11 @@ fn assemble_positions<D: Dynamics + ?Sized>(
         }
         let floor = ws.jacobian_floor();
         let (rows, _) = independent_rows(ws.full_jacobian(), m, n, &solvable, floor);
-        if rows.is_empty() {
+        // Only loop equations can be redundant: a contact whose row of J is a combination of
+        // the others' (a zero row: the follower point on the axis that moves it) is at a dead
+        // point, as a single contact with J_v = 0 is.
+        let contacts = info.n_contacts();
+        if rows.is_empty() || (0..contacts).any(|k| !rows.contains(&k)) {
             return Err(ws.singular(t0));
         }
         if choice.is_some() && rows.len() <= ws.rows().len() {

@@ -1504,7 +1504,7 @@ fn repartition_if_needed<D: Dynamics + ?Sized>(model: &D, state: &mut State) -> 
         return false;
     }
     if ws.m() > nc {
-        return reselect_rows(state, current);
+        return reselect_rows(state, current, model.info().n_contacts());
     }
     let Some(better) = choose_dependent(jacobian, nc, n, eligible) else {
         return false;
@@ -1515,13 +1515,15 @@ fn repartition_if_needed<D: Dynamics + ?Sized>(model: &D, state: &mut State) -> 
 
 /// With redundant rows left out: re-chooses the solved rows and the dependent coordinates
 /// together from the full J (as many as before), when that improves the conditioning.
-fn reselect_rows(state: &mut State, current: f64) -> bool {
+fn reselect_rows(state: &mut State, current: f64, contacts: usize) -> bool {
     let ws = &state.engine.ws;
     let (n, m, nc) = (ws.n_coordinates(), ws.m(), ws.rows().len());
     let eligible = state.partition.eligible().to_vec();
     let (rows, columns) =
         independent_rows(ws.full_jacobian(), m, n, &eligible, ws.jacobian_floor());
-    if rows.len() != nc || (rows == ws.rows() && columns == state.partition.dependent()) {
+    let unchanged = rows == ws.rows() && columns == state.partition.dependent();
+    // Only loop equations may be left out (a contact's row is never redundant).
+    if rows.len() != nc || unchanged || (0..contacts).any(|k| !rows.contains(&k)) {
         return false;
     }
     let mut gathered = vec![0.0; nc * n];
