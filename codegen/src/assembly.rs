@@ -16,7 +16,7 @@ const TOLERANCE: f64 = 1e-10;
 const MAX_ITERATIONS: usize = 50;
 
 /// Solves the free coordinates so every contact holds; returns the assembled q. A model with
-/// loops goes through [`assemble_with_loops`] (the message then names the loop furthest from
+/// loops goes through `assemble_with_loops` (the message then names the loop furthest from
 /// closing; [`assemble_located`] also gives its field).
 pub fn assemble(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
     assemble_located(model, d).map_err(|(_, message)| message)

@@ -12,7 +12,7 @@
 //! ```
 //!
 //! and a component of r along a ground axis is the special case Y = e_k. Points are moved by
-//! the recursion of eq. (9) along their path to the ground ([`point_motion`]); a direction v
+//! the recursion of eq. (9) along their path to the ground (`point_motion`); a direction v
 //! carried by a body turning at ω has columns u_j × v (revolute j), rate ω × v and
 //! v̈° = α° × v + ω × (ω × v).
 

@@ -49,7 +49,7 @@ const JACOBIAN_FLOOR: f64 = 1e-12;
 
 /// Newton (15) also stops, |h| being at its tolerance, when its corrections no longer shrink
 /// (round-off near a singular position, docs/method.md §11.4) and are at most this times
-/// (1 + ‖v‖∞) and the partition's conditioning is not degenerate ([`STALL_CONDITIONING`]):
+/// (1 + ‖v‖∞) and the partition's conditioning is not degenerate (`STALL_CONDITIONING`, 0.05):
 /// 1e-8, far above the 1e-12 of [`NEWTON_STEP_TOLERANCE`] that such a floor can exceed.
 pub const NEWTON_STALL_TOLERANCE: f64 = 1e-8;
 
