@@ -205,12 +205,16 @@ fn iftomm(name: &'static str, repeats: usize) -> Result<Benchmark, CliError> {
             last.q[0].sin(),
             last.t
         ),
+        // P3, the joint C: B = R_y(qA) (1, 0, 0), C = B + R_y(qA) R_z(qB) (0, −1, 0).
         _ => {
-            let mut p = [[0.0; 3]; 2];
-            model.loop_points(&last.q, &mut p);
+            let (a, b) = (last.q[0], last.q[1]);
+            let (x, y) = (1.0 + b.sin(), -b.cos());
             format!(
-                "F on the last rod = ({:.6}, {:.6}, {:.6}) m at t = {} s",
-                p[0][0], p[0][1], p[0][2], last.t
+                "P3 (joint C) = ({:.6}, {:.6}, {:.6}) m at t = {} s",
+                x * a.cos(),
+                y,
+                -x * a.sin(),
+                last.t
             )
         }
     };
@@ -249,8 +253,8 @@ fn render(
         let _ = writeln!(
             text,
             "| `{name}` | {:.2} µs | {:.1} µs | {:.0}× |",
-            g * 1e6,
-            n * 1e6,
+            g * 1e-3,
+            n * 1e-3,
             n / g
         );
     }
@@ -259,7 +263,9 @@ fn render(
         "\n### Andrews' squeezing mechanism: run time against error\n\nGenerated code, from the test set's consistent initial \
          state to t = 0.03 s at rtol (atol = rtol/100): the largest error of the seven angles \
          against the test set's reference solution (`andrews.f`, `solut`), median wall time \
-         of 5 runs.\n"
+         of 5 runs. Below rtol 1e-10 the error stays at \
+         1.4e-9 rad, on β and Θ (15.8 rad): 9e-11 relative, what to expect of a reference \
+         computed at 1e-14 and printed to 16 digits.\n"
     );
     let _ = writeln!(
         text,
@@ -291,7 +297,7 @@ fn render(
         "### IFToMM benchmark problems\n\nAt their model files' settings (median wall time of the \
          runs, assembly included). A02 (`n_four_bar`, N = 40: 81 links, 80 loop equations, \
          passing the horizontal singular position 20 times in 20 s) reports the point B0; A04 \
-         (`bricard`, one redundant equation left out) the joint F of the last rod. No \
+         (`bricard`, one redundant equation left out) the point P3, the joint C. No \
          reference solution files of the library were available: A02 is checked against its \
          equivalent pendulum and, for N = 2, Exudyn's published runs (`models/tests/loops.rs`).\n"
     );
