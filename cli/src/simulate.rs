@@ -138,7 +138,12 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     let (state, report) = match assembled {
         Ok(assembled) => assembled,
         Err(e) => {
-            eprintln!("error: {label}: assembly onto the cam failed: {e}");
+            let what = if info.loops.is_empty() {
+                "assembly onto the cam failed"
+            } else {
+                "assembly failed"
+            };
+            eprintln!("error: {label}: {what}: {e}");
             let _ = sink.finish(info, &[], false);
             return Outcome::Failed;
         }

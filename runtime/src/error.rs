@@ -50,7 +50,7 @@ pub enum SimError {
     /// together): Newton from the initial guess left `constraint` open by `residual`, or a
     /// loop equation that is implied by the others to first order is not satisfied.
     #[error(
-        "at t = {t} s the mechanism cannot be assembled: {constraint} is still {residual:.3e}          from closing ({why}); q = {}",
+        "at t = {t} s the mechanism cannot be assembled: {constraint} is still {residual:.3e} from closing ({why}); q = {}",
         Compact(.q)
     )]
     CannotAssemble {
