@@ -82,3 +82,26 @@ pub mod parameter_modes {
         include!(concat!(env!("OUT_DIR"), "/parameter_models/models.rs"));
     }
 }
+
+/// The published reference solution of `andrews_squeezer` at t = 0.03 s: the Test Set for
+/// IVP Solvers (W. M. Lioen, J. J. B. de Swart, CWI 1999; F. Mazzia, C. Magherini, University
+/// of Bari, release 2.4, 2008), problem `andrews`, file `andrews.f` (revision 1.2, 2006),
+/// subroutine `solut` ("computed at Cray C90 … PSIDE, rtol = atol = 1d-14"), as packaged in
+/// the R package deTestSet (`src/Ex_andrews.f`, `andsoln`). The tests compare with it and
+/// `camchain bench loops` measures the error against it.
+pub mod andrews_reference {
+    /// The test set's angles in its order (β, Θ, γ, Φ, δ, Ω, ε): the model's coordinate
+    /// names.
+    pub const ANGLES: [&str; 7] = ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"];
+
+    /// `solut`: y(1..7), the angles at t = 0.03 s (rad).
+    pub const Q_REF: [f64; 7] = [
+        0.1581077119629904e2,
+        -0.1575637105984298e2,
+        0.4082224013073101e-1,
+        -0.5347301163226948e0,
+        0.5244099658805304e0,
+        0.5347301163226948e0,
+        0.1048080741042263e1,
+    ];
+}

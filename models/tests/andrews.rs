@@ -13,22 +13,9 @@
 
 use camchain::runtime::{Dynamics, Sample, Simulate};
 use camchain_models as models;
+use camchain_models::andrews_reference::{ANGLES, Q_REF};
 use camchain_reference::NumericModel;
 use std::path::Path;
-
-/// The test set's angles in its order (β, Θ, γ, Φ, δ, Ω, ε): the model's coordinate names.
-const ANGLES: [&str; 7] = ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"];
-
-/// `solut`: y(1..7), the angles at t = 0.03 s.
-const Q_REF: [f64; 7] = [
-    0.1581077119629904e2,
-    -0.1575637105984298e2,
-    0.4082224013073101e-1,
-    -0.5347301163226948e0,
-    0.5244099658805304e0,
-    0.5347301163226948e0,
-    0.1048080741042263e1,
-];
 
 /// `solut`: y(8..14), the angular velocities at t = 0.03 s.
 const QD_REF: [f64; 7] = [

@@ -14,6 +14,7 @@ use super::timing::side_by_side;
 use crate::CliError;
 use crate::source::builtin_description;
 use camchain_models as models;
+use camchain_models::andrews_reference::{ANGLES, Q_REF};
 use camchain_reference::NumericModel;
 use camchain_runtime::{Dynamics, IntegratorKind, SimSettings, Simulate, Trajectory};
 use std::fmt::Write;
@@ -21,19 +22,6 @@ use std::time::Instant;
 
 /// The models whose right-hand side is timed.
 const RHS_MODELS: [&str; 3] = ["four_bar", "andrews_squeezer", "cam_rocker_linkage"];
-
-/// The Test Set's angles (β, Θ, γ, Φ, δ, Ω, ε) by the model's coordinate names, and their
-/// reference values at t = 0.03 s (`andrews.f`, `solut`: PSIDE, rtol = atol = 1e-14).
-const ANGLES: [&str; 7] = ["beta", "Theta", "gamma", "Phi", "delta", "Omega", "epsilon"];
-const Q_REF: [f64; 7] = [
-    0.1581077119629904e2,
-    -0.1575637105984298e2,
-    0.4082224013073101e-1,
-    -0.5347301163226948e0,
-    0.5244099658805304e0,
-    0.5347301163226948e0,
-    0.1048080741042263e1,
-];
 
 /// One rung of the Andrews ladder.
 struct Rung {
