@@ -21,7 +21,7 @@
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
 //! for a usage error (bad option or value, unknown model name), 130 for a run interrupted
-//! by Ctrl-C, 3 and up for a sweep some of whose runs failed (3 + failed − 1, at most 127),
+//! by Ctrl-C and 143 for one stopped by SIGTERM, 3 and up for a sweep some of whose runs failed (3 + failed − 1, at most 127),
 //! and 1 for anything else (a model file missing or invalid, a failed run, a file that could
 //! not be written).
 
@@ -59,8 +59,11 @@ pub enum CliError {
     Failed(String),
     /// Failures already reported as they happened (exit code 1).
     Reported,
-    /// Interrupted by Ctrl-C, already reported (exit code 130).
-    Interrupted,
+    /// Interrupted by Ctrl-C (exit code 130) or SIGTERM (143), already reported.
+    Interrupted {
+        /// The exit code.
+        code: u8,
+    },
     /// This many runs of a sweep failed, reported in their rows and the summary (exit code
     /// 3 + (failed − 1), at most 127).
     RunsFailed(usize),
@@ -71,7 +74,7 @@ impl std::fmt::Display for CliError {
         match self {
             CliError::Usage(message) | CliError::Failed(message) => f.write_str(message),
             CliError::Reported => f.write_str("failed (reported above)"),
-            CliError::Interrupted => f.write_str("interrupted (reported above)"),
+            CliError::Interrupted { .. } => f.write_str("interrupted (reported above)"),
             CliError::RunsFailed(n) => write!(f, "{n} runs failed"),
         }
     }
@@ -82,14 +85,14 @@ impl CliError {
         match self {
             CliError::Usage(_) => ExitCode::from(2),
             CliError::Failed(_) | CliError::Reported => ExitCode::from(1),
-            CliError::Interrupted => ExitCode::from(interrupt::EXIT_CODE),
+            CliError::Interrupted { code } => ExitCode::from(*code),
             CliError::RunsFailed(n) => ExitCode::from(sweep_exit_code(*n)),
         }
     }
 }
 
 /// The exit code of a sweep whose `failed` runs failed: 3 for one, one more per failure, at
-/// most 127 (below 130, Ctrl-C's).
+/// most 127 (below 130 and 143, the signals').
 pub fn sweep_exit_code(failed: usize) -> u8 {
     (3 + failed.saturating_sub(1)).min(127) as u8
 }
@@ -124,7 +127,7 @@ pub fn main() -> ExitCode {
                 CliError::Usage(message) | CliError::Failed(message) => {
                     eprintln!("error: {message}");
                 }
-                CliError::Reported | CliError::Interrupted => {}
+                CliError::Reported | CliError::Interrupted { .. } => {}
                 CliError::RunsFailed(n) => eprintln!("error: {n} runs failed (see their rows)"),
             }
             error.exit_code()

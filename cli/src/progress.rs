@@ -137,8 +137,14 @@ impl Progress {
         }
     }
 
-    /// Reports that the simulation has reached time `t`.
+    /// Reports that the simulation has reached time `t` (an output time).
     pub fn update(&mut self, t: f64) {
+        self.update_step(t, f64::NAN);
+    }
+
+    /// Reports that a step of size `h` has reached time `t`: between outputs too, so that a
+    /// run whose steps crawl still shows where it is and how short its steps are.
+    pub fn update_step(&mut self, t: f64, h: f64) {
         let elapsed = self.start.elapsed();
         let fraction = self.fraction(t);
         let t_end = self.t_end;
@@ -147,7 +153,7 @@ impl Progress {
             elapsed,
             (fraction * STEPS as f64).round() as u64,
             || format!("t = {t:.3} of {t_end} s"),
-            || progress_line(label, t, t_end, fraction, elapsed),
+            || progress_line(label, (t, h), t_end, fraction, elapsed),
         );
     }
 
@@ -157,16 +163,28 @@ impl Progress {
     }
 }
 
-/// `paper_concave: t = 523.4 of 1000 s (52 %), 12 s so far, about 11 s left`.
-fn progress_line(label: &str, t: f64, t_end: f64, fraction: f64, elapsed: Duration) -> String {
+/// `paper_concave: t = 523.4 of 1000 s (52 %), 12 s so far, about 11 s left; steps of
+/// 2.1e-3 s` (the step when known).
+fn progress_line(
+    label: &str,
+    (t, h): (f64, f64),
+    t_end: f64,
+    fraction: f64,
+    elapsed: Duration,
+) -> String {
     let spent = elapsed.as_secs_f64();
     let left = if fraction > 0.0 {
         format!(", about {:.0} s left", spent * (1.0 - fraction) / fraction)
     } else {
         String::new()
     };
+    let step = if h.is_finite() && h > 0.0 {
+        format!("; steps of {h:.1e} s")
+    } else {
+        String::new()
+    };
     format!(
-        "{label}: t = {t:.4} of {t_end} s ({:.0} %), {spent:.0} s so far{left}",
+        "{label}: t = {t:.4} of {t_end} s ({:.0} %), {spent:.0} s so far{left}{step}",
         100.0 * fraction
     )
 }
@@ -177,12 +195,21 @@ mod tests {
 
     #[test]
     fn a_progress_line_says_where_the_run_is_and_how_long_it_has_left() {
-        let line = progress_line("m", 250.0, 1000.0, 0.25, Duration::from_secs(10));
+        let line = progress_line(
+            "m",
+            (250.0, f64::NAN),
+            1000.0,
+            0.25,
+            Duration::from_secs(10),
+        );
         assert_eq!(
             line,
             "m: t = 250.0000 of 1000 s (25 %), 10 s so far, about 30 s left"
         );
-        let start = progress_line("m", 0.0, 10.0, 0.0, Duration::from_secs(10));
-        assert_eq!(start, "m: t = 0.0000 of 10 s (0 %), 10 s so far");
+        let start = progress_line("m", (0.0, 2.1e-11), 10.0, 0.0, Duration::from_secs(10));
+        assert_eq!(
+            start,
+            "m: t = 0.0000 of 10 s (0 %), 10 s so far; steps of 2.1e-11 s"
+        );
     }
 }

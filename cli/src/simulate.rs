@@ -5,9 +5,9 @@
 //! that a usage error or an unwritable destination costs no simulation and touches no file.
 //! A run streams its CSV rows to `<name>.partial.csv` and renames it when complete; a run
 //! that fails keeps what it computed there and changes nothing else (an earlier result at
-//! the destination stays as it was); Ctrl-C stops the running simulation at its next
-//! sample, keeps the partial CSV and exits with 130. A run that fails does not stop the
-//! others; the command then exits with code 1.
+//! the destination stays as it was); Ctrl-C or SIGTERM stops the running simulation within
+//! one step, keeps the partial CSV, says where, and exits with 130 or 143. A run that fails
+//! does not stop the others; the command then exits with code 1.
 
 use super::CliError;
 use super::args::SimulateArgs;
@@ -18,8 +18,10 @@ use super::plan::{Job, plan};
 use super::plots::Figure;
 use super::progress::Progress;
 use super::summary::{self, RunReport};
-use camchain_runtime::simulate::Observed;
-use camchain_runtime::{Sample, SimError, Simulate, Trajectory};
+use camchain_runtime::{
+    Cancel, ContactLaw, Monitor, Observed, Progress as StepProgress, Sample, SimError, Simulate,
+    Trajectory,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -84,7 +86,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 trajectory,
             }),
             Outcome::Failed => failed = true,
-            Outcome::Interrupted => return Err(CliError::Interrupted),
+            Outcome::Interrupted => return Err(interrupt.error()),
         }
     }
     if let (Some(dir), false) = (args.out_dir(), args.no_plots) {
@@ -152,24 +154,23 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     for warning in summary::assembly_warnings(info, &report, state.length_scale()) {
         console.warn(label, &warning);
     }
-    let mut progress = Progress::new(label, 0.0, settings.t_end, !args.quiet);
-    let mut write_error = None;
-    let mut observe = |sample: &Sample| {
-        progress.update(sample.t);
-        if let Err(e) = sink.row(info, sample) {
-            write_error = Some(e);
-            return Observed::Break(());
-        }
-        if interrupt.requested() {
-            Observed::Break(())
-        } else {
-            Observed::Continue(())
-        }
+    let mut watcher = Watcher {
+        progress: Progress::new(label, 0.0, settings.t_end, !args.quiet),
+        sink: &mut sink,
+        info,
+        write_error: None,
+        cancel: Cancel(interrupt.flag()),
     };
-    let run = match args.restitution(info.restitution) {
-        Some(e) => dynamics.simulate_unilateral_observed(state, settings, e, &mut observe),
-        None => dynamics.simulate_observed(state, settings, &mut observe),
+    let law = match args.restitution(info.restitution) {
+        Some(restitution) => ContactLaw::Unilateral { restitution },
+        None => ContactLaw::Bilateral,
     };
+    let run = dynamics.simulate_monitored(state, settings, law, &mut watcher);
+    let Watcher {
+        progress,
+        write_error,
+        ..
+    } = watcher;
     progress.finish();
     let wall = start.elapsed();
     let (trajectory, failure) = match run {
@@ -178,7 +179,8 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     };
     let saved = sink.finish(info, &trajectory.samples, failure.is_none());
     if let Some(error) = failure {
-        return report_failure(label, &error, write_error, &trajectory, saved);
+        let signal = interrupt.signal_name();
+        return report_failure(label, (&error, signal), write_error, &trajectory, saved);
     }
     let mut written = Vec::new();
     let mut ok = true;
@@ -213,7 +215,11 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
         stats: trajectory.stats,
         wall,
     }));
-    for warning in summary::result_warnings(info, &trajectory.samples) {
+    for warning in summary::result_warnings(
+        info,
+        &trajectory.samples,
+        matches!(law, ContactLaw::Unilateral { .. }),
+    ) {
         console.warn(label, &warning);
     }
     if !written.is_empty() {
@@ -226,11 +232,41 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     }
 }
 
+/// What a run shows and writes while it goes: each sample's CSV row and the progress; after
+/// every step, the progress and the interrupt flag.
+struct Watcher<'a> {
+    progress: Progress,
+    sink: &'a mut CsvSink,
+    info: &'a camchain_runtime::ModelInfo,
+    write_error: Option<std::io::Error>,
+    cancel: Cancel<'a>,
+}
+
+impl Monitor for Watcher<'_> {
+    fn sample(&mut self, sample: &Sample) -> Observed {
+        self.progress.update(sample.t);
+        if let Err(e) = self.sink.row(self.info, sample) {
+            self.write_error = Some(e);
+            return Observed::Break(());
+        }
+        self.cancel.step(&StepProgress {
+            t: sample.t,
+            h: 0.0,
+            steps: 0,
+        })
+    }
+
+    fn step(&mut self, progress: &StepProgress) -> Observed {
+        self.progress.update_step(progress.t, progress.h);
+        self.cancel.step(progress)
+    }
+}
+
 /// One `error:` line for a failed run (or one line for an interrupted one), and where its
 /// partial CSV is; no summary.
 fn report_failure(
     label: &str,
-    error: &SimError,
+    (error, signal): (&SimError, &str),
     write_error: Option<std::io::Error>,
     trajectory: &Trajectory,
     saved: Result<Saved, String>,
@@ -239,7 +275,7 @@ fn report_failure(
     match (&write_error, interrupted) {
         (Some(e), _) => eprintln!("error: {label}: the CSV could not be written: {e}"),
         (None, true) => eprintln!(
-            "{label}: interrupted at t = {} s",
+            "{label}: stopped by {signal} at t = {} s",
             error.time().unwrap_or(f64::NAN)
         ),
         (None, false) => eprintln!("error: {label}: {error}"),
@@ -281,7 +317,8 @@ fn remove_stale_outputs(dir: &Path, label: &str, written: &[PathBuf]) {
     }
 }
 
-/// "out/paper_concave/: paper_concave.csv, histories.png, …".
+/// "out/paper_concave/: paper_concave.csv, histories.png, …"; files in the current
+/// directory by their names alone.
 fn list_files(paths: &[PathBuf]) -> String {
     let dir = paths.first().and_then(|p| p.parent());
     if dir.is_some() && paths.iter().all(|p| p.parent() == dir) {
@@ -290,8 +327,10 @@ fn list_files(paths: &[PathBuf]) -> String {
             .filter_map(|p| p.file_name())
             .map(|n| n.to_string_lossy().into_owned())
             .collect();
-        let dir = dir.map(|d| d.display().to_string()).unwrap_or_default();
-        format!("{dir}/: {}", names.join(", "))
+        match dir.map(|d| d.display().to_string()) {
+            Some(dir) if !dir.is_empty() => format!("{dir}/: {}", names.join(", ")),
+            _ => names.join(", "),
+        }
     } else {
         let all: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
         all.join(", ")

@@ -104,6 +104,32 @@ fn range(samples: &[Sample], value: impl Fn(&Sample) -> f64) -> (f64, f64) {
         })
 }
 
+/// Contact k is closed in the sample (always in a bilateral run; not while a one-sided
+/// follower flies).
+fn touching(sample: &Sample, k: usize) -> bool {
+    sample.in_contact.get(k).copied().unwrap_or(true)
+}
+
+/// The range of `value` over the samples where contact k is closed; `None` if there is none.
+fn range_in_contact(
+    samples: &[Sample],
+    k: usize,
+    value: impl Fn(&Sample) -> f64,
+) -> Option<(f64, f64)> {
+    let closed: Vec<f64> = samples
+        .iter()
+        .filter(|s| touching(s, k))
+        .map(value)
+        .collect();
+    (!closed.is_empty()).then(|| {
+        closed
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            })
+    })
+}
+
 fn settings_text(settings: &SimSettings) -> String {
     let name = integrator_name(settings.integrator);
     match settings.integrator {
@@ -137,17 +163,23 @@ fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
     } else {
         &["x", "y"]
     };
-    for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
+    for (k, contact) in info.contacts.iter().enumerate() {
+        let name = &contact.name;
         for (a, axis) in axes.iter().enumerate() {
             let (lo, hi) = range(samples, |s| s.contacts[k].position[a]);
             rows.push((format!("{name}_{axis} [m]"), lo, hi));
         }
         let (lo, hi) = range(samples, |s| s.normal_force[k]);
         rows.push((format!("{name}_normal_force [N]"), lo, hi));
-        let (lo, hi) = range(samples, |s| s.contacts[k].pressure_angle());
-        rows.push((format!("{name}_pressure_angle [rad]"), lo, hi));
-        let (lo, hi) = range(samples, |s| s.contacts[k].sliding_speed);
-        rows.push((format!("{name}_sliding_speed [m/s]"), lo, hi));
+        // In contact only: a flying follower has no pressure angle or sliding speed, and a
+        // fixed cam drives nothing (no pressure angle either).
+        let angle = |s: &Sample| s.contacts[k].pressure_angle();
+        if let Some((lo, hi)) = range_in_contact(samples, k, angle).filter(|_| contact.cam_moves) {
+            rows.push((format!("{name}_pressure_angle [rad]"), lo, hi));
+        }
+        if let Some((lo, hi)) = range_in_contact(samples, k, |s| s.contacts[k].sliding_speed) {
+            rows.push((format!("{name}_sliding_speed [m/s]"), lo, hi));
+        }
     }
     // Each loop's reactions, unless there are too many loops to list (an N-four-bar): then
     // the largest reaction over all of them.
@@ -209,18 +241,23 @@ pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
 }
 
 /// One line per contact: its kind and where its pressure angle is largest (degrees, the
-/// designer's unit), over the samples in contact.
+/// designer's unit), over the samples in contact; a fixed cam drives nothing, and its line
+/// says that the pressure angle is not defined.
 fn contact_lines(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
     let mut lines = Vec::new();
     for (k, contact) in info.contacts.iter().enumerate() {
         let steepest = samples
             .iter()
-            .filter(|s| !s.dependent.is_empty())
+            .filter(|s| touching(s, k))
             .map(|s| (s, s.contacts[k].pressure_angle().abs()))
             .filter(|(_, a)| a.is_finite())
             .max_by(|a, b| a.1.total_cmp(&b.1));
         let mut line = format!("{}: {}", contact.name, contact_kind(info, contact));
-        if let Some((s, angle)) = steepest {
+        if !contact.cam_moves {
+            line.push_str(
+                "; the cam is fixed: it drives no follower, so no pressure angle is defined",
+            );
+        } else if let Some((s, angle)) = steepest {
             let _ = write!(
                 line,
                 "; largest pressure angle {:.2}° at t = {} s",
@@ -406,9 +443,12 @@ pub fn render_repartitions(info: &ModelInfo, samples: &[Sample]) -> String {
             .collect();
         list.join(", ")
     };
+    // A one-sided follower's take-off and landing change the dependent set too; they are
+    // events, not re-partitions.
+    let closed = |s: &Sample| s.in_contact.iter().all(|&c| c);
     let changes: Vec<(f64, f64, String, String)> = samples
         .windows(2)
-        .filter(|w| w[0].dependent != w[1].dependent)
+        .filter(|w| closed(&w[0]) && closed(&w[1]) && w[0].dependent != w[1].dependent)
         .map(|w| {
             let (a, b) = (&w[0].dependent, &w[1].dependent);
             (w[0].t, w[1].t, names(a, b), names(b, a))
@@ -589,15 +629,20 @@ pub fn assembly_warnings(
 }
 
 /// Warnings about results that are almost surely a modelling mistake: a normal force
-/// negative at the start or for most of the run (the cam pulls the follower).
-pub fn result_warnings(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
+/// negative at the start or for most of the run (the cam pulls the follower), over the
+/// samples in contact. A one-sided run is not warned about: its follower lifts off where the
+/// force would turn negative, as it should.
+pub fn result_warnings(info: &ModelInfo, samples: &[Sample], one_sided: bool) -> Vec<String> {
     let mut out = Vec::new();
     let Some(first) = samples.first() else {
         return out;
     };
+    if one_sided {
+        return out;
+    }
     for (k, contact) in info.contacts.iter().enumerate() {
         let name = &contact.name;
-        let in_contact: Vec<&Sample> = samples.iter().filter(|s| !s.dependent.is_empty()).collect();
+        let in_contact: Vec<&Sample> = samples.iter().filter(|s| touching(s, k)).collect();
         let negative = in_contact
             .iter()
             .filter(|s| s.normal_force[k] < 0.0)
@@ -655,6 +700,7 @@ mod tests {
             dissipated: 0.0,
             driven_work: 0.0,
             dependent: vec![0].into(),
+            in_contact: vec![true],
         }
     }
 

@@ -214,8 +214,50 @@ fn the_predicted_jump_speed_is_where_bisection_finds_it() {
     );
     // The model file's comment: about 64 rad/s.
     assert!((60.0..70.0).contains(&predicted));
+    // The closed form from the file's parameters and the cycloidal law (issue 24): the
+    // command prints 12 significant digits; its A, B, C are the dynamics' to Newton's
+    // tolerance and its root is refined between samples 0.1° apart by a parabola, whose
+    // error there (the fourth derivative of the root over θ times 0.1°⁴) is below 1e-9.
+    let parameters = parse_model_from(
+        camchain_models::source("cycloidal_roller").expect("built in"),
+        Path::new("models/cycloidal_roller.ron"),
+        &[],
+        ParameterMode::AsDeclared,
+        Files::Embedded(camchain_models::files("cycloidal_roller")),
+    )
+    .expect("valid")
+    .parameters;
+    let p = |name: &str| {
+        parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.default)
+            .unwrap_or_else(|| panic!("no parameter {name}"))
+    };
+    let closed = cycloidal::Cycloidal {
+        m: p("m"),
+        g: p("g"),
+        k: p("k"),
+        c: p("c"),
+        free: p("free"),
+        base: p("R_b") + p("rho"),
+        lift: p("h"),
+    }
+    .jump_speed()
+    .0;
+    eprintln!(
+        "jump speed: closed form {closed} rad/s ({:.1e} relative to the prediction)",
+        relative(predicted, closed)
+    );
+    assert!(
+        relative(predicted, closed) < 1e-8,
+        "predicted {predicted}, closed form {closed}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[path = "../../models/tests/support/cycloidal.rs"]
+mod cycloidal;
 
 #[test]
 fn above_the_jump_speed_the_follower_lifts_off() {

@@ -573,7 +573,7 @@ fn ctrl_c_keeps_the_rows_so_far_and_an_older_result_as_it_was() {
     assert_eq!(output.status.code(), Some(130));
     let err = text(&output.stderr);
     assert!(
-        err.contains("interrupted after") && err.contains("big.partial.csv"),
+        err.contains("stopped by Ctrl-C after") && err.contains("big.partial.csv"),
         "{err}"
     );
     assert_eq!(

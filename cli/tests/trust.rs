@@ -284,7 +284,7 @@ fn a_long_run_streams_its_rows_reports_progress_and_stops_cleanly_on_ctrl_c() {
     let rest: Vec<String> = lines.try_iter().collect();
     assert!(
         rest.iter()
-            .any(|l| l.starts_with("paper_concave_numeric: interrupted at t = ")),
+            .any(|l| l.starts_with("paper_concave_numeric: stopped by Ctrl-C at t = ")),
         "{rest:?}"
     );
     assert!(

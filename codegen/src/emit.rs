@@ -640,8 +640,10 @@ fn info_static(model: &Model) -> String {
             };
             format!(
                 "rt::ContactInfo {{ name: {:?}.to_string(), follower: rt::FollowerKind::{follower}, \
-                 profile: rt::ProfileKind::{profile}, cam_coordinate: {cam_coordinate} }}",
-                c.name
+                 profile: rt::ProfileKind::{profile}, cam_coordinate: {cam_coordinate}, \
+                 cam_moves: {} }}",
+                c.name,
+                c.cam_body.is_some()
             )
         })
         .collect();

@@ -98,6 +98,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
         cam_coordinate: c
             .cam_body
             .filter(|&b| model.bodies[b].joint.kind == JointKind::Revolute),
+        cam_moves: c.cam_body.is_some(),
     }
 }
 

@@ -14,7 +14,7 @@
 use crate::dynamics::{ContactGeometry, CoordinateKind, Dynamics};
 use crate::error::SimError;
 use crate::partition::{Partition, Workspace, independent_rows};
-use crate::simulate::{State, invalid};
+use crate::stepping::{State, invalid};
 use std::f64::consts::PI;
 
 /// What assembly did to the model's initial guess.

@@ -116,6 +116,10 @@ pub struct ContactInfo {
     /// The coordinate of the cam body's own joint when it is revolute (the cam's angle is
     /// that coordinate); `None` for a cam on the ground or on a sliding body.
     pub cam_coordinate: Option<usize>,
+    /// The cam is carried by a moving body (a camshaft, a slide), not fixed to the ground:
+    /// it drives the follower, and the pressure angle is defined. A chain's point sliding
+    /// along a fixed cam (the paper's) has none.
+    pub cam_moves: bool,
 }
 
 impl ContactInfo {
@@ -126,6 +130,7 @@ impl ContactInfo {
             follower: FollowerKind::Knife,
             profile: ProfileKind::Explicit,
             cam_coordinate: None,
+            cam_moves: false,
         }
     }
 }

@@ -110,6 +110,38 @@ pub enum SimError {
         h: f64,
     },
 
+    /// The run stalled: at the pace of its last `steps` accepted steps it could not reach its
+    /// next output time within the step budget of an output interval
+    /// ([`crate::settings::MAX_STEPS_PER_CALL`]); see [`crate::control`].
+    #[error(
+        "at t = {t} s the run has stalled: its last {steps} steps advanced only {advanced:.3e} s \
+         (the last {h:.3e} s), so reaching the next output time {next} s would take {needed:.1e} \
+         more steps, beyond the budget of 1e7 per output interval (rtol {rtol:.0e}, atol \
+         {atol:.0e}). {}",
+        StallCause(*.shrinking)
+    )]
+    Stalled {
+        /// Time (s).
+        t: f64,
+        /// The last accepted step (s).
+        h: f64,
+        /// Time advanced over the measured steps (s).
+        advanced: f64,
+        /// Number of steps measured.
+        steps: usize,
+        /// The next output time, or the end of the `step` call (s).
+        next: f64,
+        /// Steps the pace projects to reach it.
+        needed: f64,
+        /// Relative tolerance of the run.
+        rtol: f64,
+        /// Absolute tolerance of the run.
+        atol: f64,
+        /// True when the steps were still shrinking (a singular point ahead), false when
+        /// they stayed short (a stiff mode).
+        shrinking: bool,
+    },
+
     /// The step budget of one call was exhausted.
     #[error("at t = {t} s the step budget of one call was exhausted")]
     TooManySteps {
@@ -144,6 +176,7 @@ impl SimError {
             SimError::NonFinite { .. } => "NonFinite",
             SimError::StepSizeTooSmall { .. } => "StepSizeTooSmall",
             SimError::TooManySteps { .. } => "TooManySteps",
+            SimError::Stalled { .. } => "Stalled",
             SimError::Interrupted { .. } => "Interrupted",
             SimError::InvalidSettings { .. } => "InvalidSettings",
         }
@@ -159,6 +192,7 @@ impl SimError {
             | SimError::NonFinite { t, .. }
             | SimError::StepSizeTooSmall { t, .. }
             | SimError::TooManySteps { t }
+            | SimError::Stalled { t, .. }
             | SimError::Interrupted { t } => Some(*t),
             SimError::InvalidSettings { .. } => None,
         }
@@ -184,6 +218,30 @@ impl fmt::Display for SingularCause {
                 "no coordinate free to move can move the contact point across the cam (J_v \
                  singular) while it is off the cam (|h| = {residual:.3e} m): no held, driven or \
                  dependent choice can put it back"
+            )
+        }
+    }
+}
+
+/// The likely cause of a stall, from whether the steps were still shrinking.
+struct StallCause(bool);
+
+impl fmt::Display for StallCause {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0 {
+            f.write_str(
+                "The steps were still shrinking: the motion approaches a point where the \
+                 equations are singular (a dead point or a singular position of a loop, where \
+                 the constraint Jacobian loses rank; a body whose mass or inertia vanishes; a \
+                 velocity that grows without bound). Check the model there, or loosen rtol \
+                 if the point is passed at the model's default tolerances.",
+            )
+        } else {
+            f.write_str(
+                "The steps stayed short: a stiff mode (a very light body, a very stiff spring \
+                 or damper) holds the explicit integrator at its stability limit, or the \
+                 tolerances are tighter than the equations can be evaluated to. Soften the \
+                 mode or loosen rtol and atol.",
             )
         }
     }

@@ -50,58 +50,109 @@ pub struct ContactEvent {
 }
 
 /// The root of `g` in the bracket [t0, t1] where g(t0) = g0 and g(t1) = g1 have opposite
-/// signs (or g1 = 0), by the Illinois variant of regula falsi (superlinear, never leaves the
-/// bracket) safeguarded by bisection, to a bracket narrower than `tolerance`. Returns the end of the final bracket
-/// on the far side of the sign change (so that the event has happened at the returned
-/// time).
+/// signs (or g1 = 0), by Brent's method (inverse quadratic interpolation and secant steps,
+/// safeguarded by bisection: superlinear on a smooth g, never worse than bisection, never
+/// leaving the bracket), to a bracket narrower than `tolerance`. Returns the end of the
+/// final bracket on the far side of the sign change (so that the event has happened at the
+/// returned time).
 pub fn locate_root(
-    mut g: impl FnMut(f64) -> Result<f64, SimError>,
-    (mut a, mut ga): (f64, f64),
-    (mut b, mut gb): (f64, f64),
+    g: impl FnMut(f64) -> Result<f64, SimError>,
+    a: (f64, f64),
+    b: (f64, f64),
     tolerance: f64,
 ) -> Result<f64, SimError> {
-    let mut side = 0;
-    let mut width = (b - a).abs();
-    let mut bisect = false;
-    for _ in 0..200 {
-        if (b - a).abs() <= tolerance || gb == 0.0 {
-            return Ok(b);
-        }
-        let mut t = if bisect {
-            0.5 * (a + b)
-        } else {
-            (a * gb - b * ga) / (gb - ga)
-        };
-        // Keep the trial strictly inside: fall back to bisection when round-off puts it on
-        // an end.
-        if !(t > a.min(b) && t < a.max(b)) {
-            t = 0.5 * (a + b);
-        }
-        let gt = g(t)?;
-        if gt == 0.0 {
-            return Ok(t);
-        }
-        if (gt > 0.0) == (gb > 0.0) {
-            // The far end moves: t replaces b.
-            (b, gb) = (t, gt);
-            if side == -1 {
-                ga *= 0.5;
-            }
-            side = -1;
-        } else {
-            (a, ga) = (t, gt);
-            if side == 1 {
-                gb *= 0.5;
-            }
-            side = 1;
-        }
-        // A step that did not halve the bracket (a flat or high-order root, where regula
-        // falsi crawls) is followed by a bisection: at worst twice bisection's step count.
-        let new_width = (b - a).abs();
-        bisect = !bisect && new_width > 0.5 * width;
-        width = new_width;
+    locate_root_within(g, a, b, tolerance, f64::INFINITY)
+}
+
+/// [`locate_root`] that also goes on until |g| at the returned end is at most
+/// `value_tolerance` (a landing located to a gap, not only to a time), or until the bracket
+/// is down to a few units in the last place of t.
+pub fn locate_root_within(
+    mut g: impl FnMut(f64) -> Result<f64, SimError>,
+    (t0, g0): (f64, f64),
+    (t1, g1): (f64, f64),
+    tolerance: f64,
+    value_tolerance: f64,
+) -> Result<f64, SimError> {
+    if g1 == 0.0 {
+        return Ok(t1);
     }
-    Ok(b)
+    let far = g1 > 0.0;
+    // Brent's zeroin: b is the best estimate, c the other end of the bracket, a the
+    // previous b.
+    let (mut a, mut fa, mut b, mut fb) = (t0, g0, t1, g1);
+    let (mut c, mut fc) = (a, fa);
+    let mut d = b - a;
+    let mut e = d;
+    for _ in 0..200 {
+        if (fb > 0.0) == (fc > 0.0) && fb != 0.0 && fc != 0.0 {
+            (c, fc) = (a, fa);
+            d = b - a;
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            (a, fa) = (b, fb);
+            (b, fb) = (c, fc);
+            (c, fc) = (a, fa);
+        }
+        let resolution = 4.0 * f64::EPSILON * b.abs().max(c.abs());
+        // A value tolerance sets the width needed through the bracket's secant slope.
+        let slope = ((fc - fb) / (c - b)).abs();
+        let width = if value_tolerance.is_finite() && slope > 0.0 {
+            tolerance.min(value_tolerance / slope)
+        } else {
+            tolerance
+        };
+        let tol1 = resolution + 0.5 * width;
+        let half = 0.5 * (c - b);
+        // The end of the bracket on the far side of the sign change, and its value.
+        let (end, value) = if fb == 0.0 || (fb > 0.0) == far {
+            (b, fb)
+        } else {
+            (c, fc)
+        };
+        let narrow = half.abs() <= tol1 && value.abs() <= value_tolerance;
+        if narrow || fb == 0.0 || half.abs() <= resolution {
+            return Ok(end);
+        }
+        if e.abs() >= tol1 && fa.abs() > fb.abs() {
+            // Inverse quadratic interpolation, or the secant when a = c.
+            let s = fb / fa;
+            let (mut p, mut q) = if a == c {
+                (2.0 * half * s, 1.0 - s)
+            } else {
+                let q = fa / fc;
+                let r = fb / fc;
+                (
+                    s * (2.0 * half * q * (q - r) - (b - a) * (r - 1.0)),
+                    (q - 1.0) * (r - 1.0) * (s - 1.0),
+                )
+            };
+            if p > 0.0 {
+                q = -q;
+            } else {
+                p = -p;
+            }
+            if 2.0 * p < (3.0 * half * q - (tol1 * q).abs()).min((e * q).abs()) {
+                e = d;
+                d = p / q;
+            } else {
+                d = half;
+                e = d;
+            }
+        } else {
+            d = half;
+            e = d;
+        }
+        (a, fa) = (b, fb);
+        b += if d.abs() > tol1 {
+            d
+        } else {
+            tol1.copysign(half)
+        };
+        fb = g(b)?;
+    }
+    Ok(if (fb > 0.0) == far { b } else { c })
 }
 
 /// True when `from` → `to` is a sign change (crossing or reaching zero from a non-zero

@@ -14,6 +14,13 @@
 //!   output.
 //! - [`settings`]: the ranges of the settings a run accepts, checked before it starts.
 //! - [`simulate`]: assembly, `step`, `simulate`, trajectories with contact forces.
+//! - [`stepping`]: the integration engine: the state, one step, the bookkeeping after it.
+//! - `phase`: the phases of a run: outputs on a grid, events located inside steps.
+//! - `scan`: in-step scans of the watched forces and gaps (no event missed inside a
+//!   step).
+//! - [`sample`]: every output at one instant.
+//! - [`control`]: what a run reports while it goes ([`control::Monitor`]), cancellation,
+//!   and the watchdog that stops a stalled run.
 //! - [`motion_law`]: follower motion laws (dwell, cycloidal, harmonic, polynomials,
 //!   modified trapezoid and sine) in closed form, and programs of them over a turn.
 //! - [`spline`]: C² cubic splines through tables of points (profiles given as points).
@@ -27,6 +34,7 @@
 
 pub mod assembly;
 pub mod contact;
+pub mod control;
 pub mod dynamics;
 pub mod error;
 pub mod events;
@@ -35,14 +43,20 @@ pub mod metrics;
 pub mod motion_law;
 pub mod parameters;
 pub mod partition;
+pub(crate) mod phase;
+pub mod sample;
+pub(crate) mod scan;
 pub mod settings;
 pub mod simulate;
 pub mod spline;
+pub mod stepping;
 pub mod unilateral;
 
+pub use control::{Cancel, Monitor, Observed, Progress};
 pub use dynamics::*;
 pub use error::SimError;
 pub use metrics::{MetricsFailure, MetricsOptions, RunMetrics};
 pub use parameters::{ParameterError, ParameterInfo};
 pub use settings::InvalidSetting;
 pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};
+pub use unilateral::ContactLaw;

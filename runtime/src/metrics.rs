@@ -10,15 +10,19 @@
 //! ([`MetricsOptions::grid`]: also at t0 + k·dt_out, the times of a full run's samples, so
 //! that the extremes are those of its CSV). Nothing grows with the length of the run.
 
+use crate::control::{Monitor, Progress, Watchdog};
 use crate::dynamics::{ContactGeometry, Dynamics, SimSettings};
 use crate::error::SimError;
 use crate::events::{EVENT_TIME_TOLERANCE, locate_root};
+use crate::integrators::stage_quadrature;
 use crate::partition::{Partition, Workspace, normal_force};
-use crate::simulate::{
-    Grid, SampleLevel, Stats, adaptive_step, add_counters_since, all_counters, finish_step,
-    interpolate_last_step, load_state, rk4_step, sample_in_place, validate_run,
+use crate::phase::Grid;
+use crate::sample::{Sample, SampleLevel, sample_in_place};
+use crate::scan::{ForceStep, excursion_guess, find_excursion};
+use crate::stepping::{
+    State, Stats, adaptive_step, add_counters_since, all_counters, finish_step,
+    interpolate_last_step, load_state, rk4_step, validate_run,
 };
-use crate::{Sample, State};
 
 /// What a run reports of itself when its trajectory is not kept.
 #[derive(Debug, Clone, PartialEq)]
@@ -241,25 +245,37 @@ fn point_interpolated<D: Dynamics + ?Sized>(
     )
 }
 
-/// [`crate::Simulate::simulate_metrics`].
+/// [`crate::Simulate::simulate_metrics`] and
+/// [`crate::Simulate::simulate_metrics_monitored`].
 pub(crate) fn run_metrics<D: Dynamics + ?Sized>(
     model: &D,
     mut state: State,
     settings: &SimSettings,
     options: MetricsOptions,
+    monitor: &mut dyn Monitor,
 ) -> Result<RunMetrics, Box<MetricsFailure>> {
     let mut acc = Accumulator::new(state.t);
     let before = all_counters(&state.engine);
+    let mut pace = Pace {
+        watchdog: Watchdog::new(state.t, settings.rtol, settings.atol),
+        monitor,
+        steps: 0,
+        t_end: settings.t_end,
+    };
     let outcome = validate_run(model, &state, settings).and_then(|()| {
         if settings.integrator.is_adaptive() {
-            adaptive_run(model, &mut state, settings, options, &mut acc)
+            state.engine.stages.watch(model.info().n_contacts());
+            let outcome = adaptive_run(model, &mut state, settings, options, &mut acc, &mut pace);
+            state.engine.stages.watch(0);
+            outcome
         } else {
-            fixed_run(model, &mut state, settings, &mut acc)
+            fixed_run(model, &mut state, settings, &mut acc, &mut pace)
         }
     });
     let mut stats = Stats::default();
     add_counters_since(&mut stats, &state.engine, before);
     stats.repartitions = acc.metrics.stats.repartitions;
+    stats.event_evaluations = acc.metrics.stats.event_evaluations;
     match outcome {
         Ok(()) => Ok(acc.finish(stats)),
         Err(error) => Err(Box::new(MetricsFailure {
@@ -269,13 +285,41 @@ pub(crate) fn run_metrics<D: Dynamics + ?Sized>(
     }
 }
 
-/// The start, then every accepted step's end (and the grid, if asked).
+/// The stall watchdog and the monitor of a metrics run, called after every step. A metrics
+/// run has no output times: its budget runs to t_end.
+struct Pace<'m> {
+    watchdog: Watchdog,
+    monitor: &'m mut dyn Monitor,
+    steps: usize,
+    t_end: f64,
+}
+
+impl Pace<'_> {
+    fn stepped(&mut self, t: f64, h: f64) -> Result<(), SimError> {
+        self.watchdog.step(t, h, self.t_end)?;
+        self.steps += 1;
+        let progress = Progress {
+            t,
+            h,
+            steps: self.steps,
+        };
+        if self.monitor.step(&progress).is_break() {
+            return Err(SimError::Interrupted { t });
+        }
+        Ok(())
+    }
+}
+
+/// The start, then every accepted step's end (and the grid, if asked); inside a step, a
+/// normal force that changes sign or may cross zero and come back is searched on the dense
+/// output for the first lift-off.
 fn adaptive_run<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     settings: &SimSettings,
     options: MetricsOptions,
     acc: &mut Accumulator,
+    pace: &mut Pace,
 ) -> Result<(), SimError> {
     let start = Point::of_sample(&sample_in_place(model, state, SampleLevel::Full)?);
     acc.add(&start);
@@ -284,13 +328,16 @@ fn adaptive_run<D: Dynamics + ?Sized>(
     grid.next = 1;
     let mut ws = state.engine.ws.clone();
     let mut y = state.engine.y.clone();
-    let (mut end, mut probe) = (start.clone(), start);
-    let mut steps = 0;
+    let (mut end, mut probe) = (start.clone(), start.clone());
+    // −λ of every contact (the sign of its normal force) at the last step's end.
+    let mut last_p: Vec<f64> = start
+        .forces
+        .iter()
+        .zip(&start.geometry)
+        .map(|(&n, g)| n / g.force_scale)
+        .collect();
+    let (evaluations, quadrature) = stage_quadrature(settings.integrator);
     while state.t < settings.t_end {
-        if steps == crate::settings::MAX_STEPS_PER_CALL {
-            return Err(SimError::TooManySteps { t: state.t });
-        }
-        steps += 1;
         let t_old = state.t;
         let t_new = adaptive_step(model, state, settings.t_end, settings)?;
         // The step's last stage was the right-hand side at its end: the workspace holds q,
@@ -306,28 +353,45 @@ fn adaptive_run<D: Dynamics + ?Sized>(
             &mut end,
         )?;
         ws.v_anchor.copy_from_slice(&state.engine.ws.v_anchor);
-        if let Some(contact) = acc.lift_off_candidate(&end) {
-            let before = acc.last_forces[contact];
-            let after = end.forces[contact];
-            let mut force = |t: f64| -> Result<f64, SimError> {
-                point_interpolated(model, state, settings, (&mut ws, &mut y), t, &mut probe)?;
-                Ok(probe.forces[contact])
-            };
-            let t = locate_root(
-                &mut force,
-                (t_old, before),
-                (t_new, after),
-                EVENT_TIME_TOLERANCE,
-            )?;
-            acc.metrics.first_lift_off = Some((t, contact));
+        let steps = StepStages::of(state, (evaluations, quadrature), &last_p, t_new);
+        if acc.metrics.first_lift_off.is_none() {
+            let candidate = acc.lift_off_candidate(&end).map(|k| (k, None)).or_else(|| {
+                (0..last_p.len()).find_map(|k| steps.guess(k).map(|guess| (k, Some(guess))))
+            });
+            if let Some((contact, guess)) = candidate {
+                let before = acc.last_forces[contact];
+                let after = end.forces[contact];
+                let mut searched = Vec::new();
+                let mut force = |t: f64| -> Result<f64, SimError> {
+                    point_interpolated(model, state, settings, (&mut ws, &mut y), t, &mut probe)?;
+                    searched.push(probe.clone());
+                    Ok(probe.forces[contact])
+                };
+                let bracket = match guess {
+                    None => Some(((t_old, before), (t_new, after))),
+                    Some(guess) => {
+                        find_excursion(&mut force, (t_old, before), (t_new, after), guess)?
+                            .map(|excursion| excursion.leaves)
+                    }
+                };
+                if let Some((a, b)) = bracket {
+                    let t = locate_root(&mut force, a, b, EVENT_TIME_TOLERANCE)?;
+                    acc.metrics.first_lift_off = Some((t, contact));
+                }
+                acc.metrics.stats.event_evaluations += searched.len();
+                for point in &searched {
+                    acc.add(point);
+                }
+            }
         }
+        last_p = steps.end;
         if options.grid {
-            while let Some(t_out) = grid.pending_time(settings).filter(|&t| t < t_new) {
+            while let Some(t_out) = grid.pending(settings).filter(|&t| t < t_new) {
                 point_interpolated(model, state, settings, (&mut ws, &mut y), t_out, &mut probe)?;
                 acc.add(&probe);
                 grid.next += 1;
             }
-            if grid.pending_time(settings).is_some_and(|t| t <= t_new) {
+            if grid.pending(settings).is_some_and(|t| t <= t_new) {
                 grid.next += 1;
             }
         }
@@ -336,8 +400,68 @@ fn adaptive_run<D: Dynamics + ?Sized>(
         if finish_step(model, state, t_new)? {
             acc.metrics.stats.repartitions += 1;
         }
+        pace.stepped(t_new, t_new - t_old)?;
     }
     Ok(())
+}
+
+/// What the stage log of the last step says of each contact's −λ.
+struct StepStages {
+    t0: f64,
+    t1: f64,
+    start: Vec<f64>,
+    end: Vec<f64>,
+    mean: Vec<f64>,
+    /// (t, −λ of every contact) at the interior stages.
+    stages: Vec<(f64, Vec<f64>)>,
+}
+
+impl StepStages {
+    fn of(
+        state: &State,
+        (evaluations, quadrature): (usize, &[f64]),
+        start: &[f64],
+        t1: f64,
+    ) -> Self {
+        let log = &state.engine.stages;
+        let complete = log.len() >= evaluations;
+        let mut mean: Vec<f64> = start.iter().map(|p| quadrature[0] * p).collect();
+        let mut stages = Vec::with_capacity(evaluations);
+        let mut end = vec![f64::NAN; start.len()];
+        for ((t, values), b) in log.last(evaluations).zip(&quadrature[1..]) {
+            for (m, v) in mean.iter_mut().zip(values) {
+                *m += b * v;
+            }
+            if t < t1 {
+                stages.push((t, values.to_vec()));
+            } else {
+                end.copy_from_slice(values);
+            }
+        }
+        if !complete {
+            mean.fill(f64::NAN);
+        }
+        StepStages {
+            t0: state.t,
+            t1,
+            start: start.to_vec(),
+            end,
+            mean,
+            stages,
+        }
+    }
+
+    /// Where contact k's force may cross zero and come back inside the step.
+    fn guess(&self, k: usize) -> Option<f64> {
+        let stages: Vec<(f64, f64)> = self.stages.iter().map(|(t, v)| (*t, v[k])).collect();
+        excursion_guess(&ForceStep {
+            start: (self.t0, self.start[k]),
+            end: (self.t1, self.end[k]),
+            mean: self.mean[k],
+            stages: &stages,
+        })
+        .filter(|_| self.start[k] > 0.0)
+    }
 }
 
 /// RK4: the start and the end of every step (a full evaluation each: RK4's last stage is
@@ -347,16 +471,13 @@ fn fixed_run<D: Dynamics + ?Sized>(
     state: &mut State,
     settings: &SimSettings,
     acc: &mut Accumulator,
+    pace: &mut Pace,
 ) -> Result<(), SimError> {
     let start = Point::of_sample(&sample_in_place(model, state, SampleLevel::Full)?);
     acc.add(&start);
     acc.remember(&start);
-    let mut steps = 0;
     while state.t < settings.t_end {
-        if steps == crate::settings::MAX_STEPS_PER_CALL {
-            return Err(SimError::TooManySteps { t: state.t });
-        }
-        steps += 1;
+        let t_old = state.t;
         let t_new = rk4_step(model, state, settings.t_end, settings.dt)?;
         if finish_step(model, state, t_new)? {
             acc.metrics.stats.repartitions += 1;
@@ -370,6 +491,7 @@ fn fixed_run<D: Dynamics + ?Sized>(
         }
         acc.add(&end);
         acc.remember(&end);
+        pace.stepped(t_new, t_new - t_old)?;
     }
     Ok(())
 }

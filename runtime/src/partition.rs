@@ -502,6 +502,15 @@ impl Workspace {
         out
     }
 
+    /// λ of constraint row `row` of all m (zero when the row is left out), without
+    /// allocating.
+    pub fn contact_lambda(&self, row: usize) -> f64 {
+        self.rows
+            .iter()
+            .position(|&r| r == row)
+            .map_or(0.0, |k| self.lambda[k])
+    }
+
     /// Copies the chosen rows of the full h, J into the solved ones.
     fn gather_rows(&mut self) {
         let n = self.n;

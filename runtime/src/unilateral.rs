@@ -1,15 +1,16 @@
 //! One-sided contact: the follower may leave the cam and land on it again.
 //!
 //! The paper's contact is bilateral: the cam may pull as well as push. A real follower held
-//! on the cam by gravity or a spring is one-sided. [`simulate_unilateral`] integrates in
-//! phases:
+//! on the cam by gravity or a spring is one-sided. [`crate::Simulate::simulate_unilateral`]
+//! integrates in phases:
 //!
 //! - **in contact** the constrained equations (13)–(18) run as usual and the normal force N
-//!   is watched; where it reaches zero from above (located to 1e-9 s on the dense output) the
-//!   follower **lifts off**;
+//!   is watched, inside every step too (`scan`); where it reaches zero from above
+//!   (located to 1e-9 s on the dense output) the follower **lifts off**;
 //! - **in flight** the same chain runs without the constraint (the model seen through
-//!   [`Detached`]) and the gap h(q) (3), positive above the cam, is watched; where it
-//!   reaches zero the follower **lands**;
+//!   [`Detached`]) and the gap h(q) (3), positive above the cam, is checked along every step
+//!   in pieces short enough for the cam's turn; where it first reaches zero the follower
+//!   **lands** (located until |h| is below max(atol, 1e-12)·L, L the model's length scale);
 //! - at landing the **impact law** applies: a frictionless impulse along the contact normal
 //!   (Jᵀ Λ, on the free coordinates only: driven joints keep their prescribed velocity) such
 //!   that the normal velocity reverses with Newton's coefficient of restitution e:
@@ -21,15 +22,15 @@
 //!
 //! Outputs stay on the run's grid; in flight the samples report N = 0 and the gap as h.
 
+use crate::SimSettings;
 use crate::dynamics::VelocityTerms;
 use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, Energy, ModelInfo};
 use crate::error::SimError;
 use crate::events::{ContactEvent, EventKind};
-use crate::simulate::{
-    Emit, Grid, Observed, Phase, SampleLevel, SimFailure, Simulate, State, Stats, Stop, Trajectory,
-    Watch, add_phase_counters, phase_counters, validate_run,
-};
-use crate::{Sample, SimSettings};
+use crate::phase::{GapReading, Grid, Phase, Recorder, Stop, Watch, landing_tolerance};
+use crate::sample::{Sample, SampleLevel};
+use crate::simulate::Simulate;
+use crate::stepping::{State, add_phase_counters, phase_counters, validate_run};
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
@@ -235,56 +236,13 @@ fn complete_flight_sample<D: Dynamics + ?Sized>(model: &D, sample: &mut Sample) 
     sample.contacts = contacts;
     sample.normal_force = vec![0.0; nc];
     sample.lambda = vec![0.0; nc];
+    sample.in_contact = vec![false; nc];
 }
 
 /// What the follower is doing.
 enum Mode<'a, D: ?Sized> {
     Contact(State),
     Flight(State, &'a Detached<'a, D>),
-}
-
-/// Simulates `state` of `model` (one cam contact) to `settings.t_end` with one-sided contact
-/// and restitution `restitution` (see the module documentation). Needs an adaptive
-/// integrator (events are located on its dense output).
-pub fn simulate_unilateral<D: Dynamics + ?Sized>(
-    model: &D,
-    state: State,
-    settings: &SimSettings,
-    restitution: f64,
-    observe: &mut dyn FnMut(&Sample) -> Observed,
-) -> Result<Trajectory, Box<SimFailure>> {
-    let mut trajectory = Trajectory::default();
-    let mut events = Vec::new();
-    let mut stats = Stats::default();
-    let outcome = validate_unilateral(model, &state, settings, restitution).and_then(|()| {
-        let mut emit = |sample: Sample| {
-            let flow = observe(&sample);
-            let t = sample.t;
-            trajectory.samples.push(sample);
-            match flow {
-                Observed::Continue(()) => Ok(()),
-                Observed::Break(()) => Err(SimError::Interrupted { t }),
-            }
-        };
-        run_phases(
-            model,
-            state,
-            settings,
-            restitution,
-            &mut emit,
-            &mut stats,
-            &mut events,
-        )
-    });
-    trajectory.events = events;
-    trajectory.stats = stats;
-    match outcome {
-        Ok(()) => Ok(trajectory),
-        Err(error) => Err(Box::new(SimFailure {
-            error,
-            partial: trajectory,
-        })),
-    }
 }
 
 fn validate_unilateral<D: Dynamics + ?Sized>(
@@ -324,20 +282,26 @@ fn validate_unilateral<D: Dynamics + ?Sized>(
     Ok(())
 }
 
-fn run_phases<D: Dynamics + ?Sized>(
+/// Runs `state` of `model` (one cam contact) to `settings.t_end` with one-sided contact and
+/// restitution `restitution` (see the module documentation), recording into `record`.
+/// Needs an adaptive integrator (events are located on its dense output).
+pub(crate) fn run_phases<D: Dynamics + ?Sized>(
     model: &D,
     state: State,
     settings: &SimSettings,
     restitution: f64,
-    emit: &mut Emit,
-    stats: &mut Stats,
-    events: &mut Vec<ContactEvent>,
+    record: &mut Recorder,
 ) -> Result<(), SimError> {
+    validate_unilateral(model, &state, settings, restitution)?;
     let detached = Detached::new(model);
+    let tolerance = landing_tolerance(settings, state.length_scale());
+    let n = model.info().n();
+    let gap = |q: &[f64], qd: &[f64]| gap_reading(model, n, q, qd);
+    let complete = |sample: &mut Sample| complete_flight_sample(model, sample);
     let mut grid = Grid::new(state.t, settings);
     let mut mode = Mode::Contact(state);
     loop {
-        if events.len() > MAX_EVENTS {
+        if record.events.len() > MAX_EVENTS {
             return Err(SimError::InvalidSettings {
                 message: format!(
                     "more than {MAX_EVENTS} contact events before t_end: the follower \
@@ -348,21 +312,13 @@ fn run_phases<D: Dynamics + ?Sized>(
         let (stop, flying) = match &mut mode {
             Mode::Contact(state) => {
                 let watch = Watch::Forces { stop: true };
-                let stop = run_phase(
-                    model, state, settings, &watch, &mut grid, emit, stats, events,
-                )?;
+                let stop = run_phase(model, state, settings, &watch, &mut grid, record, None)?;
                 (stop, false)
             }
             Mode::Flight(state, detached) => {
-                let gap = |q: &[f64]| {
-                    let mut h = [0.0];
-                    model.constraint(q, &mut h);
-                    h[0]
-                };
-                let watch = Watch::Gap { gap: &gap };
-                let mut flight_emit = |mut sample: Sample| {
-                    complete_flight_sample(model, &mut sample);
-                    emit(sample)
+                let watch = Watch::Gap {
+                    gap: &gap,
+                    tolerance,
                 };
                 let stop = run_phase(
                     *detached,
@@ -370,9 +326,8 @@ fn run_phases<D: Dynamics + ?Sized>(
                     settings,
                     &watch,
                     &mut grid,
-                    &mut flight_emit,
-                    stats,
-                    events,
+                    record,
+                    Some(&complete),
                 )?;
                 (stop, true)
             }
@@ -389,7 +344,7 @@ fn run_phases<D: Dynamics + ?Sized>(
                 stop.contact,
                 restitution,
             )?;
-            events.push(ContactEvent {
+            record.events.push(ContactEvent {
                 t: stop.t,
                 contact: stop.contact,
                 kind: EventKind::Impact {
@@ -412,7 +367,7 @@ fn run_phases<D: Dynamics + ?Sized>(
                 Mode::Flight(next, &detached)
             }
         } else {
-            events.push(ContactEvent {
+            record.events.push(ContactEvent {
                 t: stop.t,
                 contact: stop.contact,
                 kind: EventKind::LiftOff,
@@ -426,28 +381,57 @@ fn run_phases<D: Dynamics + ?Sized>(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The gap of the (only) contact at (q, q̇): h, ḣ = J q̇, how fast the cam turns relative to
+/// the follower point (the point's speed in the cam frame over its distance from the frame's
+/// origin, at least a micrometre), and a bound on |ḣ| from both.
+fn gap_reading<D: Dynamics + ?Sized>(model: &D, n: usize, q: &[f64], qd: &[f64]) -> GapReading {
+    let mut h = [0.0];
+    model.constraint(q, &mut h);
+    let mut j = vec![0.0; n];
+    model.constraint_jacobian(q, &mut j);
+    let rate = j.iter().zip(qd).map(|(a, b)| a * b).sum();
+    let mut kinematics = ContactKinematics::new(n);
+    model.contact_kinematics_into(q, qd, 0, &mut kinematics);
+    let speed_x: f64 = kinematics.j1.iter().zip(qd).map(|(a, b)| a * b).sum();
+    let speed_y: f64 = kinematics.j2.iter().zip(qd).map(|(a, b)| a * b).sum();
+    let distance = kinematics.x.hypot(kinematics.y).max(1e-6);
+    let point_speed = speed_x.hypot(speed_y);
+    let turn_rate = point_speed / distance;
+    // The cam's material at the contact point moves relative to the follower at most the
+    // follower point's speed plus the turn rate times their distance (a rigid relative
+    // motion, the turn rate standing for its spin).
+    let geometry = &kinematics.geometry;
+    let offset = (0..3)
+        .map(|i| (geometry.position[i] - geometry.follower[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    GapReading {
+        g: h[0],
+        rate,
+        turn_rate,
+        speed: point_speed + turn_rate * offset,
+    }
+}
+
 fn run_phase<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
     settings: &SimSettings,
     watch: &Watch,
     grid: &mut Grid,
-    emit: &mut Emit,
-    stats: &mut Stats,
-    events: &mut Vec<ContactEvent>,
+    record: &mut Recorder,
+    complete: Option<&dyn Fn(&mut Sample)>,
 ) -> Result<Option<Stop>, SimError> {
+    let before = phase_counters(state);
     let mut phase = Phase {
         settings,
         level: SampleLevel::Full,
         watch,
         grid,
-        emit,
-        stats,
-        events,
+        record,
+        complete,
     };
-    let before = phase_counters(state);
     let outcome = phase.run(model, state);
-    add_phase_counters(phase.stats, state, before);
+    add_phase_counters(&mut phase.record.stats, state, before);
     outcome
 }

@@ -375,6 +375,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             follower: rt::FollowerKind::Roller,
             profile: rt::ProfileKind::Parametric,
             cam_coordinate: Some(0),
+            cam_moves: true,
         },
     ]),
     loops: Vec::from([]),

@@ -487,6 +487,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             follower: rt::FollowerKind::Knife,
             profile: rt::ProfileKind::Explicit,
             cam_coordinate: None,
+            cam_moves: false,
         },
     ]),
     loops: Vec::from([]),

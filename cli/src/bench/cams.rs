@@ -499,6 +499,8 @@ mod tests {
                 rejected: 1,
                 rhs_evaluations: 500,
                 repartitions: 0,
+                event_evaluations: 0,
+                gap_evaluations: 0,
             },
             error: 1e-17,
             check: Check::Flat,

@@ -26,7 +26,9 @@ use camchain_codegen::ParameterMode;
 use camchain_codegen::schema::Files;
 use camchain_models as models;
 use camchain_reference::NumericModel;
-use camchain_runtime::{Dynamics, MetricsOptions, ParameterInfo, SimSettings, Simulate};
+use camchain_runtime::{
+    Cancel, Dynamics, MetricsOptions, ParameterInfo, SimError, SimSettings, Simulate,
+};
 use spec::{Design, Runs, Shard};
 use std::collections::BTreeMap;
 use std::fs;
@@ -34,7 +36,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use table::{Preamble, Row};
 
 /// Above this many runs no figure is drawn (their data would not stay small); the CSV has
@@ -417,8 +419,9 @@ pub fn preamble(plan: &Plan) -> Preamble {
     }
 }
 
-/// One run: the model with the run's values, assembly, a metrics run.
-pub fn run_one(plan: &Plan, run: usize) -> Row {
+/// One run: the model with the run's values, assembly, a metrics run that stops within one
+/// step once `cancel` is set. `None` when it was cancelled (the row is not the run's).
+pub fn run_one(plan: &Plan, run: usize, cancel: &AtomicBool) -> Option<Row> {
     let start = Instant::now();
     let values = plan.runs.values(run);
     let names: Vec<&str> = plan.runs.swept.iter().map(|s| s.name.as_str()).collect();
@@ -427,19 +430,27 @@ pub fn run_one(plan: &Plan, run: usize) -> Row {
         Err(e) => (None, Some(e)),
         Ok(model) => match model.assemble(0.0) {
             Err(e) => (None, Some(format!("assembly: {e}"))),
-            Ok(state) => match model.simulate_metrics(state, &plan.settings, plan.options) {
-                Ok(m) => (Some(m), None),
-                Err(failure) => (Some(failure.partial), Some(failure.error.to_string())),
-            },
+            Ok(state) => {
+                let mut monitor = Cancel(cancel);
+                let settings = &plan.settings;
+                match model.simulate_metrics_monitored(state, settings, plan.options, &mut monitor)
+                {
+                    Ok(m) => (Some(m), None),
+                    Err(failure) if matches!(failure.error, SimError::Interrupted { .. }) => {
+                        return None;
+                    }
+                    Err(failure) => (Some(failure.partial), Some(failure.error.to_string())),
+                }
+            }
         },
     };
-    Row {
+    Some(Row {
         run,
         values,
         metrics,
         error,
         wall_time: start.elapsed().as_secs_f64(),
-    }
+    })
 }
 
 /// Where the rows go while the sweep runs: a regular (or new) file through
@@ -640,7 +651,11 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
                     let Some(&run) = runs.get(k) else {
                         break;
                     };
-                    if tx.send((k, run_one(plan, run))).is_err() {
+                    // A run cancelled in flight sends nothing: its row is not written.
+                    let Some(row) = run_one(plan, run, stop) else {
+                        break;
+                    };
+                    if tx.send((k, row)).is_err() {
                         break;
                     }
                 }
@@ -650,7 +665,19 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
         // Rows in run order: a finished row waits until every earlier one is written.
         let mut waiting: BTreeMap<usize, Row> = BTreeMap::new();
         let mut flushed = Instant::now();
-        for (k, row) in rx.iter() {
+        loop {
+            // Waits for rows a tenth of a second at a time, so that an interrupt is passed on
+            // to the runs in flight at once, not when the next row arrives.
+            let (k, row) = match rx.recv_timeout(Duration::from_millis(100)) {
+                Ok(received) => received,
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if interrupt.requested() {
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                    continue;
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            };
             waiting.insert(k, row);
             while let Some(row) = waiting.remove(&written) {
                 if write_error.is_none() {
@@ -691,14 +718,15 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
     if written < total {
         let kept = sink.abandon();
         eprintln!(
-            "{} sweep: interrupted after {written} of {total} runs{}",
+            "{} sweep: stopped by {} after {written} of {total} runs{}",
             plan.label,
+            interrupt.signal_name(),
             kept.map_or(String::new(), |p| format!(
                 "; the rows so far are in {}",
                 p.display()
             ))
         );
-        return Err(CliError::Interrupted);
+        return Err(interrupt.error());
     }
     let saved = sink.finish().map_err(CliError::Failed)?;
     let drawn = match (&plan.figures, plot.complete) {

@@ -262,6 +262,8 @@ mod tests {
                 rejected: 14,
                 rhs_evaluations: 1201,
                 repartitions: 0,
+                event_evaluations: 0,
+                gap_evaluations: 0,
             },
         }
     }

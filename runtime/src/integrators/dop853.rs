@@ -157,6 +157,17 @@ const B: [(usize, f64); 8] = [
     (11, 4.47106157277725905176885569043e-2),
 ];
 
+/// The eighth-order weights over k1…k13 (k13, the derivative at the new point, has none).
+const QUADRATURE: [f64; 13] = {
+    let mut weights = [0.0; 13];
+    let mut i = 0;
+    while i < B.len() {
+        weights[B[i].0] = B[i].1;
+        i += 1;
+    }
+    weights
+};
+
 /// Third-order embedded weights (subtracted from the eighth-order increment).
 const BHH: [(usize, f64); 3] = [
     (0, 0.244094488188976377952755905512e+00),
@@ -356,6 +367,9 @@ impl Dop853 {
 }
 
 impl Adaptive for Dop853 {
+    const EVALUATIONS_PER_ATTEMPT: usize = 12;
+    const QUADRATURE: &'static [f64] = &QUADRATURE;
+
     /// One accepted step from `(t, y)` trying `h_try` first (see [`super::Dopri5::step`]
     /// for the handling of rejections and failing right-hand sides).
     fn step<F>(
@@ -483,6 +497,24 @@ mod tests {
         rtol: 1e10,
         atol: 1e10,
     };
+
+    #[test]
+    fn the_stage_quadrature_has_order_eight() {
+        // Σ bᵢ cᵢᵏ = 1/(k + 1) for k ≤ 7, at the nodes of the start, stages 2–12 and the new
+        // point: the order conditions of the quadrature alone.
+        assert_eq!(QUADRATURE.len(), 1 + Dop853::EVALUATIONS_PER_ATTEMPT);
+        for k in 0..=7 {
+            let sum: f64 = QUADRATURE
+                .iter()
+                .zip(&C[..13])
+                .map(|(b, c)| b * c.powi(k))
+                .sum();
+            assert!(
+                (sum - 1.0 / f64::from(k + 1)).abs() < 1e-14,
+                "degree {k}: {sum}"
+            );
+        }
+    }
 
     #[test]
     fn tableau_is_consistent() {

@@ -10,6 +10,7 @@
 //! (quadratures such as dissipated energy) are integrated with the same stages but excluded
 //! from the error norm.
 
+use crate::dynamics::IntegratorKind;
 use crate::error::SimError;
 
 mod dop853;
@@ -147,6 +148,16 @@ const MAX_FAILED_ATTEMPTS: usize = 8;
 /// Step floor relative to max(|t|, 1): below 16 ε the sum t + h keeps fewer than ~48 of h's
 /// 53 bits, and the step no longer advances time meaningfully.
 const STEP_FLOOR: f64 = 16.0 * f64::EPSILON;
+
+/// The stage evaluations per attempt and the quadrature weights of the adaptive method
+/// `kind` (see [`Adaptive::QUADRATURE`]); none for RK4.
+pub fn stage_quadrature(kind: IntegratorKind) -> (usize, &'static [f64]) {
+    match kind {
+        IntegratorKind::Rk4 => (0, &[]),
+        IntegratorKind::Dopri5 => (Dopri5::EVALUATIONS_PER_ATTEMPT, Dopri5::QUADRATURE),
+        IntegratorKind::Dop853 => (Dop853::EVALUATIONS_PER_ATTEMPT, Dop853::QUADRATURE),
+    }
+}
 
 /// Outcome of one accepted adaptive step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -301,6 +312,17 @@ impl Dopri5 {
 /// What the simulator needs of an adaptive integrator with dense output (implemented by
 /// [`Dopri5`] and [`Dop853`]).
 pub trait Adaptive {
+    /// Right-hand sides one attempt of a step evaluates (its stages after the first, and the
+    /// derivative at the new point): the last this many evaluations of an accepted step are
+    /// its own, in order.
+    const EVALUATIONS_PER_ATTEMPT: usize;
+
+    /// The weights bᵢ of the step's quadrature over (the derivative at the step's start,
+    /// then the attempt's evaluations in order): for an extra component ż = g(t, y),
+    /// h Σ bᵢ gᵢ is the step's increment of z, so Σ bᵢ gᵢ is the mean of g over the step to
+    /// the method's order.
+    const QUADRATURE: &'static [f64];
+
     /// One accepted step from `(t, y)` trying `h_try` first; `y` is overwritten with the
     /// new state only on success.
     fn step<F>(
@@ -331,6 +353,10 @@ pub trait Adaptive {
 }
 
 impl Adaptive for Dopri5 {
+    const EVALUATIONS_PER_ATTEMPT: usize = 6;
+    // Stages 1 (the start), 2–6, 7 (the new point; not in the fifth-order solution).
+    const QUADRATURE: &'static [f64] = &[B1, 0.0, B3, B4, B5, B6, 0.0];
+
     /// One accepted step from `(t, y)` trying `h_try` first; rejected attempts are retried
     /// with smaller steps. `y` is overwritten with the new state only on success.
     ///
@@ -603,6 +629,25 @@ mod tests {
     // ≤ 256 steps (~1e-15). ±0.25 around the theoretical order is then safe, yet it still
     // tells neighbouring orders apart.
     const ORDER_BAND: f64 = 0.25;
+
+    #[test]
+    fn the_stage_quadrature_of_dopri5_has_its_order() {
+        // Σ bᵢ cᵢᵏ = 1/(k + 1) for k ≤ 4: the quadrature of ż = g(t) is exact for
+        // polynomials of degree 4 (order 5), at the nodes of the start and the evaluations.
+        let nodes = [0.0, C2, C3, C4, C5, 1.0, 1.0];
+        assert_eq!(nodes.len(), 1 + Dopri5::EVALUATIONS_PER_ATTEMPT);
+        for k in 0..=4 {
+            let sum: f64 = Dopri5::QUADRATURE
+                .iter()
+                .zip(nodes)
+                .map(|(b, c)| b * c.powi(k))
+                .sum();
+            assert!(
+                (sum - 1.0 / f64::from(k + 1)).abs() < 1e-15,
+                "degree {k}: {sum}"
+            );
+        }
+    }
 
     #[test]
     fn rk4_has_order_four() {
