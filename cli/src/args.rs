@@ -47,8 +47,12 @@ pub enum Command {
                       paper_convex), DIR/paper_concave_vs_convex.png/.svg side by side. A run \
                       on the numeric path is named <model>_numeric. With --csv FILE only that \
                       file is written, unless --out is given too.\n\n\
+                      Ctrl-C or SIGTERM stops a run within one step and keeps its rows in \
+                      <name>.partial.csv; a run that stalls (steps collapsed at a singular \
+                      point, or too short to finish) stops with its diagnosis.\n\n\
                       Exit codes: 0 success, 1 a model file or a run failed or a file could not \
-                      be written, 2 a usage error (bad option or value, unknown model name).",
+                      be written, 2 a usage error (bad option or value, unknown model name), 130 \
+                      interrupted by Ctrl-C, 143 stopped by SIGTERM.",
         after_help = "Examples:\n  \
                       camchain simulate                         # both paper cams, files in out/\n  \
                       camchain simulate paper_convex --coords q4,q3 --t-end 4\n  \
@@ -105,7 +109,8 @@ pub enum Command {
                       (for a batch array on a cluster); `camchain merge` joins the shards.\n\n\
                       Exit codes: 0 every run completed; 3 + (failed runs - 1), at most 127, \
                       when runs failed; 1 a file could not be written; 2 a usage error; 130 \
-                      interrupted by Ctrl-C (the rows so far stay in <name>.partial.csv).",
+                      interrupted by Ctrl-C, 143 stopped by SIGTERM (the runs in flight are \
+                      cancelled at once; the rows so far stay in <name>.partial.csv).",
         after_help = "Examples:\n  \
                       camchain sweep paper_concave --param swing=-0.5:0.5:21 --param k3=20,40,80\n  \
                       camchain sweep driven_convex --param period=1:8:50 --metric first_lift_off\n  \
@@ -246,6 +251,10 @@ pub enum BenchWhat {
     /// Closed loops alone: the loop models' right-hand sides, Andrews' squeezer's work
     /// against precision, the IFToMM benchmarks A02 and A04 (also part of `evaluations`).
     Loops,
+    /// What finding events inside steps costs: right-hand sides per step of every built-in
+    /// model with a contact, watched and not; one-sided runs near the jump speed and at high
+    /// cam speeds.
+    Events,
     /// Whole-run overhead, sweep throughput with 1 and 2 workers, sweep memory.
     Sweep,
     /// Draw the scaling figure from the scaling example's CSV (--scaling-csv).

@@ -5,8 +5,9 @@
 //! coordinates, m), `C_cam_x`, `C_cam_y` (the same point in the cam's frame, which turns with
 //! the cam's body, m), `C_cam_angle` (only when the cam's body turns on a revolute joint of
 //! its own: that joint's angle, rad), `C_normal_force` (N, positive when the cam pushes on
-//! the follower), `C_pressure_angle` (rad, between the contact normal and the direction in
-//! which the follower's own joint moves the follower point), `C_sliding_speed` (m/s, the
+//! the follower), `C_pressure_angle` (only when the cam moves, as it must to drive the
+//! follower: rad, between the contact normal and the direction in which the follower's own
+//! joint moves the follower point), `C_sliding_speed` (m/s, the
 //! follower's tangential speed over the cam at the contact point), `C_h` (the constraint
 //! residual, m; in flight the gap); for each equation E of each loop L, `L_E_h` (its
 //! residual: m for the gap's components `x`, `y`, `z` and `normal`, dimensionless for `turn`
@@ -40,10 +41,11 @@ pub fn header(info: &ModelInfo) -> Vec<String> {
         if info.contacts[k].cam_coordinate.is_some() {
             columns.push(format!("{contact}_cam_angle"));
         }
-        columns.extend(
-            ["normal_force", "pressure_angle", "sliding_speed", "h"]
-                .map(|a| format!("{contact}_{a}")),
-        );
+        columns.push(format!("{contact}_normal_force"));
+        if info.contacts[k].cam_moves {
+            columns.push(format!("{contact}_pressure_angle"));
+        }
+        columns.extend(["sliding_speed", "h"].map(|a| format!("{contact}_{a}")));
     }
     for (_, l) in info.loop_rows() {
         for e in &l.equations {
@@ -73,12 +75,11 @@ pub fn row(info: &ModelInfo, sample: &Sample) -> Vec<f64> {
         if let Some(i) = about.cam_coordinate {
             values.push(sample.q[i]);
         }
-        values.extend([
-            sample.normal_force[k],
-            contact.pressure_angle(),
-            contact.sliding_speed,
-            sample.h[k],
-        ]);
+        values.push(sample.normal_force[k]);
+        if about.cam_moves {
+            values.push(contact.pressure_angle());
+        }
+        values.extend([contact.sliding_speed, sample.h[k]]);
     }
     // Each loop equation's residual and its reaction −λ (docs/model-format.md, "Loops").
     for k in info.n_contacts()..info.n_constraints() {

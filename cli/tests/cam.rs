@@ -256,6 +256,8 @@ fn the_predicted_jump_speed_is_where_bisection_finds_it() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+// The closed form of the jump speed; its run-time helpers serve the models' tests only.
+#[allow(dead_code)]
 #[path = "../../models/tests/support/cycloidal.rs"]
 mod cycloidal;
 

@@ -11,10 +11,10 @@ use common::{camchain, scratch};
 use std::path::Path;
 
 const PAPER_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_cam_x,A_cam_y,\
-                            A_normal_force,A_pressure_angle,A_sliding_speed,A_h,energy,\
+                            A_normal_force,A_sliding_speed,A_h,energy,\
                             dissipated,driven_work";
 const DRIVEN_HEADER: &str = "t,q1,q2,q3,q4,q1_dot,q2_dot,q3_dot,q4_dot,A_x,A_y,A_cam_x,A_cam_y,\
-                             A_normal_force,A_pressure_angle,A_sliding_speed,A_h,q1_drive,\
+                             A_normal_force,A_sliding_speed,A_h,q1_drive,\
                              energy,dissipated,driven_work";
 
 fn text(bytes: &[u8]) -> String {

@@ -6,11 +6,13 @@
 //! signal handler or another thread stops a run through [`Cancel`], which the stepping loop
 //! reads after every step: a run answers within one step, not at its next output time.
 //!
-//! A run stalls when its steps become so short that it cannot reach its next output time
-//! within the step budget of an output interval ([`MAX_STEPS_PER_CALL`]). The watchdog
-//! measures the pace of every [`STALL_WINDOW`] accepted steps and stops the run as soon as
-//! that pace projects past the budget ([`SimError::Stalled`], naming the time, the step, the
-//! tolerances and the likely cause), rather than after the ten million steps themselves.
+//! A run stalls when its steps become so short that it cannot reach its end within
+//! [`STALL_STEPS`] more steps, or its next output time within the step budget of an output
+//! interval ([`MAX_STEPS_PER_CALL`]). The watchdog measures the pace of every
+//! [`STALL_WINDOW`] accepted steps and stops the run as soon as that pace projects past
+//! either ([`SimError::Stalled`], naming the time, the step, the tolerances and the likely
+//! cause), rather than after the steps themselves: a run at steps of 1e-10 s is stopped
+//! within a few hundred steps of reaching them, not hours later.
 
 use crate::error::SimError;
 use crate::sample::Sample;
@@ -90,7 +92,17 @@ impl Monitor for Cancel<'_> {
 }
 
 /// Accepted steps over which the stall watchdog measures a run's pace.
-pub const STALL_WINDOW: usize = 1000;
+pub const STALL_WINDOW: usize = 500;
+
+/// A run whose pace projects more further steps than this to its end is stalled: at the
+/// fastest right-hand sides (a microsecond) that is a quarter of an hour of steps, at a
+/// typical model's hours, for a run whose steps have collapsed or that a stiff mode holds
+/// far below its time scale.
+pub const STALL_STEPS: f64 = 1e8;
+
+/// A window whose pace is below this fraction of the run's fastest window has collapsed
+/// (the likely cause then is a singular point ahead, not a stiff mode).
+const COLLAPSE: f64 = 1e-2;
 
 /// Stops a run whose pace cannot reach its next output time within the step budget of an
 /// output interval ([`MAX_STEPS_PER_CALL`]).
@@ -101,8 +113,9 @@ pub(crate) struct Watchdog {
     /// Steps and time at the start of the current window.
     window_steps: usize,
     window_t: f64,
-    /// Mean step of the previous window (s), to tell a collapse from a steady crawl.
-    previous_pace: Option<f64>,
+    /// Mean step of the run's fastest window so far (s), to tell a collapse from a steady
+    /// crawl.
+    fastest_pace: f64,
     /// Where the run is, for the diagnosis.
     rtol: f64,
     atol: f64,
@@ -115,7 +128,7 @@ impl Watchdog {
             since_output: 0,
             window_steps: 0,
             window_t: t,
-            previous_pace: None,
+            fastest_pace: 0.0,
             rtol,
             atol,
         }
@@ -127,12 +140,12 @@ impl Watchdog {
     }
 
     /// After an accepted step that ended at `t` with size `h`, on the way to `next` (the next
-    /// output time, or the end of a `step` call).
+    /// output time, or the end of a `step` call) and to `end` (the run's end).
     ///
     /// # Errors
     /// [`SimError::TooManySteps`] when the budget is spent, [`SimError::Stalled`] when the
-    /// pace of the last [`STALL_WINDOW`] steps projects past it.
-    pub(crate) fn step(&mut self, t: f64, h: f64, next: f64) -> Result<(), SimError> {
+    /// pace of the last [`STALL_WINDOW`] steps projects past it or past [`STALL_STEPS`].
+    pub(crate) fn step(&mut self, t: f64, h: f64, (next, end): (f64, f64)) -> Result<(), SimError> {
         self.since_output += 1;
         self.window_steps += 1;
         if self.since_output >= MAX_STEPS_PER_CALL {
@@ -143,28 +156,38 @@ impl Watchdog {
         }
         let advanced = t - self.window_t;
         let pace = advanced / self.window_steps as f64;
-        let remaining = (next - t).max(0.0);
-        let budget = (MAX_STEPS_PER_CALL - self.since_output) as f64;
-        let needed = if pace > 0.0 {
-            remaining / pace
-        } else {
-            f64::INFINITY
+        let projected = |target: f64| {
+            let remaining = (target - t).max(0.0);
+            if remaining == 0.0 {
+                0.0
+            } else if pace > 0.0 {
+                remaining / pace
+            } else {
+                f64::INFINITY
+            }
         };
-        let shrinking = self.previous_pace.is_some_and(|p| pace < 0.5 * p);
-        self.previous_pace = Some(pace);
+        let budget = (MAX_STEPS_PER_CALL - self.since_output) as f64;
+        let (to_next, to_end) = (projected(next), projected(end));
+        let collapsed = pace < COLLAPSE * self.fastest_pace;
+        self.fastest_pace = self.fastest_pace.max(pace);
         self.window_steps = 0;
         self.window_t = t;
-        if needed > budget {
+        if to_next > budget || to_end > STALL_STEPS {
+            let (target, needed) = if to_next > budget {
+                (next, to_next)
+            } else {
+                (end, to_end)
+            };
             return Err(SimError::Stalled {
                 t,
                 h,
                 advanced,
                 steps: STALL_WINDOW,
-                next,
+                target,
                 needed,
                 rtol: self.rtol,
                 atol: self.atol,
-                shrinking,
+                collapsed,
             });
         }
         Ok(())
@@ -180,31 +203,58 @@ mod tests {
         // Steps of 1e-4 s towards an output 1 s away: 1e4 steps, far within the budget.
         let mut steady = Watchdog::new(0.0, 1e-8, 1e-10);
         let mut t = 0.0;
-        for _ in 0..5 * STALL_WINDOW {
+        for _ in 0..10 * STALL_WINDOW {
             t += 1e-4;
-            steady.step(t, 1e-4, 1.0).unwrap();
+            steady.step(t, 1e-4, (1.0, 1.0)).unwrap();
         }
-        // Steps shrinking by 0.1 % each (a run approaching a singular point) towards an
-        // output 1 s away: 1e-6 s steps need 1e6 steps (within the budget of 1e7); three
-        // windows later the pace (about 8.5e-8 s) projects 1.2e7 and the run is stopped,
-        // called shrinking (each window's pace is 0.37 of the one before).
+        // Steps of 1e-3 s, then shrinking by 1 % each (a run approaching a singular point),
+        // towards an end 100 s away (no output before it): stopped once 500 steps average
+        // below 1e-6 s (1e8 steps to the end), and called a collapse (its pace is below
+        // 1e-2 of the first windows.).
         let mut collapsing = Watchdog::new(0.0, 1e-10, 1e-12);
-        let (mut t, mut h) = (0.0, 1e-6);
+        let (mut t, mut h) = (0.0, 1e-3);
+        let mut steps = 0;
         let error = loop {
             t += h;
-            if let Err(e) = collapsing.step(t, h, 1.0) {
+            steps += 1;
+            if let Err(e) = collapsing.step(t, h, (100.0, 100.0)) {
                 break e;
             }
-            h *= 0.999;
+            if steps > 2 * STALL_WINDOW {
+                h *= 0.99;
+            }
         };
         let SimError::Stalled {
-            needed, shrinking, ..
+            needed, collapsed, ..
         } = error
         else {
             panic!("{error}");
         };
-        assert!(needed > MAX_STEPS_PER_CALL as f64 && shrinking, "{error}");
-        assert!(t < 1e-3, "stopped after {t} s");
+        assert!(
+            needed > MAX_STEPS_PER_CALL as f64 / 2.0 && collapsed,
+            "{error}"
+        );
+        assert!(steps < 6 * STALL_WINDOW, "stopped after {steps} steps");
+        // Steady steps of 1e-7 s from the start (a stiff mode) towards an end 20 s away:
+        // stopped after the first window, not called a collapse.
+        let mut stiff = Watchdog::new(0.0, 1e-10, 1e-12);
+        let mut t = 0.0;
+        let error = loop {
+            t += 1e-7;
+            if let Err(e) = stiff.step(t, 1e-7, (1.0, 20.0)) {
+                break e;
+            }
+        };
+        assert!(
+            matches!(
+                error,
+                SimError::Stalled {
+                    collapsed: false,
+                    ..
+                }
+            ),
+            "{error}"
+        );
     }
 
     #[test]
@@ -215,7 +265,7 @@ mod tests {
         for k in 1..=20 {
             while t < k as f64 * 1e-3 - 1e-12 {
                 t += 1e-6;
-                dog.step(t, 1e-6, k as f64 * 1e-3).unwrap();
+                dog.step(t, 1e-6, (k as f64 * 1e-3, 0.02)).unwrap();
             }
             dog.output_reached();
         }

@@ -111,14 +111,14 @@ pub enum SimError {
     },
 
     /// The run stalled: at the pace of its last `steps` accepted steps it could not reach its
-    /// next output time within the step budget of an output interval
-    /// ([`crate::settings::MAX_STEPS_PER_CALL`]); see [`crate::control`].
+    /// end within [`crate::control::STALL_STEPS`] more steps, or its next output time within
+    /// the step budget of an output interval ([`crate::settings::MAX_STEPS_PER_CALL`]); see
+    /// [`crate::control`].
     #[error(
         "at t = {t} s the run has stalled: its last {steps} steps advanced only {advanced:.3e} s \
-         (the last {h:.3e} s), so reaching the next output time {next} s would take {needed:.1e} \
-         more steps, beyond the budget of 1e7 per output interval (rtol {rtol:.0e}, atol \
-         {atol:.0e}). {}",
-        StallCause(*.shrinking)
+         (the last {h:.3e} s), so reaching t = {target} s would take {needed:.1e} more steps \
+         (rtol {rtol:.0e}, atol {atol:.0e}). {}",
+        StallCause(*.collapsed)
     )]
     Stalled {
         /// Time (s).
@@ -129,17 +129,17 @@ pub enum SimError {
         advanced: f64,
         /// Number of steps measured.
         steps: usize,
-        /// The next output time, or the end of the `step` call (s).
-        next: f64,
+        /// What the pace was projected to: the next output time or the run's end (s).
+        target: f64,
         /// Steps the pace projects to reach it.
         needed: f64,
         /// Relative tolerance of the run.
         rtol: f64,
         /// Absolute tolerance of the run.
         atol: f64,
-        /// True when the steps were still shrinking (a singular point ahead), false when
-        /// they stayed short (a stiff mode).
-        shrinking: bool,
+        /// True when the steps collapsed to a hundredth of the run's earlier ones (a
+        /// singular point ahead), false when they were short all along (a stiff mode).
+        collapsed: bool,
     },
 
     /// The step budget of one call was exhausted.
@@ -230,15 +230,16 @@ impl fmt::Display for StallCause {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if self.0 {
             f.write_str(
-                "The steps were still shrinking: the motion approaches a point where the \
-                 equations are singular (a dead point or a singular position of a loop, where \
-                 the constraint Jacobian loses rank; a body whose mass or inertia vanishes; a \
-                 velocity that grows without bound). Check the model there, or loosen rtol \
-                 if the point is passed at the model's default tolerances.",
+                "The steps collapsed to a hundredth of the run's earlier ones: the motion \
+                 approaches a point where the equations are singular (a dead point or a \
+                 singular position of a loop, where the constraint Jacobian loses rank; a \
+                 body whose mass or inertia vanishes; a velocity that grows without bound). \
+                 Check the model there, or loosen rtol if the point is passed at the model's \
+                 default tolerances.",
             )
         } else {
             f.write_str(
-                "The steps stayed short: a stiff mode (a very light body, a very stiff spring \
+                "The steps were short all along: a stiff mode (a very light body, a very stiff spring \
                  or damper) holds the explicit integrator at its stability limit, or the \
                  tolerances are tighter than the equations can be evaluated to. Soften the \
                  mode or loosen rtol and atol.",

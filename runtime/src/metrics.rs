@@ -296,7 +296,7 @@ struct Pace<'m> {
 
 impl Pace<'_> {
     fn stepped(&mut self, t: f64, h: f64) -> Result<(), SimError> {
-        self.watchdog.step(t, h, self.t_end)?;
+        self.watchdog.step(t, h, (self.t_end, self.t_end))?;
         self.steps += 1;
         let progress = Progress {
             t,

@@ -58,6 +58,8 @@ pub(crate) struct Recorder<'m> {
     monitor: &'m mut dyn Monitor,
     watchdog: Watchdog,
     steps: usize,
+    /// The run's end time.
+    end: f64,
 }
 
 impl<'m> Recorder<'m> {
@@ -70,6 +72,7 @@ impl<'m> Recorder<'m> {
             monitor,
             watchdog: Watchdog::new(t0, settings.rtol, settings.atol),
             steps: 0,
+            end: settings.t_end,
         }
     }
 
@@ -89,13 +92,14 @@ impl<'m> Recorder<'m> {
         }
     }
 
-    /// After an accepted step that ended at `t` with size `h`, on the way to `next`.
+    /// After an accepted step that ended at `t` with size `h`, on the way to `next` (the next
+    /// output time) and to the run's end.
     ///
     /// # Errors
     /// [`SimError::Stalled`] or [`SimError::TooManySteps`] from the watchdog,
     /// [`SimError::Interrupted`] when the monitor asks to stop.
     pub(crate) fn stepped(&mut self, t: f64, h: f64, next: f64) -> Result<(), SimError> {
-        self.watchdog.step(t, h, next)?;
+        self.watchdog.step(t, h, (next, self.end))?;
         self.steps += 1;
         let progress = Progress {
             t,

@@ -93,7 +93,7 @@ pub trait Simulate: Dynamics {
         let mut stats = Stats::default();
         let target = state.t + dt;
         let mut watchdog = crate::control::Watchdog::new(state.t, settings.rtol, settings.atol);
-        let mut after_step = |t: f64, h: f64| watchdog.step(t, h, target);
+        let mut after_step = |t: f64, h: f64| watchdog.step(t, h, (target, target));
         advance(self, state, target, settings, &mut stats, &mut after_step)?;
         Ok(stats)
     }

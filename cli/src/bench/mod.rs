@@ -11,6 +11,9 @@
 //!   points against the same cam given by its motion law, and revolutions of the designed cams;
 //!   then (section `loops`) the reduced right-hand side of loop models, Andrews' squeezer's
 //!   work against precision, and the IFToMM benchmarks A02 and A04;
+//! - `events`: what finding events inside steps costs on the built-in models (right-hand
+//!   sides per step watched and not), and the one-sided runs where the scans find every
+//!   lift-off and impact;
 //! - `sweep`: the whole-run overhead of a metrics run, the throughput of `camchain sweep` with
 //!   1 and 2 workers, and its memory against the number of runs;
 //! - `scaling-figure`: the figure of the scaling study from the CSV of
@@ -22,6 +25,7 @@
 mod cams;
 mod designs;
 mod evaluations;
+mod events;
 mod loops;
 mod markdown;
 mod scaling;
@@ -71,6 +75,11 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         scaling::run(csv, &args.figures)?;
         println!("wrote {}/scaling.png and .svg", args.figures.display());
         return Ok(());
+    }
+    if matches!(args.what, BenchWhat::Events | BenchWhat::All) {
+        let section = events::run(args.quick)?;
+        markdown::replace_section(report, "events", &section)?;
+        println!("updated {} (section events)", report.display());
     }
     if matches!(args.what, BenchWhat::Sweep | BenchWhat::All) {
         let section = sweep::run(args.quick)?;
