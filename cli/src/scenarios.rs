@@ -2,7 +2,7 @@
 //! measurements made on their runs.
 //!
 //! Used by `camchain stress` (which writes `STRESS.md` and its figures) and by the fast
-//! checks in `cli/tests/stress.rs`. A variant is the validated [`Model`] of a file in `models/`
+//! checks in `cli/tests/suite/stress.rs`. A variant is the validated [`Model`] of a file in `models/`
 //! changed in memory — dampers removed, springs stiffened, masses
 //! scaled, another profile — and run on the numeric recursive reference
 //! ([`NumericModel`]), so no rebuild is needed. The unmodified built-in models run their

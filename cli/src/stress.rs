@@ -900,7 +900,7 @@ fn render(ctx: &Context, sections: &[Section]) -> String {
          at the output times; *energy drift*: the largest change of energy + dissipated − \
          driven work; *max |q − q_ref|*: the largest coordinate difference from the \
          reference run named in the section, at the output times. Fast checks of the same \
-         properties run in `cargo test` (`cli/tests/stress.rs`, `cli/tests/repartition.rs`).\n\n",
+         properties run in `cargo test` (`cli/tests/suite/stress.rs`, `cli/tests/suite/repartition.rs`).\n\n",
     );
     if ctx.quick {
         text.push_str("**This is a `--quick` run: long runs last 100 s, not 1000 s.**\n\n");

@@ -713,6 +713,95 @@ mod tests {
         assert!(lift_off(&samples[2..], 0).unwrap().from_start);
     }
 
+    /// A driven eccentric with one-sided contact: `cam_angle` driven, `lift` dependent in
+    /// contact and free in flight.
+    fn one_sided_info(cam_moves: bool) -> ModelInfo {
+        let coordinate = |name: &str, driven| camchain_runtime::CoordinateInfo {
+            name: name.into(),
+            kind: camchain_runtime::CoordinateKind::Revolute,
+            driven,
+        };
+        let mut contact = camchain_runtime::ContactInfo::knife("face");
+        contact.cam_moves = cam_moves;
+        ModelInfo {
+            name: "m".into(),
+            description: String::new(),
+            coordinates: vec![coordinate("cam_angle", true), coordinate("lift", false)],
+            contacts: vec![contact],
+            loops: Vec::new(),
+            spatial: false,
+            initial: camchain_runtime::InitialGuess {
+                q: vec![0.0; 2],
+                qd: vec![0.0; 2],
+                hold: vec![false; 2],
+                given_q: vec![false; 2],
+                given_qd: vec![false; 2],
+            },
+            defaults: SimSettings {
+                t_end: 1.0,
+                dt_out: 0.1,
+                integrator: IntegratorKind::Dop853,
+                dt: 1e-3,
+                rtol: 1e-9,
+                atol: 1e-12,
+            },
+            restitution: None,
+            parameters: Vec::new(),
+        }
+    }
+
+    /// A sample of the one-sided eccentric at t: in contact (lift dependent) or flying.
+    fn phase_sample(t: f64, force: f64, flying: bool) -> Sample {
+        let mut s = sample(t, force);
+        s.q = vec![0.0, 0.0];
+        s.qd = vec![0.0, 0.0];
+        s.dependent = if flying { vec![] } else { vec![1] }.into();
+        s.in_contact = vec![!flying];
+        s
+    }
+
+    #[test]
+    fn a_one_sided_run_is_summarised_honestly() {
+        // Issue 24: take-offs and landings were listed as re-partitions with a blank name,
+        // the pressure angle was taken over flight samples and the cam was said to pull.
+        let info = one_sided_info(true);
+        let samples = [
+            phase_sample(0.0, -0.07, false),
+            phase_sample(0.1, 0.0, true),
+            phase_sample(0.2, 12.0, false),
+            phase_sample(0.3, 0.0, true),
+        ];
+        assert_eq!(render_repartitions(&info, &samples), "");
+        assert!(result_warnings(&info, &samples, true).is_empty());
+        // The same samples of a bilateral run that starts pulling are warned about.
+        assert_eq!(result_warnings(&info, &samples, false).len(), 1);
+        // A real re-partition between two samples in contact is still listed, by name.
+        let mut moved = phase_sample(0.4, 10.0, false);
+        moved.dependent = vec![0].into();
+        let text = render_repartitions(&info, &[phase_sample(0.3, 10.0, false), moved]);
+        assert!(
+            text.contains("lift now independent, cam_angle dependent"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_fixed_cam_has_no_pressure_angle() {
+        let samples = [phase_sample(0.0, 5.0, false), phase_sample(0.1, 6.0, false)];
+        let fixed = contact_lines(&one_sided_info(false), &samples).join("\n");
+        assert!(fixed.contains("no pressure angle is defined"), "{fixed}");
+        let names: Vec<String> = rows(&one_sided_info(false), &samples)
+            .into_iter()
+            .map(|r| r.0)
+            .collect();
+        assert!(
+            !names.iter().any(|n| n.contains("pressure_angle")),
+            "{names:?}"
+        );
+        let moving = contact_lines(&one_sided_info(true), &samples).join("\n");
+        assert!(moving.contains("largest pressure angle"), "{moving}");
+    }
+
     #[test]
     fn numbers_are_compact() {
         assert_eq!(number(0.0), "0");

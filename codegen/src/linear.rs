@@ -14,7 +14,7 @@
 //! shared factors out is greedy and can, on long sums of products (the contact Jacobians of
 //! spatial chains), cost a few operations more than it saves; [`crate::Derivation`] therefore
 //! keeps the rewritten expressions of a term group only where they need fewer operations
-//! (`codegen/tests/linear_pass.rs` checks every model file and the scaling chains).
+//! (`codegen/tests/suite/linear_pass.rs` checks every model file and the scaling chains).
 
 use crate::expr::{Graph, Id, Node};
 use std::collections::BTreeMap;

@@ -40,8 +40,8 @@ pub fn files(name: &str) -> &'static [(&'static str, &'static str)] {
 }
 
 /// Random models of the property tests (`tests/random_models/`, written by
-/// `reference/tests/random_models.rs`), compiled like the built-in ones so that
-/// `tests/random_compiled.rs` checks the emitted Rust itself against the numeric reference.
+/// `reference/tests/suite/random_models.rs`), compiled like the built-in ones so that
+/// `tests/suite/random_compiled.rs` checks the emitted Rust itself against the numeric reference.
 /// Not part of the built-in model list: compiled only with the `random-models` feature,
 /// which this package's tests turn on.
 #[cfg(feature = "random-models")]
@@ -52,7 +52,7 @@ pub mod random_models {
 
 /// The contact kinds the built-in models do not use (`tests/contact_models/`: parametric
 /// profiles, rollers and flat faces on explicit ones, an applied joint torque), compiled like
-/// the built-in ones for `tests/contacts_compiled.rs`. Behind the `random-models` feature.
+/// the built-in ones for `tests/suite/contacts_compiled.rs`. Behind the `random-models` feature.
 #[cfg(feature = "random-models")]
 #[doc(hidden)]
 pub mod contact_models {
@@ -64,7 +64,7 @@ pub mod contact_models {
 
 /// The built-in models compiled with every parameter folded (`ParameterMode::FoldAll`) and
 /// with every parameter read at run time (`ParameterMode::AllAtRunTime`), and the test models
-/// of `tests/parameter_models/`: what `tests/parameters.rs` compares. Compiled only with the
+/// of `tests/parameter_models/`: what `tests/suite/parameters.rs` compares. Compiled only with the
 /// `parameter-modes` feature, which this package's tests turn on.
 #[cfg(feature = "parameter-modes")]
 #[doc(hidden)]

@@ -1,0 +1,7 @@
+//! The integration tests of `camchain-build`, in one test binary: each file of `tests/suite/` is
+//! a module here (it used to be a binary of its own; one binary links the crate and its
+//! dependencies once). `cargo test -p camchain-build --test suite NAME` runs the tests whose path
+//! contains NAME, e.g. a module's name.
+
+mod api;
+mod golden;
