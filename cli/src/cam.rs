@@ -189,7 +189,7 @@ pub fn run(args: &CamArgs) -> Result<(), CliError> {
         table: args.table.as_deref().map(|t| (t, args.points)),
     });
     let written = written.map_err(CliError::Failed)?;
-    say(&format!("  wrote {}\n", list_files(&written)));
+    say(&format!("  wrote {}\n", output::list_files(&written)));
     match one_sided {
         Err(why) if info.n_contacts() == 1 => {
             Err(CliError::Failed(format!("{}: {why}", subject.label)))
@@ -288,8 +288,7 @@ fn write_outputs(o: &Outputs) -> Result<Vec<PathBuf>, String> {
     let csv = o.dir.join("design.csv");
     output::write_file(&csv, |out| {
         report::write_csv(out, o.analysis, &o.nominal.force)
-    })
-    .map_err(|e| format!("cannot write {}: {e}", csv.display()))?;
+    })?;
     written.push(csv);
     if let Some((path, points)) = o.table {
         let what = if o.designed > 1 {
@@ -301,30 +300,8 @@ fn write_outputs(o: &Outputs) -> Result<Vec<PathBuf>, String> {
             format!("{}'s cam (camchain cam {} --table)", o.name, o.name)
         };
         let text = o.design.profile_table(points, &what);
-        output::write_bytes(path, text.as_bytes())
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        output::write_bytes(path, text.as_bytes())?;
         written.push(path.to_path_buf());
     }
     Ok(written)
-}
-
-/// "out/x_cam/: svaj.png, …" (files elsewhere by their whole path).
-fn list_files(paths: &[PathBuf]) -> String {
-    let dir = paths.first().and_then(|p| p.parent());
-    let (inside, outside): (Vec<&PathBuf>, Vec<&PathBuf>) =
-        paths.iter().partition(|p| p.parent() == dir);
-    let names: Vec<String> = inside
-        .iter()
-        .filter_map(|p| p.file_name())
-        .map(|n| n.to_string_lossy().into_owned())
-        .collect();
-    let mut text = format!(
-        "{}/: {}",
-        dir.map(|d| d.display().to_string()).unwrap_or_default(),
-        names.join(", ")
-    );
-    for path in outside {
-        text.push_str(&format!("; {}", path.display()));
-    }
-    text
 }

@@ -26,6 +26,8 @@ pub struct Job {
     pub dir: Option<PathBuf>,
     /// Directory of its figures, if figures are written.
     pub figures: Option<PathBuf>,
+    /// Its destinations' locks, held until the command ends: no other run writes them.
+    pub locks: Vec<output::Lock>,
 }
 
 /// Resolves the models and checks every option, setting and destination.
@@ -59,6 +61,7 @@ pub fn plan(args: &SimulateArgs) -> Result<Vec<Job>, CliError> {
             csv: CsvTarget::Stdout,
             dir: None,
             figures: None,
+            locks: Vec::new(),
         });
     }
     destinations(&mut jobs, args)?;
@@ -177,12 +180,14 @@ fn destinations(jobs: &mut [Job], args: &SimulateArgs) -> Result<(), CliError> {
         let label = &job.model.label;
         let dir = args.out_dir().map(|d| d.join(label));
         if let Some(dir) = &dir {
-            output::create_dir(dir).map_err(CliError::Failed)?;
+            job.locks
+                .push(output::create_dir(dir).map_err(CliError::Failed)?);
         }
         job.csv = match (&args.csv, &dir) {
             (Some(_), _) if args.csv_to_stdout() => CsvTarget::Stdout,
             (Some(path), _) => {
-                output::check_csv_destination(path).map_err(CliError::Failed)?;
+                job.locks
+                    .extend(output::claim(path).map_err(CliError::Failed)?);
                 CsvTarget::File(path.clone())
             }
             (None, Some(dir)) => CsvTarget::File(dir.join(format!("{label}.csv"))),

@@ -246,8 +246,7 @@ impl Figure {
             self.draw(&root, Target::Vector)?;
             root.present()?;
         }
-        crate::output::write_bytes(&svg_path, svg.as_bytes())
-            .map_err(|e| PlotError(format!("cannot write {}: {e}", svg_path.display())))?;
+        crate::output::write_bytes(&svg_path, svg.as_bytes()).map_err(PlotError)?;
         let png_path = dir.join(format!("{stem}.png"));
         let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
         {
@@ -305,7 +304,7 @@ fn write_png(path: &Path, rgb: &[u8], (width, height): (u32, u32)) -> Result<(),
         writer.write_image_data(rgb).map_err(|e| e.to_string())?;
         writer.finish().map_err(|e| e.to_string())?;
     }
-    crate::output::write_bytes(path, &bytes).map_err(|e| e.to_string())
+    crate::output::write_bytes(path, &bytes)
 }
 
 /// Tick labels with as many decimals as the tick spacing needs (about 6 ticks per axis),

@@ -201,9 +201,6 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
             }
         }
     }
-    if let (Some(dir), true) = (&job.dir, ok) {
-        remove_stale_outputs(dir, label, &written);
-    }
     let engine = with_changed_parameters(model.engine.describe(), dynamics);
     console.say(&summary::render(&RunReport {
         label,
@@ -223,7 +220,10 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
         console.warn(label, &warning);
     }
     if !written.is_empty() {
-        console.say(&format!("  wrote {}\n", list_files(&written)));
+        console.say(&format!(
+            "  wrote {}\n",
+            super::output::list_files(&written)
+        ));
     }
     if ok {
         Outcome::Done(trajectory)
@@ -238,7 +238,7 @@ struct Watcher<'a> {
     progress: Progress,
     sink: &'a mut CsvSink,
     info: &'a camchain_runtime::ModelInfo,
-    write_error: Option<std::io::Error>,
+    write_error: Option<String>,
     cancel: Cancel<'a>,
 }
 
@@ -246,7 +246,8 @@ impl Monitor for Watcher<'_> {
     fn sample(&mut self, sample: &Sample) -> Observed {
         self.progress.update(sample.t);
         if let Err(e) = self.sink.row(self.info, sample) {
-            self.write_error = Some(e);
+            let file = self.sink.partial().map(|p| p.display().to_string());
+            self.write_error = Some(format!("cannot write {}: {e}", file.unwrap_or_default()));
             return Observed::Break(());
         }
         self.cancel.step(&StepProgress {
@@ -267,13 +268,16 @@ impl Monitor for Watcher<'_> {
 fn report_failure(
     label: &str,
     (error, signal): (&SimError, &str),
-    write_error: Option<std::io::Error>,
+    write_error: Option<String>,
     trajectory: &Trajectory,
     saved: Result<Saved, String>,
 ) -> Outcome {
     let interrupted = matches!(error, SimError::Interrupted { .. }) && write_error.is_none();
     match (&write_error, interrupted) {
-        (Some(e), _) => eprintln!("error: {label}: the CSV could not be written: {e}"),
+        (Some(e), _) => eprintln!(
+            "error: {label}: {e}; the run stopped at t = {} s",
+            trajectory.samples.last().map_or(0.0, |s| s.t)
+        ),
         (None, true) => eprintln!(
             "{label}: stopped by {signal} at t = {} s",
             error.time().unwrap_or(f64::NAN)
@@ -293,47 +297,6 @@ fn report_failure(
         Outcome::Interrupted
     } else {
         Outcome::Failed
-    }
-}
-
-/// The figures a run writes in its directory, besides its CSV.
-const FIGURE_STEMS: [&str; 3] = ["histories", "snapshots", "contact"];
-
-/// Removes, after a complete run, the outputs of an earlier run of the same name that this
-/// one did not write again (a figure it could not draw this time, a partial CSV of a run
-/// that failed), so that a run directory never mixes two runs. Only those known names are
-/// touched, and only regular files.
-fn remove_stale_outputs(dir: &Path, label: &str, written: &[PathBuf]) {
-    let mut known: Vec<PathBuf> = FIGURE_STEMS
-        .iter()
-        .flat_map(|stem| ["png", "svg"].map(|ext| dir.join(format!("{stem}.{ext}"))))
-        .collect();
-    known.push(dir.join(format!("{label}.partial.csv")));
-    for path in known {
-        let regular = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_file());
-        if regular && !written.contains(&path) {
-            let _ = std::fs::remove_file(&path);
-        }
-    }
-}
-
-/// "out/paper_concave/: paper_concave.csv, histories.png, …"; files in the current
-/// directory by their names alone.
-fn list_files(paths: &[PathBuf]) -> String {
-    let dir = paths.first().and_then(|p| p.parent());
-    if dir.is_some() && paths.iter().all(|p| p.parent() == dir) {
-        let names: Vec<String> = paths
-            .iter()
-            .filter_map(|p| p.file_name())
-            .map(|n| n.to_string_lossy().into_owned())
-            .collect();
-        match dir.map(|d| d.display().to_string()) {
-            Some(dir) if !dir.is_empty() => format!("{dir}/: {}", names.join(", ")),
-            _ => names.join(", "),
-        }
-    } else {
-        let all: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-        all.join(", ")
     }
 }
 
@@ -421,7 +384,10 @@ fn draw_pairs(
         };
         let stem = format!("{prefix}_concave_vs_convex{suffix}");
         match figure.save(dir, &stem) {
-            Ok(paths) => console.say(&format!("side by side: wrote {}\n", list_files(&paths))),
+            Ok(paths) => console.say(&format!(
+                "side by side: wrote {}\n",
+                super::output::list_files(&paths)
+            )),
             Err(e) => {
                 eprintln!("error: {stem}: {e}");
                 ok = false;

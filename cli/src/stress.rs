@@ -88,8 +88,9 @@ pub fn run(args: &StressArgs) -> Result<(), CliError> {
         .figures
         .clone()
         .unwrap_or_else(|| out_dir.join("docs").join("stress"));
-    std::fs::create_dir_all(&figures)
-        .map_err(|e| CliError::Failed(format!("cannot create {}: {e}", figures.display())))?;
+    // Both destinations checked and held before the first of the suite's minutes.
+    let _report_lock = crate::output::claim(&args.out).map_err(CliError::Failed)?;
+    let _figures_lock = crate::output::create_dir(&figures).map_err(CliError::Failed)?;
     let link_dir = figures
         .strip_prefix(&out_dir)
         .map(Path::to_path_buf)
@@ -111,8 +112,7 @@ pub fn run(args: &StressArgs) -> Result<(), CliError> {
         non_finite(&ctx)?,
     ];
     let report = render(&ctx, &sections);
-    crate::output::write_bytes(&args.out, report.as_bytes())
-        .map_err(|e| CliError::Failed(format!("cannot write {}: {e}", args.out.display())))?;
+    crate::output::write_bytes(&args.out, report.as_bytes()).map_err(CliError::Failed)?;
     say(&format!(
         "wrote {} and its figures in {} ({:.0} s)\n",
         args.out.display(),

@@ -18,8 +18,7 @@ pub fn replace_section(path: &Path, name: &str, body: &str) -> Result<(), CliErr
         }
     };
     let new = with_section(&old, name, body);
-    crate::output::write_bytes(path, new.as_bytes())
-        .map_err(|e| CliError::Failed(format!("{}: {e}", path.display())))
+    crate::output::write_bytes(path, new.as_bytes()).map_err(CliError::Failed)
 }
 
 /// `text` with the section `name` replaced by (or extended with) `body`.

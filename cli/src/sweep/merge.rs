@@ -174,18 +174,20 @@ pub fn run(args: &MergeArgs) -> Result<(), CliError> {
         .and_then(|s| s.split(" (").next())
         .unwrap_or("model")
         .to_string();
+    // Held until the merged files are written: no other run writes them meanwhile.
+    let mut locks: Vec<output::Lock> = Vec::new();
     let dir = match (&args.out, &args.csv) {
         (Some(dir), _) => Some(dir.clone()),
         (None, Some(_)) => None,
         (None, None) => Some(PathBuf::from(crate::args::DEFAULT_OUT)),
     };
     if let Some(dir) = &dir {
-        output::create_dir(dir).map_err(CliError::Failed)?;
+        locks.push(output::create_dir(dir).map_err(CliError::Failed)?);
     }
     let csv = match &args.csv {
         Some(p) if p.as_os_str() == "-" => None,
         Some(p) => {
-            output::check_csv_destination(p).map_err(CliError::Failed)?;
+            locks.extend(output::claim(p).map_err(CliError::Failed)?);
             Some(p.clone())
         }
         None => dir.as_ref().map(|d| d.join(format!("{model}_sweep.csv"))),
@@ -255,15 +257,15 @@ pub fn run(args: &MergeArgs) -> Result<(), CliError> {
         }
         Some(path) => {
             let mut result = Ok(());
-            output::write_file(path, |out| {
+            let written = output::write_file(path, |out| {
                 result = write_rows(out, &mut plot, &mut failed);
                 match &result {
                     Ok(()) => Ok(()),
                     Err(e) => Err(std::io::Error::other(e.to_string())),
                 }
-            })
-            .map_err(|e| CliError::Failed(format!("cannot write {}: {e}", path.display())))?;
+            });
             result?;
+            written.map_err(CliError::Failed)?;
             Some(path.clone())
         }
     };

@@ -12,6 +12,7 @@
 pub mod figures;
 mod merge;
 mod progress;
+mod sink;
 pub mod spec;
 pub mod table;
 
@@ -29,10 +30,11 @@ use camchain_reference::NumericModel;
 use camchain_runtime::{
     Cancel, Dynamics, MetricsOptions, ParameterInfo, SimError, SimSettings, Simulate,
 };
+use sink::Sink;
 use spec::{Design, Runs, Shard};
 use std::collections::BTreeMap;
 use std::fs;
-use std::io::{self, BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
@@ -92,6 +94,9 @@ impl Factory {
     }
 }
 
+/// Most workers a sweep starts (`--jobs`): each is a thread holding its own model.
+pub const MAX_JOBS: usize = 1024;
+
 /// Everything a sweep needs, checked.
 pub struct Plan {
     /// The model's name.
@@ -118,6 +123,8 @@ pub struct Plan {
     pub plotted: Vec<String>,
     /// No summary, no progress.
     pub quiet: bool,
+    /// The destinations' locks, held until the sweep ends: no other run writes them.
+    pub _locks: Vec<output::Lock>,
 }
 
 /// `camchain sweep`.
@@ -158,15 +165,22 @@ pub fn plan(args: &SweepArgs) -> Result<Plan, CliError> {
         .map_err(|e| usage(format!("settings: {e}")))?;
     let jobs = match args.jobs {
         Some(0) => return Err(usage("--jobs must be at least 1".to_string())),
+        Some(n) if n > MAX_JOBS => {
+            return Err(usage(format!(
+                "--jobs {n}: at most {MAX_JOBS} workers (each is a thread with its own model)"
+            )));
+        }
         Some(n) => n,
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
+    }
+    // No more workers than runs: an idle worker is only a thread.
+    .min(shard.len(runs.len()).max(1));
     let plotted = plotted_metrics(&args.metric)?;
     let stem = match (shard.count, &args.shard) {
         (1, _) | (_, None) => format!("{label}_sweep"),
         _ => format!("{label}_sweep.shard-{}-of-{}", shard.index, shard.count),
     };
-    let (csv, figures) = destinations(args, &label, &stem)?;
+    let (csv, figures, locks) = destinations(args, &label, &stem)?;
     Ok(Plan {
         model,
         label,
@@ -180,6 +194,7 @@ pub fn plan(args: &SweepArgs) -> Result<Plan, CliError> {
         figures,
         plotted,
         quiet: args.quiet,
+        _locks: locks,
     })
 }
 
@@ -361,12 +376,14 @@ pub(crate) fn plotted_metrics(given: &[String]) -> Result<Vec<String>, CliError>
     Ok(given.to_vec())
 }
 
-/// The CSV's path (`None`: standard output) and the figures' directory, checked writable.
+/// The CSV's path (`None`: standard output) and the figures' directory, checked writable and
+/// locked for this sweep.
 fn destinations(
     args: &SweepArgs,
     label: &str,
     stem: &str,
-) -> Result<(Option<PathBuf>, Option<PathBuf>), CliError> {
+) -> Result<(Option<PathBuf>, Option<PathBuf>, Vec<output::Lock>), CliError> {
+    let mut locks = Vec::new();
     let dir = match (&args.out, &args.csv) {
         (Some(dir), _) => Some(dir.join(format!("{label}_sweep"))),
         (None, Some(_)) => None,
@@ -375,18 +392,18 @@ fn destinations(
         }
     };
     if let Some(dir) = &dir {
-        output::create_dir(dir).map_err(CliError::Failed)?;
+        locks.push(output::create_dir(dir).map_err(CliError::Failed)?);
     }
     let csv = match &args.csv {
         Some(path) if path.as_os_str() == "-" => None,
         Some(path) => {
-            output::check_csv_destination(path).map_err(CliError::Failed)?;
+            locks.extend(output::claim(path).map_err(CliError::Failed)?);
             Some(path.clone())
         }
         None => dir.as_ref().map(|d| d.join(format!("{stem}.csv"))),
     };
     let figures = if args.no_plots { None } else { dir };
-    Ok((csv, figures))
+    Ok((csv, figures, locks))
 }
 
 /// The `#` lines of this sweep.
@@ -451,82 +468,6 @@ pub fn run_one(plan: &Plan, run: usize, cancel: &AtomicBool) -> Option<Row> {
         error,
         wall_time: start.elapsed().as_secs_f64(),
     })
-}
-
-/// Where the rows go while the sweep runs: a regular (or new) file through
-/// `<name>.partial.csv` renamed when complete, or standard output and special files
-/// directly.
-enum Sink {
-    Partial {
-        dest: PathBuf,
-        partial: PathBuf,
-        out: BufWriter<fs::File>,
-    },
-    Direct(Box<dyn Write>),
-}
-
-impl Sink {
-    fn open(csv: &Option<PathBuf>) -> Result<Self, String> {
-        let Some(path) = csv else {
-            return Ok(Sink::Direct(Box::new(BufWriter::new(io::stdout()))));
-        };
-        match output::destination(path) {
-            Ok(output::Destination::Replaceable(dest)) => {
-                let partial = output::partial_path(&dest);
-                let file = fs::File::create(&partial)
-                    .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
-                Ok(Sink::Partial {
-                    dest,
-                    partial,
-                    out: BufWriter::new(file),
-                })
-            }
-            Ok(output::Destination::Special) => {
-                let file = fs::OpenOptions::new()
-                    .write(true)
-                    .open(path)
-                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-                Ok(Sink::Direct(Box::new(BufWriter::new(file))))
-            }
-            Err(e) => Err(format!("cannot write {}: {e}", path.display())),
-        }
-    }
-
-    fn out(&mut self) -> &mut dyn Write {
-        match self {
-            Sink::Partial { out, .. } => out,
-            Sink::Direct(out) => out.as_mut(),
-        }
-    }
-
-    /// Complete: the partial file takes the final name.
-    fn finish(mut self) -> Result<Option<PathBuf>, String> {
-        self.out().flush().map_err(|e| e.to_string())?;
-        match self {
-            Sink::Partial { dest, partial, out } => {
-                let file = out.into_inner().map_err(|e| e.to_string())?;
-                file.sync_all().map_err(|e| e.to_string())?;
-                fs::rename(&partial, &dest).map_err(|e| {
-                    format!(
-                        "cannot rename {} to {}: {e}",
-                        partial.display(),
-                        dest.display()
-                    )
-                })?;
-                Ok(Some(dest))
-            }
-            Sink::Direct(_) => Ok(None),
-        }
-    }
-
-    /// Interrupted or failed: the partial file stays (flushed); its path.
-    fn abandon(mut self) -> Option<PathBuf> {
-        let _ = self.out().flush();
-        match self {
-            Sink::Partial { partial, .. } => Some(partial),
-            Sink::Direct(_) => None,
-        }
-    }
 }
 
 /// The smallest and largest value of each plotted metric and the parameters of their runs,
@@ -613,12 +554,12 @@ impl PlotData {
 pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
     let preamble = preamble(plan);
     let names: Vec<String> = plan.runs.swept.iter().map(|s| s.name.clone()).collect();
-    let mut sink = Sink::open(&plan.csv).map_err(CliError::Failed)?;
-    let header = table::header(&names).join(",");
+    let mut head = Vec::new();
     preamble
-        .write(sink.out())
-        .and_then(|()| writeln!(sink.out(), "{header}"))
-        .map_err(|e| CliError::Failed(format!("cannot write the CSV: {e}")))?;
+        .write(&mut head)
+        .and_then(|()| writeln!(head, "{}", table::header(&names).join(",")))
+        .map_err(|e| CliError::Failed(format!("cannot format the CSV's header: {e}")))?;
+    let mut sink = Sink::open(plan.csv.as_deref(), &head).map_err(CliError::Failed)?;
     let total = plan.shard.len(plan.runs.len());
     let mut progress =
         progress::Progress::new(&format!("{} sweep", plan.label), total, !plan.quiet);
@@ -681,8 +622,8 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
             waiting.insert(k, row);
             while let Some(row) = waiting.remove(&written) {
                 if write_error.is_none() {
-                    if let Err(e) = writeln!(sink.out(), "{}", row.cells().join(",")) {
-                        write_error = Some(e.to_string());
+                    if let Err(e) = sink.row(&row.cells().join(",")) {
+                        write_error = Some(e);
                         stop.store(true, Ordering::Relaxed);
                     }
                 }
@@ -694,8 +635,11 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
             }
             // What is computed reaches the file at least every second (a crash or a killed
             // batch job keeps it).
-            if flushed.elapsed().as_secs() >= 1 {
-                let _ = sink.out().flush();
+            if flushed.elapsed().as_secs() >= 1 && write_error.is_none() {
+                if let Err(e) = sink.flush() {
+                    write_error = Some(e);
+                    stop.store(true, Ordering::Relaxed);
+                }
                 flushed = Instant::now();
             }
             if interrupt.requested() {
@@ -708,9 +652,9 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
     if let Some(e) = write_error {
         let kept = sink.abandon();
         return Err(CliError::Failed(format!(
-            "cannot write the CSV: {e}{}",
+            "{e}{}",
             kept.map_or(String::new(), |p| format!(
-                " (rows so far in {})",
+                " (the complete rows before it are kept in {})",
                 p.display()
             ))
         )));
