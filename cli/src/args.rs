@@ -189,12 +189,13 @@ pub struct CamArgs {
     pub speed: Option<f64>,
 
     /// Samples over a turn: rows of design.csv and figures, output angles of the runs, the
-    /// grid the peaks are refined from
-    #[arg(long, value_name = "N", default_value_t = 3600, value_parser = at_least_one)]
+    /// grid the peaks are refined from; 1 to 1000000
+    #[arg(long, value_name = "N", default_value_t = 3600, value_parser = cam_samples)]
     pub samples: usize,
 
-    /// Turns of the camshaft in the one-sided run at ω
-    #[arg(long, value_name = "N", default_value_t = 3, value_parser = at_least_one)]
+    /// Turns of the camshaft in the one-sided run at ω, 1 to 10000 (and at most 1000000
+    /// samples in all: turns × --samples)
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = cam_turns)]
     pub turns: usize,
 
     /// Coefficient of restitution of the one-sided run (0 plastic … 1 elastic) [default:
@@ -212,7 +213,7 @@ pub struct CamArgs {
     pub table: Option<PathBuf>,
 
     /// Points of the --table profile (at evenly spaced cam angles, the first repeated at
-    /// the end), at least 3
+    /// the end), 3 to 1000000
     #[arg(long, value_name = "N", default_value_t = 720, value_parser = table_points, requires = "table")]
     pub points: usize,
 }
@@ -652,14 +653,35 @@ fn count(text: &str, least: usize) -> Result<usize, String> {
     }
 }
 
-/// A whole number, at least 1.
-fn at_least_one(text: &str) -> Result<usize, String> {
-    count(text, 1)
+/// Points of a profile table: at least 3 (a closed curve), at most [`MAX_CAM_SAMPLES`].
+fn table_points(text: &str) -> Result<usize, String> {
+    bounded(count(text, 3)?, MAX_CAM_SAMPLES)
 }
 
-/// Points of a profile table: at least 3 (a closed curve).
-fn table_points(text: &str) -> Result<usize, String> {
-    count(text, 3)
+/// Most samples a turn `camchain cam` takes (`--samples`, `--points`): each is a row
+/// of every curve the report keeps in memory (about 200 bytes), so a million is 200 MB.
+pub const MAX_CAM_SAMPLES: usize = 1_000_000;
+
+/// Most turns of `camchain cam`'s one-sided run.
+pub const MAX_CAM_TURNS: usize = 10_000;
+
+/// `value`, or an error when it is above `most`.
+fn bounded(value: usize, most: usize) -> Result<usize, String> {
+    if value <= most {
+        Ok(value)
+    } else {
+        Err(format!("{value} is too large: at most {most}"))
+    }
+}
+
+/// `cam --samples`: 1 to [`MAX_CAM_SAMPLES`].
+fn cam_samples(text: &str) -> Result<usize, String> {
+    bounded(count(text, 1)?, MAX_CAM_SAMPLES)
+}
+
+/// `cam --turns`: 1 to [`MAX_CAM_TURNS`].
+fn cam_turns(text: &str) -> Result<usize, String> {
+    bounded(count(text, 1)?, MAX_CAM_TURNS)
 }
 
 #[cfg(test)]

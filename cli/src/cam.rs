@@ -132,6 +132,15 @@ pub fn run(args: &CamArgs) -> Result<(), CliError> {
             n
         );
     }
+    let one_sided_samples = args.turns.saturating_mul(n);
+    if one_sided_samples > crate::args::MAX_CAM_SAMPLES {
+        return Err(CliError::Usage(format!(
+            "--turns {} × --samples {n} = {one_sided_samples} samples in the one-sided run, more \
+             than {}: fewer turns or samples",
+            args.turns,
+            crate::args::MAX_CAM_SAMPLES
+        )));
+    }
     let (turns, one_sided) = rayon::join(
         || {
             use rayon::prelude::*;

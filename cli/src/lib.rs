@@ -154,6 +154,15 @@ fn one_line(rendered: &str) -> String {
         .next()
         .unwrap_or("error: invalid command line")
         .to_string();
+    // "the following required arguments were not provided:" and the arguments, one a line.
+    if text.ends_with(':') {
+        let missing: Vec<&str> = lines
+            .by_ref()
+            .take_while(|l| !l.starts_with("Usage:"))
+            .collect();
+        text.push(' ');
+        text.push_str(&missing.join(", "));
+    }
     if let Some(values) = lines.find(|l| l.starts_with("[possible values")) {
         text.push(' ');
         text.push_str(values);
@@ -179,5 +188,56 @@ mod tests {
         let error = Cli::try_parse_from(["camchain", "simulate", "--t-end", "-1"]).unwrap_err();
         let text = one_line(&error.render().to_string());
         assert!(text.contains("must be positive"), "{text}");
+    }
+
+    #[test]
+    fn the_following_required_arguments_are_named() {
+        for (args, missing) in [
+            (&["camchain", "sweep", "paper_concave"][..], "--param"),
+            (&["camchain", "cam"][..], "<MODEL>"),
+            (&["camchain", "merge", "--csv", "m.csv"][..], "<FILE>"),
+        ] {
+            let error = Cli::try_parse_from(args).unwrap_err();
+            let text = one_line(&error.render().to_string());
+            assert!(
+                text.contains("not provided: ") && text.contains(missing),
+                "{args:?}: {text}"
+            );
+        }
+    }
+
+    #[test]
+    fn cam_sizes_that_meet_memory_are_refused_before_running() {
+        for args in [
+            &[
+                "camchain",
+                "cam",
+                "cycloidal_roller",
+                "--samples",
+                "1000000000000",
+            ][..],
+            &[
+                "camchain",
+                "cam",
+                "cycloidal_roller",
+                "--turns",
+                "1000000000",
+            ][..],
+            &[
+                "camchain",
+                "cam",
+                "cycloidal_roller",
+                "--table",
+                "t.csv",
+                "--points",
+                "1000000000",
+            ][..],
+        ] {
+            let error = Cli::try_parse_from(args).unwrap_err();
+            assert!(
+                one_line(&error.render().to_string()).contains("too large: at most"),
+                "{args:?}"
+            );
+        }
     }
 }

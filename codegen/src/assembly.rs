@@ -51,9 +51,23 @@ fn assemble_with_loops(model: &Model, d: &Derivation) -> Result<Vec<f64>, (Strin
     let free: Vec<usize> = (0..n)
         .filter(|&i| !model.initial.hold[i] && model.bodies[i].joint.prescribed.is_none())
         .collect();
+    if free.is_empty() {
+        return Err((
+            "initial.hold".to_string(),
+            format!(
+                "the mechanism cannot be assembled: every coordinate is held or driven, so none \
+                 can be solved to close its {} loop equation{}: leave some out of initial.hold",
+                m,
+                if m == 1 { "" } else { "s" }
+            ),
+        ));
+    }
     let mut h = d.eval(&h_ids, 0.0, &q, &qd);
+    if let Some(error) = not_finite(model, &h, &q) {
+        return Err(("initial".to_string(), error));
+    }
     for _ in 0..MAX_ITERATIONS {
-        let residual = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let residual = largest(&h);
         if residual <= TOLERANCE {
             return Ok(q);
         }
@@ -128,6 +142,39 @@ fn assemble_with_loops(model: &Model, d: &Derivation) -> Result<Vec<f64>, (Strin
     ))
 }
 
+/// The largest |v|: NaN when any value is NaN (a plain `max` fold would skip it and call a
+/// profile that is not defined "closed").
+fn largest(values: &[f64]) -> f64 {
+    values.iter().fold(0.0f64, |a, v| {
+        if v.is_nan() || a.is_nan() {
+            f64::NAN
+        } else {
+            a.max(v.abs())
+        }
+    })
+}
+
+/// A message when a constraint value or derivative at the initial guess is not a number:
+/// the profile (or a loop's geometry) is not defined there.
+fn not_finite(model: &Model, values: &[f64], q: &[f64]) -> Option<String> {
+    let bad = values.iter().find(|v| !v.is_finite())?;
+    let profiles: Vec<String> = model
+        .contacts
+        .iter()
+        .map(|c| format!("contact `{}`", c.name))
+        .collect();
+    Some(format!(
+        "the constraints are {bad} at the initial guess q = {q:?}: a profile or a length is \
+         not defined there (a division by zero, a logarithm or square root of a negative \
+         number, a value beyond f64's range); check the profiles of {} and initial.q",
+        if profiles.is_empty() {
+            "the loops".to_string()
+        } else {
+            profiles.join(", ")
+        }
+    ))
+}
+
 /// [`assemble`] for a model without loops.
 fn assemble_contacts(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> {
     let n = model.n();
@@ -161,8 +208,11 @@ fn assemble_contacts(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> 
     let mut residual = f64::INFINITY;
     for _ in 0..MAX_ITERATIONS {
         let h = d.eval(&h_ids, 0.0, &q, &qd);
-        residual = h.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let j = d.eval(&j_ids, 0.0, &q, &qd);
+        if let Some(error) = not_finite(model, &h, &q).or_else(|| not_finite(model, &j, &q)) {
+            return Err(error);
+        }
+        residual = largest(&h);
         if residual <= TOLERANCE {
             // On the cams; the run must also be able to choose one dependent coordinate
             // per contact there (the runtime's partition needs an invertible J_v).

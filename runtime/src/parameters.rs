@@ -156,24 +156,42 @@ pub mod checks {
         }
     }
 
-    /// A finite number > 0.
+    /// Largest magnitude of a physical quantity that must be positive (a mass, a stiffness),
+    /// and the inverse of the smallest nonzero one: far beyond any mechanism in SI units
+    /// (the Sun's mass is 2e30 kg), and far enough inside f64's range (1.8e308) that the
+    /// equations' products of a few such values (m g l, k x²) stay finite.
+    pub const MAGNITUDE: f64 = 1e100;
+
+    /// A finite number > 0, within 1/[`MAGNITUDE`] … [`MAGNITUDE`].
     pub fn positive(what: &str, value: f64) -> Result<f64, String> {
-        if value.is_finite() && value > 0.0 {
-            Ok(value)
-        } else {
+        if !(value.is_finite() && value > 0.0) {
             Err(format!("{what} must be positive and finite, got {value}"))
+        } else if !(1.0 / MAGNITUDE..=MAGNITUDE).contains(&value) {
+            Err(out_of_range(what, value))
+        } else {
+            Ok(value)
         }
     }
 
-    /// A finite number ≥ 0.
+    /// A finite number ≥ 0, at most [`MAGNITUDE`] (and 0 or at least 1/[`MAGNITUDE`]).
     pub fn non_negative(what: &str, value: f64) -> Result<f64, String> {
-        if value.is_finite() && value >= 0.0 {
-            Ok(value)
-        } else {
+        if !(value.is_finite() && value >= 0.0) {
             Err(format!(
                 "{what} must be non-negative and finite, got {value}"
             ))
+        } else if value != 0.0 && !(1.0 / MAGNITUDE..=MAGNITUDE).contains(&value) {
+            Err(out_of_range(what, value))
+        } else {
+            Ok(value)
         }
+    }
+
+    fn out_of_range(what: &str, value: f64) -> String {
+        format!(
+            "{what} = {value:e} is outside 1e-100 … 1e100, the range the equations can be \
+             computed in without overflow (the products of a few such values must stay below \
+             f64's 1.8e308)"
+        )
     }
 
     /// A parameter's value against its declared range; `what` names the value (`its value`

@@ -59,16 +59,17 @@ impl Lock {
             )
         };
         for _ in 0..RETRIES {
-            let (file, created) = match OpenOptions::new().write(true).create_new(true).open(lock) {
-                Ok(file) => (file, true),
-                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
-                    match OpenOptions::new().read(true).open(lock) {
-                        Ok(file) => (file, false),
-                        // Removed by its holder meanwhile: try again.
-                        Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
-                        Err(e) => return Err(cannot(e)),
-                    }
-                }
+            if let Some(file) = create_locked(lock).map_err(cannot)? {
+                return Ok(Lock {
+                    file,
+                    path: lock.to_path_buf(),
+                    created: true,
+                });
+            }
+            let file = match OpenOptions::new().read(true).open(lock) {
+                Ok(file) => file,
+                // Removed by its holder meanwhile: try again.
+                Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
                 Err(e) => return Err(cannot(e)),
             };
             match file.try_lock() {
@@ -91,10 +92,11 @@ impl Lock {
                 _ => false,
             };
             if same {
+                // A lock file left by a killed run: used, and left in place.
                 return Ok(Lock {
                     file,
                     path: lock.to_path_buf(),
-                    created,
+                    created: false,
                 });
             }
         }
@@ -103,6 +105,27 @@ impl Lock {
             guarded.display(),
             lock.display()
         ))
+    }
+}
+
+/// Creates the lock file already locked, so that no other run can lock it first and leave
+/// it behind: a file of this run's own is locked, then linked to the lock's name (which
+/// fails if the name exists) and its own name removed. `None` when the lock file exists.
+/// On a file system without hard links, the file is created in place and locked at once.
+fn create_locked(lock: &Path) -> io::Result<Option<File>> {
+    let name = lock.file_name().unwrap_or_default().to_string_lossy();
+    let pid = std::process::id();
+    let (file, own) = super::create_unique(|n| lock.with_file_name(format!("{name}.{pid}.{n}")))?;
+    let linked = file.lock().and_then(|()| fs::hard_link(&own, lock));
+    let _ = fs::remove_file(&own);
+    match linked {
+        Ok(()) => Ok(Some(file)),
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => Ok(None),
+        Err(_) => match OpenOptions::new().write(true).create_new(true).open(lock) {
+            Ok(file) => file.lock().map(|()| Some(file)),
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => Ok(None),
+            Err(e) => Err(e),
+        },
     }
 }
 

@@ -41,6 +41,8 @@ pub struct Stream {
     committed: u64,
     /// Rows (after the header) written or buffered.
     rows: usize,
+    /// Rows in the file up to `committed`.
+    committed_rows: usize,
     flushed: Instant,
 }
 
@@ -98,6 +100,7 @@ impl Stream {
             buffer: Vec::with_capacity(BUFFER),
             committed: 0,
             rows: 0,
+            committed_rows: 0,
             flushed: Instant::now(),
         };
         stream.buffer.extend_from_slice(head);
@@ -141,11 +144,13 @@ impl Stream {
         match self.file.write_all(&self.buffer) {
             Ok(()) => {
                 self.committed += self.buffer.len() as u64;
+                self.committed_rows = self.rows;
                 self.buffer.clear();
                 Ok(())
             }
             Err(e) => {
                 self.buffer.clear();
+                self.rows = self.committed_rows;
                 // Best effort: a disk too full to take the rows can still give back space.
                 let _ = self.file.set_len(self.committed);
                 Err(e)

@@ -88,10 +88,14 @@ pub fn resolve(path: &Path) -> Result<Target, String> {
             continue;
         }
         if kind.is_dir() {
-            return Err(cannot(format!(
-                "{} is a directory (a file name is expected)",
-                current.display()
-            )));
+            return Err(cannot(if current == path {
+                "it is a directory (a file name is expected)".to_string()
+            } else {
+                format!(
+                    "its link's target {} is a directory (a file name is expected)",
+                    current.display()
+                )
+            }));
         }
         if !kind.is_file() {
             return Ok(Target::Special(current));

@@ -167,7 +167,7 @@ fn arm(t_end: f64) -> String {
 }
 
 #[test]
-fn a_failed_run_keeps_the_previous_complete_run_and_a_complete_one_clears_stale_files() {
+fn a_failed_run_keeps_the_previous_complete_run_and_later_runs_never_touch_its_rows() {
     let dir = scratch("trust-mix");
     let model = write(&dir, "arm.ron", &arm(0.5));
     let path = model.to_str().unwrap();
@@ -194,20 +194,19 @@ fn a_failed_run_keeps_the_previous_complete_run_and_a_complete_one_clears_stale_
         stderr.contains("are in out/arm/arm.partial.csv"),
         "{stderr}"
     );
-    // A complete run again: the stale partial file goes.
+    // A complete run again: it replaces arm.csv and touches nothing it did not create,
+    // neither the kept rows nor the earlier figures (it draws none with --no-plots).
     write(&dir, "arm.ron", &arm(0.5));
     let again = camchain(&dir, &["simulate", path, "-q", "--no-plots"]);
     assert_eq!(again.status.code(), Some(0), "{}", text(&again.stderr));
-    assert!(
-        !partial.exists(),
-        "a stale partial CSV stays beside a complete run"
-    );
-    // --no-plots: this run drew no figures, so the older ones go rather than pass for its.
-    let names: Vec<String> = std::fs::read_dir(&run_dir)
-        .expect("the run directory")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    assert_eq!(names, ["arm.csv"], "only this run's files remain");
+    assert_eq!(std::fs::read(&partial).expect("kept"), rows);
+    let mut now = snapshot(&run_dir);
+    now.remove(&partial);
+    let csv = run_dir.join("arm.csv");
+    assert!(now.remove(&csv).is_some());
+    let mut earlier = complete.clone();
+    earlier.remove(&csv);
+    assert_eq!(now, earlier, "the earlier figures are as they were");
 }
 
 /// The lines of standard error of a running child, as they come.

@@ -332,6 +332,14 @@ const CASES: &[Case] = &[
         "bodies[1].com[1]",
         "must be finite, got NaN",
     ),
+    // `1e308` after `mass:`.
+    case(
+        "huge_mass.ron",
+        24,
+        19,
+        "bodies[1].mass",
+        "mass = 1e308 is outside 1e-100 … 1e100",
+    ),
     // `NaN` after `mass:`.
     case(
         "nan_mass.ron",
@@ -764,6 +772,27 @@ const CASES: &[Case] = &[
         "gravty",
         "Unexpected field named `gravty`",
     ),
+    // The `(` after `initial:`: the profile is infinite there (it divides by x - x), which
+    // the message says instead of calling |h| zero.
+    Case {
+        file: "profile_undefined_at_guess.ron",
+        line: 70,
+        column: 14,
+        field: "initial",
+        phrase: "the constraints are -inf at the initial guess",
+        reference: Reference::Assemble,
+        located: None,
+    },
+    // The hold list: every coordinate held, none left to close the loop.
+    Case {
+        file: "loop_every_coordinate_held.ron",
+        line: 53,
+        column: 15,
+        field: "initial.hold",
+        phrase: "every coordinate is held or driven",
+        reference: Reference::Assemble,
+        located: None,
+    },
     // The `(` after `initial:`.
     Case {
         file: "unreachable_initial_state.ron",
