@@ -310,7 +310,8 @@ pub struct SweepArgs {
     #[arg(long, value_name = "NAMES", value_delimiter = ',')]
     pub metric: Vec<String>,
 
-    /// Runs at a time [default: the number of cores]
+    /// Runs at a time, at most 1024 and never more than the runs [default: the number of
+    /// cores]
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
 

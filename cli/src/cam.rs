@@ -94,10 +94,12 @@ pub fn run(args: &CamArgs) -> Result<(), CliError> {
     } else {
         format!("{}_cam", subject.label)
     });
-    if let Some(table) = &args.table {
-        check_table_destination(table)?;
-    }
-    output::create_dir(&dir).map_err(CliError::Failed)?;
+    let _table_lock = match &args.table {
+        Some(table) => output::claim(table).map_err(CliError::Failed)?,
+        None => None,
+    };
+    // Held until the report's files are written.
+    let _lock = output::create_dir(&dir).map_err(CliError::Failed)?;
     for warning in &subject.warnings {
         eprintln!("warning: {}: {warning}", subject.label);
     }
@@ -204,29 +206,6 @@ pub fn run(args: &CamArgs) -> Result<(), CliError> {
             Err(CliError::Failed(format!("{}: {why}", subject.label)))
         }
         _ => Ok(()),
-    }
-}
-
-/// The table's destination can be written: not a directory, in a directory that exists.
-fn check_table_destination(path: &Path) -> Result<(), CliError> {
-    if path.is_dir() {
-        return Err(CliError::Failed(format!(
-            "cannot write {}: it is a directory (--table takes a file name)",
-            path.display()
-        )));
-    }
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(CliError::Failed(format!(
-            "cannot write {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        )))
     }
 }
 

@@ -641,10 +641,10 @@ fn decimate(points: &[(f64, f64)], (x0, x1): (f64, f64), buckets: usize) -> Vec<
         }
         i = j;
     }
-    if let (Some(last), Some(end)) = (kept.last(), points.last()) {
-        if last != end {
-            kept.push(*end);
-        }
+    if let (Some(last), Some(end)) = (kept.last(), points.last())
+        && last != end
+    {
+        kept.push(*end);
     }
     kept
 }

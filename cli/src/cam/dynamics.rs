@@ -307,13 +307,13 @@ fn jump_speed(coefficients: &[[f64; 3]]) -> JumpSpeed {
         .enumerate()
         .filter(|(_, c)| c[0].is_finite())
         .min_by(|a, b| a.1[0].total_cmp(&b.1[0]));
-    if let Some((k, c)) = at_rest {
-        if c[0] <= 0.0 {
-            return JumpSpeed::AtRest {
-                theta: angle(k),
-                force: c[0],
-            };
-        }
+    if let Some((k, c)) = at_rest
+        && c[0] <= 0.0
+    {
+        return JumpSpeed::AtRest {
+            theta: angle(k),
+            force: c[0],
+        };
     }
     let roots: Vec<Option<f64>> = coefficients
         .iter()

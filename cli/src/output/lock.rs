@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 
 /// A held lock; released (and its file removed, if this run created it) when dropped.
 #[derive(Debug)]
+#[must_use = "the lock is released when dropped: keep it until the outputs are written"]
 pub struct Lock {
     file: File,
     path: PathBuf,

@@ -376,13 +376,12 @@ pub(crate) fn plotted_metrics(given: &[String]) -> Result<Vec<String>, CliError>
     Ok(given.to_vec())
 }
 
+/// A sweep's CSV path (`None`: standard output), figures' directory and their locks.
+type Destinations = (Option<PathBuf>, Option<PathBuf>, Vec<output::Lock>);
+
 /// The CSV's path (`None`: standard output) and the figures' directory, checked writable and
 /// locked for this sweep.
-fn destinations(
-    args: &SweepArgs,
-    label: &str,
-    stem: &str,
-) -> Result<(Option<PathBuf>, Option<PathBuf>, Vec<output::Lock>), CliError> {
+fn destinations(args: &SweepArgs, label: &str, stem: &str) -> Result<Destinations, CliError> {
     let mut locks = Vec::new();
     let dir = match (&args.out, &args.csv) {
         (Some(dir), _) => Some(dir.join(format!("{label}_sweep"))),
@@ -621,11 +620,11 @@ pub fn execute(plan: &Plan, interrupt: &Interrupt) -> Result<(), CliError> {
             };
             waiting.insert(k, row);
             while let Some(row) = waiting.remove(&written) {
-                if write_error.is_none() {
-                    if let Err(e) = sink.row(&row.cells().join(",")) {
-                        write_error = Some(e);
-                        stop.store(true, Ordering::Relaxed);
-                    }
+                if write_error.is_none()
+                    && let Err(e) = sink.row(&row.cells().join(","))
+                {
+                    write_error = Some(e);
+                    stop.store(true, Ordering::Relaxed);
                 }
                 failed += usize::from(row.error.is_some());
                 plot.add(&row);
@@ -795,5 +794,42 @@ fn summary(
         eprint!("{text}");
     } else {
         print!("{text}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::args::{Cli, Command};
+    use clap::Parser;
+
+    fn sweep_plan(jobs: &str) -> Result<Plan, CliError> {
+        let cli = Cli::try_parse_from([
+            "camchain",
+            "sweep",
+            "paper_concave",
+            "--param",
+            "k3=20:80:5",
+            "--csv",
+            "-",
+            "--jobs",
+            jobs,
+        ])
+        .expect("parsed");
+        let Some(Command::Sweep(args)) = cli.command else {
+            panic!("a sweep");
+        };
+        plan(&args)
+    }
+
+    #[test]
+    fn sweep_jobs_are_capped_at_the_runs_and_a_documented_maximum() {
+        // 5 runs: 1000 workers would be 995 idle threads.
+        assert_eq!(sweep_plan("1000").map(|p| p.jobs).ok(), Some(5));
+        assert_eq!(sweep_plan("2").map(|p| p.jobs).ok(), Some(2));
+        match sweep_plan("100000") {
+            Err(CliError::Usage(message)) => assert!(message.contains("at most 1024"), "{message}"),
+            _ => panic!("--jobs 100000 is a usage error"),
+        }
     }
 }
