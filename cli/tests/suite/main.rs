@@ -7,6 +7,7 @@ mod cam;
 mod cli;
 #[path = "../common/mod.rs"]
 mod common;
+mod merge;
 mod repartition;
 mod signals;
 mod special_files;
