@@ -121,8 +121,8 @@ fn sweep_of(first: &ShardFile, count: usize, bytes: Option<u64>) -> Result<Sweep
         let room = bytes / columns.len() as u64;
         if total as u64 > room {
             return Err(format!(
-                "{}: the {count} shards ({bytes} bytes) cannot hold {total} rows of at least \
-                 {} bytes: rows are missing",
+                "{}: the shards ({bytes} bytes in all) cannot hold {total} rows of at least \
+                 {} bytes each: rows are missing",
                 line1(),
                 columns.len()
             ));
@@ -187,7 +187,6 @@ fn open_all(files: &[PathBuf], bytes: Option<u64>) -> Result<(Sweep, Vec<ShardFi
             ));
         }
     }
-    let sweep = sweep_of(first, count, bytes)?;
     shards.sort_by_key(|s| s.preamble.shard.0);
     for pair in shards.windows(2) {
         if pair[0].preamble.shard.0 == pair[1].preamble.shard.0 {
@@ -224,6 +223,8 @@ fn open_all(files: &[PathBuf], bytes: Option<u64>) -> Result<(Sweep, Vec<ShardFi
             if absent == 1 { "is" } else { "are" }
         ));
     }
+    // Last: a Latin hypercube's points are drawn only for a complete set of shards.
+    let sweep = sweep_of(&shards[0], count, bytes)?;
     Ok((sweep, shards))
 }
 
@@ -426,7 +427,7 @@ fn write_to(
 #[cfg(test)]
 mod tests {
     use super::definition;
-    use crate::sweep::spec::{Design, Runs};
+    use crate::sweep::spec::{Design, Runs, parse_param};
 
     fn runs_of(parameters: &str) -> Result<Runs, String> {
         let (swept, design) = definition(parameters)?;
@@ -446,6 +447,25 @@ mod tests {
             }
         );
         assert_eq!(lhs.len(), 200);
+        // What the sweep records reads back as the same runs, even from specs written with
+        // spaces, and a Latin hypercube's points are the same.
+        for (specs, design) in [
+            (
+                vec!["k3 = 20, 40 ,80", "swing=-0.5 : 0.5 : 3"],
+                Design::Product,
+            ),
+            (
+                vec!["k2=5:30", "k4= 1 : 2"],
+                Design::LatinHypercube {
+                    samples: 7,
+                    seed: 11,
+                },
+            ),
+        ] {
+            let swept = specs.iter().map(|s| parse_param(s).expect(s)).collect();
+            let runs = Runs::new(swept, design).expect("runs");
+            assert_eq!(runs_of(&runs.describe()), Ok(runs));
+        }
         for bad in [
             "k2=5:30 samples x seed 3",
             "k2=5:30 samples 3 seed",
