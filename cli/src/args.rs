@@ -415,7 +415,8 @@ pub struct MergeArgs {
     pub files: Vec<PathBuf>,
 
     /// Write the merged CSV to FILE (`-`: standard output); nothing else is written unless
-    /// --out is given too [default: DIR/<model>_sweep.csv]
+    /// --out is given too [default: DIR/<model>_sweep.csv, the model's name made a plain
+    /// file name]
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,
 

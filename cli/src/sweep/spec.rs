@@ -28,7 +28,8 @@ pub enum Values {
 pub struct Swept {
     /// The parameter's name.
     pub name: String,
-    /// SPEC as written (recorded in the CSV's header line).
+    /// SPEC as written, without whitespace (recorded in the CSV's `parameters` line, whose
+    /// specs `merge` reads back split at whitespace).
     pub spec: String,
     /// Its values.
     pub values: Values,
@@ -61,7 +62,7 @@ pub fn parse_param(text: &str) -> Result<Swept, String> {
     let values = parse_values(spec).map_err(|e| format!("{name}={spec}: {e}"))?;
     Ok(Swept {
         name: name.to_string(),
-        spec: spec.to_string(),
+        spec: spec.split_whitespace().collect(),
         values,
     })
 }
@@ -176,8 +177,10 @@ pub struct Runs {
     pub swept: Vec<Swept>,
     /// How the runs are made.
     pub design: Design,
-    /// The Latin hypercube's points (empty for a product).
-    points: Vec<Vec<f64>>,
+    /// The Latin hypercube's points, one after the other, each with a value per swept
+    /// parameter (empty for a product): one allocation, 8 bytes a value, however many
+    /// samples.
+    points: Vec<f64>,
 }
 
 impl Runs {
@@ -259,7 +262,8 @@ impl Runs {
     /// The parameter values of run `index` (in the order of [`Runs::swept`]).
     pub fn values(&self, index: usize) -> Vec<f64> {
         if let Design::LatinHypercube { .. } = self.design {
-            return self.points[index].clone();
+            let n = self.swept.len();
+            return self.points[index * n..(index + 1) * n].to_vec();
         }
         let mut rest = index;
         let mut out = vec![0.0; self.swept.len()];
@@ -375,15 +379,16 @@ impl SplitMix {
 /// `samples` points in the box `intervals`: each interval cut in `samples` equal strata,
 /// each stratum used once per parameter, a uniform point inside it, the strata of the
 /// parameters paired by independent random permutations (McKay, Beckman & Conover 1979).
-fn latin_hypercube(intervals: &[(f64, f64)], samples: usize, seed: u64) -> Vec<Vec<f64>> {
+fn latin_hypercube(intervals: &[(f64, f64)], samples: usize, seed: u64) -> Vec<f64> {
     let mut rng = SplitMix(seed);
-    let mut points = vec![vec![0.0; intervals.len()]; samples];
+    let n = intervals.len();
+    let mut points = vec![0.0; samples * n];
     for (k, &(a, b)) in intervals.iter().enumerate() {
         let mut strata: Vec<usize> = (0..samples).collect();
         for i in (1..samples).rev() {
             strata.swap(i, rng.below(i + 1));
         }
-        for (point, stratum) in points.iter_mut().zip(strata) {
+        for (point, stratum) in points.chunks_exact_mut(n).zip(strata) {
             let u = (stratum as f64 + rng.uniform()) / samples as f64;
             point[k] = a + (b - a) * u;
         }

@@ -13,7 +13,10 @@
 //! first, third and fourth lines, and its own shard line); CSV readers skip them
 //! (`pandas.read_csv(path, comment='#')`). Numbers use Rust's shortest round-trip form; a
 //! failed run has `status` `failed`, the error in `error`, and empty metrics but for how
-//! far it got (`t_reached`) and the work it did.
+//! far it got (`t_reached`) and the work it did. [`rows`] reads rows back and accepts only
+//! what this module writes (what `camchain merge` checks of every row).
+
+pub mod rows;
 
 use camchain_runtime::RunMetrics;
 use std::io::{self, Write};
@@ -33,6 +36,36 @@ pub const METRICS: [(&str, &str); 13] = [
     ("repartitions", ""),
     ("t_reached", "s"),
     ("wall_time", "s"),
+];
+
+/// The metric columns that hold counts: whole numbers, written without a decimal point.
+pub const COUNTERS: [&str; 5] = [
+    "lift_off_contact",
+    "steps",
+    "rejected",
+    "rhs_evaluations",
+    "repartitions",
+];
+
+/// The metrics a failed run keeps (how far it got and the work it did); its other metric
+/// cells are empty. A run that failed before its integration started (the model refused
+/// the values, assembly failed) has these empty too.
+pub const KEPT_WHEN_FAILED: [&str; 5] = [
+    "steps",
+    "rejected",
+    "rhs_evaluations",
+    "repartitions",
+    "t_reached",
+];
+
+/// The metrics a completed run may leave empty: the normal forces (not a number when the
+/// model has no contact force) and the first lift-off's time and contact (both empty when
+/// the follower never lifts off).
+pub const OPTIONAL_WHEN_OK: [&str; 4] = [
+    "max_normal_force",
+    "min_normal_force",
+    "first_lift_off",
+    "lift_off_contact",
 ];
 
 /// The metrics a figure may show (`--metric`), all but the work counters.
@@ -77,6 +110,17 @@ impl Preamble {
             .and_then(|n| n.parse().ok())
     }
 
+    /// The model's name and the path that ran it (`generated code`, `numeric reference`),
+    /// from the first line, `camchain sweep of <model> (<path>): <n> runs`; None when the
+    /// line is not of that form. The name is the model's as written, which may hold any
+    /// character (a model file's `name:`): it is data, never a path.
+    pub fn model(&self) -> Option<(&str, &str)> {
+        let rest = self.sweep.strip_prefix("camchain sweep of ")?;
+        let (head, _) = rest.rsplit_once(": ")?;
+        let (model, path) = head.strip_suffix(')')?.rsplit_once(" (")?;
+        (!model.is_empty() && !path.is_empty()).then_some((model, path))
+    }
+
     /// Writes the four lines.
     pub fn write(&self, out: &mut dyn Write) -> io::Result<()> {
         writeln!(out, "# {}", self.sweep)?;
@@ -85,24 +129,25 @@ impl Preamble {
         writeln!(out, "# settings: {}", self.settings)
     }
 
-    /// Reads the four lines (without their `# `); the error says which is missing.
-    pub fn parse(lines: &[&str]) -> Result<Self, String> {
-        let line = |k: usize, prefix: &str| -> Result<String, String> {
+    /// Reads the four lines (with their `# `); the error gives the line's number (1-based)
+    /// and what is wrong with it.
+    pub fn parse(lines: &[&str]) -> Result<Self, (usize, String)> {
+        let line = |k: usize, prefix: &str| -> Result<String, (usize, String)> {
             lines
                 .get(k)
                 .and_then(|l| l.strip_prefix("# "))
                 .and_then(|l| l.strip_prefix(prefix))
                 .map(str::to_string)
                 .ok_or_else(|| {
-                    format!(
-                        "line {} is not `# {prefix}…`: not a CSV written by camchain sweep",
-                        k + 1
+                    (
+                        k + 1,
+                        format!("not `# {prefix}…`: not a CSV written by camchain sweep"),
                     )
                 })
         };
         let sweep = format!("camchain sweep{}", line(0, "camchain sweep")?);
         let shard = line(1, "shard ")?;
-        let shard = super::spec::parse_shard(&shard).map_err(|e| format!("line 2: {e}"))?;
+        let shard = super::spec::parse_shard(&shard).map_err(|e| (2, e))?;
         Ok(Preamble {
             sweep,
             shard: (shard.index, shard.count),
@@ -160,15 +205,8 @@ impl Row {
                 None,
             ];
             if self.error.is_some() {
-                let kept = [
-                    "steps",
-                    "rejected",
-                    "rhs_evaluations",
-                    "repartitions",
-                    "t_reached",
-                ];
                 for (k, (name, _)) in METRICS.iter().enumerate() {
-                    if !kept.contains(name) {
+                    if !KEPT_WHEN_FAILED.contains(name) {
                         values[k] = None;
                     }
                 }
@@ -184,10 +222,7 @@ impl Row {
         cells.extend(self.values.iter().map(|v| number(*v)));
         cells.push(if self.error.is_none() { "ok" } else { "failed" }.to_string());
         for (value, (name, _)) in self.metric_values().iter().zip(METRICS) {
-            let counter = matches!(
-                name,
-                "lift_off_contact" | "steps" | "rejected" | "rhs_evaluations" | "repartitions"
-            );
+            let counter = COUNTERS.contains(&name);
             cells.push(match value {
                 None => String::new(),
                 Some(v) if counter => format!("{}", *v as u64),
@@ -221,31 +256,17 @@ pub fn quoted(text: &str) -> String {
     }
 }
 
-/// Splits one CSV line into cells (RFC 4180 quotes).
-pub fn split(line: &str) -> Vec<String> {
-    let mut cells = Vec::new();
-    let mut cell = String::new();
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (c, quoted) {
-            ('"', true) if chars.peek() == Some(&'"') => {
-                cell.push('"');
-                chars.next();
-            }
-            ('"', _) => quoted = !quoted,
-            (',', false) => cells.push(std::mem::take(&mut cell)),
-            _ => cell.push(c),
-        }
-    }
-    cells.push(cell);
-    cells
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use camchain_runtime::Stats;
+
+    /// The cells of a line, as the strict reader splits them.
+    fn split(line: &str) -> Vec<String> {
+        rows::split(line, 100)
+            .map(|cells| cells.into_iter().map(|c| c.text.into_owned()).collect())
+            .unwrap_or_default()
+    }
 
     fn metrics() -> RunMetrics {
         RunMetrics {
@@ -327,6 +348,8 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(Preamble::parse(&lines), Ok(p.clone()));
         assert_eq!(p.runs(), Some(63));
-        assert!(Preamble::parse(&lines[1..]).is_err());
+        assert_eq!(Preamble::parse(&lines[1..]).map_err(|(k, _)| k), Err(1));
+        let bad_shard = [lines[0], "# shard 3/2", lines[2], lines[3]];
+        assert_eq!(Preamble::parse(&bad_shard).map_err(|(k, _)| k), Err(2));
     }
 }

@@ -8,6 +8,7 @@ mod cli;
 #[path = "../common/mod.rs"]
 mod common;
 mod destinations;
+mod merge;
 mod repartition;
 mod signals;
 mod special_files;
