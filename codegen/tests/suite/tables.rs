@@ -244,3 +244,25 @@ fn a_huge_number_in_table_cams_table_is_reported_at_its_cell() {
     let e = refused(PARAMETRIC, &lines.join("\n"));
     assert_at(&e, 5, 23, &["y = 1e308 is beyond ±1e100"]);
 }
+
+/// Numbers within bounds can still overflow the spline when two abscissas are a subnormal
+/// step apart (the slope between them is infinite): refused at the first point whose
+/// curvature could not be computed, not carried into the run as infinities.
+#[test]
+fn a_spline_that_overflows_is_refused_at_its_point() {
+    let source = table_cam(
+        "table: (form: Explicit, points: [(0.0, 0.05), (5e-324, 0.06), (0.1, 0.05), (0.2, \
+         0.05)]),",
+    );
+    let e = check_source_in(
+        &source,
+        Path::new("models/table_cam.ron"),
+        Files::Embedded(&[]),
+    )
+    .expect_err("the spline overflows");
+    assert!(
+        e.field.starts_with("contacts[0].table.points["),
+        "located at a point: {e}"
+    );
+    assert!(e.message.contains("curvature overflows"), "{e}");
+}
