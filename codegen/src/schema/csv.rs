@@ -122,19 +122,17 @@ fn header(cells: &[(usize, &str)], names: [&str; 2], line: usize) -> Result<(), 
 
 /// A cell's finite number.
 fn number_in(cell: &str, name: &str, line: usize, column: usize) -> Result<f64, CsvError> {
-    match cell.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(v) => Err(CsvError {
-            line,
-            column,
-            message: format!("{name} must be a finite number, not {v}"),
-        }),
-        Err(_) => Err(CsvError {
-            line,
-            column,
-            message: format!("`{cell}` is not a number ({name})"),
-        }),
-    }
+    let message = match cell.parse::<f64>() {
+        Ok(v) if v.is_finite() => return Ok(v),
+        Ok(_) => format!("{name} must be a finite number, not `{cell}`"),
+        Err(_) if cell.is_empty() => format!("the {name} cell is empty: a row holds two numbers"),
+        Err(_) => format!("`{cell}` is not a number ({name})"),
+    };
+    Err(CsvError {
+        line,
+        column,
+        message,
+    })
 }
 
 #[cfg(test)]

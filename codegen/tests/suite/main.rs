@@ -17,4 +17,5 @@ mod parameters;
 mod scaling;
 #[path = "../common/scenes.rs"]
 mod scenes;
+mod tables;
 mod yardstick;

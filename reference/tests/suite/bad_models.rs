@@ -856,7 +856,7 @@ const CASES: &[Case] = &[
         49,
         107,
         "contacts[0].table.points[4]",
-        "must end where it starts",
+        "r is 0.051 here and 0.05 on points[0]",
     ),
     case(
         "table_polar_not_a_turn.ron",
@@ -887,6 +887,16 @@ const CASES: &[Case] = &[
         phrase: "`0.0395x` is not a number (y)",
         reference: Reference::Load,
         located: Some("tables/not_a_number.csv"),
+    },
+    // `0.0,-0.04` on line 6, the last row: not the first point, `0.04,0.0` on line 3.
+    Case {
+        file: "table_csv_not_closed.ron",
+        line: 6,
+        column: 1,
+        field: "contacts[0].table.file",
+        phrase: "must repeat its first (0.04, 0) on line 3",
+        reference: Reference::Load,
+        located: Some("tables/not_closed.csv"),
     },
     Case {
         file: "table_csv_wrong_header.ron",

@@ -9,3 +9,4 @@ mod contacts;
 mod random_models;
 mod settings_ranges;
 mod symbolic_vs_numeric;
+mod tables;

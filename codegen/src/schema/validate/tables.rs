@@ -6,9 +6,16 @@
 //! - polar: θ, r of r(θ) over one turn, the last point repeating the first 2π later; always
 //!   periodic; θ in radians, or in degrees with `degrees: true`;
 //! - parametric: x, y of a curve in order along it, parametrised by the length of the
-//!   polygon through the points (chord length); closed (periodic) when the last point
-//!   repeats the first, and then turned counterclockwise if it was written clockwise (the cam's
-//!   material on the left, as for every parametric profile); natural ends when open.
+//!   polygon through the points (chord length); closed (periodic) unless declared open
+//!   (`ends: Natural`), its last point then repeating the first, and turned counterclockwise
+//!   if it was written clockwise (the cam's material on the left, as for every parametric
+//!   profile).
+//!
+//! A closed table must close: its last row repeats the first one's value one period later,
+//! checked before anything is built ([`closes`]), so that a table that lost its closing row
+//! is an error at that row rather than an open curve or a jump at the seam. Every number is
+//! within ±[`LARGEST`], so that the spline's arithmetic cannot overflow, and the spline
+//! built is checked finite.
 
 use super::{Checked, Context, Profile};
 use crate::error::ModelError;
@@ -26,18 +33,38 @@ use std::path::{Path, PathBuf};
 enum At {
     /// `points[k]` in the model file.
     Inline(usize),
-    /// A line and column of a table file (shown as `file`).
+    /// A line of a table file (shown as `file`) and the columns of its two cells.
     File {
         file: PathBuf,
         line: usize,
-        column: usize,
+        columns: [usize; 2],
     },
 }
+
+impl At {
+    /// Where the point is, for messages that refer to another point: `line 4` or
+    /// `points[0]`.
+    fn described(&self) -> String {
+        match self {
+            At::Inline(k) => format!("points[{k}]"),
+            At::File { line, .. } => format!("line {line}"),
+        }
+    }
+}
+
+/// Largest magnitude of a number in a table. The spline's arithmetic squares and cubes
+/// differences of the table's numbers and sums up to a table's length of them (chord
+/// lengths, slopes, the cubic's terms): below 1e100 every such product stays below 1e300,
+/// far inside f64's 1.8e308, while any physical table (metres, radians, degrees) is many
+/// orders of magnitude below it.
+pub(crate) const LARGEST: f64 = 1e100;
 
 /// The points of a table with where each is written.
 struct Points {
     values: Vec<[f64; 2]>,
     at: Vec<At>,
+    /// The names of the two columns (`x, y` or `theta, r`).
+    names: [&'static str; 2],
     /// `file`'s path as the model writes it, for descriptions.
     from: Option<String>,
 }
@@ -56,6 +83,7 @@ pub(super) fn table_profile(
         TableForm::Explicit | TableForm::Parametric => ["x", "y"],
     };
     let points = points(cx, &field, table, names)?;
+    within_range(cx, &field, &points)?;
     let ends = table.ends.map(ends_of);
     let described = |what: &str| match &points.from {
         Some(file) => format!(
@@ -66,8 +94,12 @@ pub(super) fn table_profile(
     };
     match table.form {
         TableForm::Explicit => {
+            let ends = ends.unwrap_or(Ends::Natural);
+            if ends == Ends::Periodic {
+                closes(cx, &field, &points, "a periodic table")?;
+            }
             let (x, y) = columns(&points.values);
-            let spline = spline(cx, &field, &points, &x, &y, ends.unwrap_or(Ends::Natural))?;
+            let spline = spline(cx, &field, &points, &x, &y, ends)?;
             let f = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
             let range = (x[0], x[x.len() - 1]);
             let source = described("a spline");
@@ -85,8 +117,9 @@ pub(super) fn table_profile(
             let scale = if table.degrees { TAU / 360.0 } else { 1.0 };
             let (theta, r): (Vec<f64>, Vec<f64>) =
                 points.values.iter().map(|p| (p[0] * scale, p[1])).unzip();
-            let spline = spline(cx, &field, &points, &theta, &r, Ends::Periodic)?;
             one_turn(cx, &field, &points, &theta, table.degrees)?;
+            closes(cx, &field, &points, "a polar table")?;
+            let spline = spline(cx, &field, &points, &theta, &r, Ends::Periodic)?;
             let r = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
             let source = described("a periodic spline");
             Ok((Profile::Polar { source, r }, (0.0, TAU)))
@@ -95,7 +128,8 @@ pub(super) fn table_profile(
     }
 }
 
-/// A parametric table: x(t) and y(t) splines of the chord length t.
+/// A parametric table: x(t) and y(t) splines of the chord length t; closed unless declared
+/// open (`ends: Natural`).
 fn parametric(
     cx: &Context,
     field: &str,
@@ -111,22 +145,14 @@ fn parametric(
         ));
     }
     let n = points.values.len();
-    let meet = n > 1 && {
-        let (a, b) = (points.values[0], points.values[n - 1]);
-        let size = points
-            .values
-            .iter()
-            .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
-        (a[0] - b[0]).hypot(a[1] - b[1]) <= CLOSURE_TOLERANCE * size.max(f64::MIN_POSITIVE)
-    };
-    let closed = match ends {
-        Some(e) => e == Ends::Periodic,
-        None => meet,
-    };
-    if closed && signed_area(&points.values) < 0.0 {
-        // Counterclockwise, so that the cam's material is on the left.
-        points.values.reverse();
-        points.at.reverse();
+    let closed = ends.is_none_or(|e| e == Ends::Periodic);
+    if closed {
+        curve_closes(cx, field, &points)?;
+        if signed_area(&points.values) < 0.0 {
+            // Counterclockwise, so that the cam's material is on the left.
+            points.values.reverse();
+            points.at.reverse();
+        }
     }
     let mut t = Vec::with_capacity(n);
     let mut length = 0.0;
@@ -139,9 +165,11 @@ fn parametric(
                     cx,
                     field,
                     &points.at[k],
+                    0,
                     format!(
-                        "point {k} repeats the point before it: a curve's points must differ \
-                         from their neighbours"
+                        "this point repeats its neighbour at {} along the curve: a curve's \
+                         points must differ from their neighbours",
+                        points.at[k - 1].described()
                     ),
                 ));
             }
@@ -198,7 +226,99 @@ fn columns(values: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
     values.iter().map(|p| (p[0], p[1])).unzip()
 }
 
-/// The spline through (x, y), its errors located at the point they concern.
+/// Every number of the table is finite and within ±[`LARGEST`].
+fn within_range(cx: &Context, field: &str, points: &Points) -> Checked<()> {
+    for (p, at) in points.values.iter().zip(&points.at) {
+        for (cell, &v) in p.iter().enumerate() {
+            let name = points.names[cell];
+            let problem = if !v.is_finite() {
+                format!("{name} must be a finite number, not {v}")
+            } else if v.abs() > LARGEST {
+                format!(
+                    "{name} = {v:e} is beyond ±{LARGEST:e}, the largest magnitude a table's \
+                     spline computes with"
+                )
+            } else {
+                continue;
+            };
+            return Err(point_error(cx, field, at, cell, problem));
+        }
+    }
+    Ok(())
+}
+
+/// A closed table's second column ends where it starts: the last row's value is the first
+/// one's, within [`CLOSURE_TOLERANCE`] of the column's largest magnitude (the runtime's
+/// rule). A table written with ten significant digits or more (CAD exports, `camchain cam
+/// --table`, which writes every number to the last bit) closes far within it, and a table
+/// that lost its closing row misses it by the profile's change over one step, unless the
+/// profile dwells there: its angle or length then tells ([`one_turn`], [`curve_closes`]).
+fn closes(cx: &Context, field: &str, points: &Points, what: &str) -> Checked<()> {
+    let n = points.values.len();
+    if n < 2 {
+        return Ok(());
+    }
+    let name = points.names[1];
+    let (first, last) = (points.values[0][1], points.values[n - 1][1]);
+    let scale = points.values.iter().fold(0.0f64, |m, p| m.max(p[1].abs()));
+    let difference = (last - first).abs();
+    if difference <= CLOSURE_TOLERANCE * scale.max(f64::MIN_POSITIVE) {
+        return Ok(());
+    }
+    Err(point_error(
+        cx,
+        field,
+        &points.at[n - 1],
+        1,
+        format!(
+            "{what} is closed: its last row repeats the first one's {name} one period later, \
+             but {name} is {last} here and {first} on {} (difference {difference:.3e}, more \
+             than {CLOSURE_TOLERANCE:e} of the largest |{name}|, {scale}); is the closing row \
+             missing?",
+            points.at[0].described()
+        ),
+    ))
+}
+
+/// A closed curve's last point is its first, within [`CLOSURE_TOLERANCE`] of the table's
+/// largest coordinate (see [`closes`]); a curve that lost its closing row misses it by a
+/// whole chord.
+fn curve_closes(cx: &Context, field: &str, points: &Points) -> Checked<()> {
+    let n = points.values.len();
+    if n < 2 {
+        return Ok(());
+    }
+    let (a, b) = (points.values[0], points.values[n - 1]);
+    let size = points
+        .values
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+    let gap = (a[0] - b[0]).hypot(a[1] - b[1]);
+    if gap <= CLOSURE_TOLERANCE * size.max(f64::MIN_POSITIVE) {
+        return Ok(());
+    }
+    Err(point_error(
+        cx,
+        field,
+        &points.at[n - 1],
+        0,
+        format!(
+            "a parametric table is a closed curve unless declared open, and its last point \
+             ({}, {}) must repeat its first ({}, {}) on {}, but they are {gap:.3e} m apart \
+             (more than {CLOSURE_TOLERANCE:e} of its largest coordinate, {size} m): add the \
+             first point again as the last row, or declare an open curve with `ends: Natural`",
+            b[0],
+            b[1],
+            a[0],
+            a[1],
+            points.at[0].described()
+        ),
+    ))
+}
+
+/// The spline through (x, y), its errors located at the point (and cell) they concern; a
+/// spline whose solve overflowed (points too close for their values) is refused at the
+/// first knot it could not compute.
 fn spline(
     cx: &Context,
     field: &str,
@@ -207,22 +327,48 @@ fn spline(
     y: &[f64],
     ends: Ends,
 ) -> Checked<Spline> {
-    Spline::new(x, y, ends).map_err(|e| {
-        let point = match &e {
-            SplineError::NotFinite { index, .. } | SplineError::NotIncreasing { index, .. } => {
-                Some(*index)
+    let spline = Spline::new(x, y, ends).map_err(|e| {
+        let (point, cell, message) = match &e {
+            SplineError::NotIncreasing {
+                index,
+                value,
+                previous,
+            } => {
+                let name = points.names[0];
+                let message = format!(
+                    "the {name} column must increase strictly, but {name} = {value} here does \
+                     not exceed {previous} on {}",
+                    points.at[index - 1].described()
+                );
+                (Some(*index), 0, message)
             }
-            SplineError::EndsDoNotMeet { .. } => Some(x.len() - 1),
-            SplineError::TooFewPoints { .. } | SplineError::LengthMismatch { .. } => None,
+            SplineError::NotFinite { index, .. } => (Some(*index), 0, e.to_string()),
+            SplineError::EndsDoNotMeet { .. } => (Some(x.len() - 1), 1, e.to_string()),
+            SplineError::TooFewPoints { .. } | SplineError::LengthMismatch { .. } => {
+                (None, 0, e.to_string())
+            }
         };
         match point.and_then(|k| points.at.get(k)) {
-            Some(at) => point_error(cx, field, at, e.to_string()),
-            None => cx.at.error(field, e.to_string()),
+            Some(at) => point_error(cx, field, at, cell, message),
+            None => cx.at.error(field, message),
         }
-    })
+    })?;
+    let overflow = spline.knot_curvatures().iter().position(|m| !m.is_finite());
+    match overflow.and_then(|k| points.at.get(k)) {
+        Some(at) => Err(point_error(
+            cx,
+            field,
+            at,
+            0,
+            "the spline's curvature overflows at this point: its neighbours are too close for \
+             the change of value between them"
+                .to_string(),
+        )),
+        None => Ok(spline),
+    }
 }
 
-/// A polar table covers exactly one turn.
+/// A polar table covers exactly one turn: its last angle is the first plus 2π (360°).
 fn one_turn(
     cx: &Context,
     field: &str,
@@ -230,6 +376,9 @@ fn one_turn(
     theta: &[f64],
     degrees: bool,
 ) -> Checked<()> {
+    if theta.len() < 2 {
+        return Ok(());
+    }
     let span = theta[theta.len() - 1] - theta[0];
     if (span - TAU).abs() <= CLOSURE_TOLERANCE * TAU {
         return Ok(());
@@ -244,20 +393,32 @@ fn one_turn(
         cx,
         field,
         &points.at[last],
+        0,
         format!(
             "a polar table covers one turn, its last point repeating the first {turn} later, \
-             but its angles span {shown}{}",
-            if degrees { "°" } else { " rad" }
+             but its angles span {shown}{}{}",
+            if degrees { "°" } else { " rad" },
+            if span < TAU {
+                " (is the closing row missing?)"
+            } else {
+                ""
+            }
         ),
     ))
 }
 
 /// The table's points, from the model file or from its CSV file.
-fn points(cx: &Context, field: &str, table: &raw::Table, names: [&str; 2]) -> Checked<Points> {
+fn points(
+    cx: &Context,
+    field: &str,
+    table: &raw::Table,
+    names: [&'static str; 2],
+) -> Checked<Points> {
     match (&table.points, &table.file) {
         (Some(points), None) => Ok(Points {
             values: points.iter().map(|&(a, b)| [a, b]).collect(),
             at: (0..points.len()).map(At::Inline).collect(),
+            names,
             from: None,
         }),
         (None, Some(written)) => {
@@ -276,9 +437,10 @@ fn points(cx: &Context, field: &str, table: &raw::Table, names: [&str; 2]) -> Ch
                     .map(|r| At::File {
                         file: shown.clone(),
                         line: r.line,
-                        column: r.columns[0],
+                        columns: r.columns,
                     })
                     .collect(),
+                names,
                 from: Some(written.clone()),
             })
         }
@@ -290,14 +452,19 @@ fn points(cx: &Context, field: &str, table: &raw::Table, names: [&str; 2]) -> Ch
     }
 }
 
-/// An error about one point of a table.
-fn point_error(cx: &Context, field: &str, at: &At, message: String) -> ModelError {
+/// An error about one point of a table: at `points[k]` in the model file, or at the line
+/// and the column of its cell `cell` (0 or 1) in a table file.
+fn point_error(cx: &Context, field: &str, at: &At, cell: usize, message: String) -> ModelError {
     match at {
         At::Inline(k) => cx.at.error(&format!("{field}.points[{k}]"), message),
-        At::File { file, line, column } => ModelError {
+        At::File {
+            file,
+            line,
+            columns,
+        } => ModelError {
             file: file.clone(),
             line: *line,
-            column: *column,
+            column: columns[cell.min(1)],
             field: format!("{field}.file"),
             message,
         },
