@@ -10,6 +10,7 @@ mod common;
 mod repartition;
 mod signals;
 mod special_files;
+mod streaming;
 mod stress;
 mod sweep;
 mod trust;
