@@ -21,7 +21,7 @@ pub const ATOL_RANGE: (f64, f64) = (1e-18, 1.0);
 /// The most samples, (t_end − t0) / dt_out, of a run that keeps them in its trajectory
 /// (`simulate` and every variant whose monitor keeps its samples, see
 /// [`crate::Monitor::keep_samples`]): each holds a few vectors of the model's size, so a
-/// million are some hundred megabytes (about 720 MB for `paper_concave`, 4.2 GB for
+/// million are some hundred megabytes (about 780 MB for `paper_concave`, 4.2 GB for
 /// `n_four_bar`); more is almost surely a mistyped `dt_out` or `t_end`. A model file's
 /// `simulation` section is held to the same number (`camchain-codegen`).
 pub const MAX_SAMPLES: f64 = 1e6;
