@@ -358,8 +358,10 @@ pub struct IntegrationArgs {
     #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub t_end: Option<f64>,
 
-    /// Output interval in seconds: one CSV row and one plotted point per interval (for a
-    /// sweep, the grid of --grid) [default: the model's]
+    /// Output interval in seconds: one CSV row per interval, and one plotted point up to
+    /// 20 000 of them (a longer run's figures are drawn from every k-th); at most 1e9
+    /// intervals (1e6 with --csv -, whose rows are kept until the run ends). For a sweep,
+    /// the grid of --grid [default: the model's]
     #[arg(long, value_name = "SECONDS", value_parser = positive_time, allow_hyphen_values = true)]
     pub dt_out: Option<f64>,
 

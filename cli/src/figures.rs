@@ -15,7 +15,7 @@
 
 use super::kinematics::Geometry;
 use super::plots::{Figure, Frame, LinePanel, MechanismPanel, Panel, Row, Series, time_color};
-use super::summary::{lift_off, unit};
+use super::summary::{LiftOff, unit};
 use camchain_runtime::{CoordinateKind, ModelInfo, Sample};
 use plotters::style::RGBColor;
 
@@ -38,8 +38,14 @@ pub struct RunView<'a> {
     pub label: &'a str,
     /// The model.
     pub info: &'a ModelInfo,
-    /// The samples.
+    /// The samples drawn, in time order: all of a short run's, a long run's decimated
+    /// (`simulate::decimated`: evenly spaced, the first, the last and the markers' kept
+    /// exactly), thinned to what the figures read (t, q, q̇, q̈, normal forces, the
+    /// contacts' h, contact geometry).
     pub samples: &'a [Sample],
+    /// Where each contact's normal force first turns negative, from every sample of the run
+    /// (the contact figure's markers).
+    pub lift_offs: &'a [Option<LiftOff>],
     /// The model's geometry, for snapshots.
     pub geometry: Option<&'a Geometry>,
 }
@@ -204,7 +210,11 @@ pub fn contact(run: &RunView) -> Option<Figure> {
             .iter()
             .map(|s| (s.t, s.normal_force[k]))
             .collect();
-        let markers = lift_off(run.samples, k)
+        let markers = run
+            .lift_offs
+            .get(k)
+            .copied()
+            .flatten()
             .map(|l| vec![(l.t, format!("lift-off at t ≈ {:.3} s", l.t))])
             .unwrap_or_default();
         let y_range = padded(union(data_range(force.iter().map(|p| p.1)), (0.0, 0.0)));

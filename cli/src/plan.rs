@@ -83,13 +83,18 @@ fn given_twice(model: &LoadedModel, first: &str) -> CliError {
 }
 
 /// The run's settings: the model's defaults overridden by the options, within the
-/// runtime's ranges; `--restitution` only where one-sided contact can run.
+/// runtime's ranges (those of a run that streams its samples, or, for a CSV written to
+/// standard output at the end, of one that keeps them); `--restitution` only where
+/// one-sided contact can run.
 fn checked_settings(model: &LoadedModel, args: &SimulateArgs) -> Result<SimSettings, CliError> {
     let info = model.engine.dynamics().info();
     let settings = args.settings(&info.defaults);
-    settings
-        .validate(0.0)
-        .map_err(|e| setting_error(&e, args, model))?;
+    if args.csv_to_stdout() {
+        settings.validate(0.0)
+    } else {
+        settings.validate_streamed(0.0)
+    }
+    .map_err(|e| setting_error(&e, args, model))?;
     if args.restitution(info.restitution).is_some() {
         if !settings.integrator.is_adaptive() {
             return Err(CliError::Usage(format!(

@@ -51,6 +51,17 @@ pub trait Monitor {
         let _ = progress;
         Observed::Continue(())
     }
+
+    /// Whether the run keeps every sample in its trajectory (the default) or only the last
+    /// one. A monitor that consumes the samples as they come (writes them to a file, digests
+    /// them) returns false: the run's memory then does not grow with its length, its
+    /// trajectory holds the last sample (the last accepted state after a failure) and
+    /// counts the others in [`crate::Trajectory::sample_count`], and its output times are
+    /// held to [`crate::settings::MAX_STREAMED_SAMPLES`] instead of
+    /// [`crate::settings::MAX_SAMPLES`]. Asked once, when the run starts.
+    fn keep_samples(&self) -> bool {
+        true
+    }
 }
 
 /// A monitor that watches nothing.

@@ -262,7 +262,8 @@ pub(crate) fn run_metrics<D: Dynamics + ?Sized>(
         steps: 0,
         t_end: settings.t_end,
     };
-    let outcome = validate_run(model, &state, settings).and_then(|()| {
+    // A metrics run keeps no samples: held to the streamed runs' cap on its output times.
+    let outcome = validate_run(model, &state, settings, false).and_then(|()| {
         if settings.integrator.is_adaptive() {
             state.engine.stages.watch(model.info().n_contacts());
             let outcome = adaptive_run(model, &mut state, settings, options, &mut acc, &mut pace);

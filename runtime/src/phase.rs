@@ -50,9 +50,15 @@ impl Grid {
 }
 
 /// What a run keeps across its phases: the samples (each shown to the monitor as soon as it
-/// is recorded), the events, the work done, and the pace of its steps.
+/// is recorded; all of them, or only the last when the monitor keeps none), the events, the
+/// work done, and the pace of its steps.
 pub(crate) struct Recorder<'m> {
+    /// Every sample in time order, or only the last one (see [`Monitor::keep_samples`]).
     pub(crate) samples: Vec<Sample>,
+    /// Samples recorded, kept or not.
+    pub(crate) count: usize,
+    /// Whether every sample is kept.
+    keep: bool,
     pub(crate) events: Vec<ContactEvent>,
     pub(crate) stats: Stats,
     monitor: &'m mut dyn Monitor,
@@ -67,6 +73,8 @@ impl<'m> Recorder<'m> {
     pub(crate) fn new(monitor: &'m mut dyn Monitor, settings: &SimSettings, t0: f64) -> Self {
         Recorder {
             samples: Vec::new(),
+            count: 0,
+            keep: monitor.keep_samples(),
             events: Vec::new(),
             stats: Stats::default(),
             monitor,
@@ -83,12 +91,28 @@ impl<'m> Recorder<'m> {
     pub(crate) fn emit(&mut self, sample: Sample) -> Result<(), SimError> {
         let flow = self.monitor.sample(&sample);
         let t = sample.t;
-        self.samples.push(sample);
+        self.keep_sample(sample);
         self.watchdog.output_reached();
         if flow.is_break() {
             Err(SimError::Interrupted { t })
         } else {
             Ok(())
+        }
+    }
+
+    /// Whether every sample is kept (the monitor's choice when the run started).
+    pub(crate) fn keeps_samples(&self) -> bool {
+        self.keep
+    }
+
+    /// Counts a sample and keeps it: after the others, or in place of the last one when the
+    /// run keeps only that. Not shown to the monitor (the last accepted state after a
+    /// failure goes through here alone).
+    pub(crate) fn keep_sample(&mut self, sample: Sample) {
+        self.count += 1;
+        match self.samples.last_mut() {
+            Some(last) if !self.keep => *last = sample,
+            _ => self.samples.push(sample),
         }
     }
 
@@ -618,13 +642,19 @@ enum Crossing {
 }
 
 /// Number of output intervals: the last one may be shorter and ends at t_end. A remainder
-/// below 1e-9·dt_out is round-off, not an interval.
+/// below 1e-9·dt_out (or the quotient's round-off, on grids of more than a million
+/// intervals) is not an interval.
 pub(crate) fn output_intervals(t0: f64, settings: &SimSettings) -> usize {
     let span = settings.t_end - t0;
     if span <= 0.0 {
         return 0;
     }
-    (span / settings.dt_out - 1e-9).ceil().max(1.0) as usize
+    // A quotient within round-off (4 ulp, at least 1e-9) of a whole number is that number:
+    // no extra interval of zero length at t_end.
+    let ratio = span / settings.dt_out;
+    (ratio - (4.0 * f64::EPSILON * ratio).max(1e-9))
+        .ceil()
+        .max(1.0) as usize
 }
 
 /// t0 + k·dt_out (computed by multiplication: no accumulated round-off), t_end for the last.
@@ -633,5 +663,39 @@ pub(crate) fn output_time(t0: f64, k: usize, intervals: usize, settings: &SimSet
         settings.t_end
     } else {
         t0 + k as f64 * settings.dt_out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::IntegratorKind;
+
+    fn grid(t_end: f64, dt_out: f64) -> SimSettings {
+        SimSettings {
+            t_end,
+            dt_out,
+            integrator: IntegratorKind::Dop853,
+            dt: 1e-3,
+            rtol: 1e-9,
+            atol: 1e-12,
+        }
+    }
+
+    #[test]
+    fn long_grids_have_no_interval_of_round_off() {
+        // 0.1 + 123 456 789 · 0.01 s: the quotient (t_end − t0)/dt_out comes out as
+        // 123456789.00000001, a round-off of 1.5e-8 that the former absolute tolerance of
+        // 1e-9 took for one more interval (two samples at t_end). Streamed runs may have
+        // such grids.
+        let t0 = 0.1;
+        let settings = grid(t0 + 123_456_789.0 * 0.01, 0.01);
+        assert_eq!(output_intervals(t0, &settings), 123_456_789);
+        // A true remainder is still an interval, and short grids are counted as before.
+        let settings = grid(t0 + 123_456_789.5 * 0.01, 0.01);
+        assert_eq!(output_intervals(t0, &settings), 123_456_790);
+        assert_eq!(output_intervals(0.0, &grid(10.0, 0.01)), 1000);
+        assert_eq!(output_intervals(0.0, &grid(1.0 + 1e-7, 1e-3)), 1001);
+        assert_eq!(output_intervals(0.0, &grid(0.0, 0.01)), 0);
     }
 }

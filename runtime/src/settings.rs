@@ -18,10 +18,23 @@ pub const RTOL_RANGE: (f64, f64) = (1e-14, 0.1);
 /// a radian or a metre of error is accepted.
 pub const ATOL_RANGE: (f64, f64) = (1e-18, 1.0);
 
-/// The most samples a run keeps (t_end / dt_out): each holds a few vectors of the model's
-/// size, so a million are some hundred megabytes; more is almost surely a mistyped
-/// `dt_out` or `t_end`.
+/// The most samples, (t_end − t0) / dt_out, of a run that keeps them in its trajectory
+/// (`simulate` and every variant whose monitor keeps its samples, see
+/// [`crate::Monitor::keep_samples`]): each holds a few vectors of the model's size, so a
+/// million are some hundred megabytes (about 780 MB for `paper_concave`, 4.2 GB for
+/// `n_four_bar`); more is almost surely a mistyped `dt_out` or `t_end`. A model file's
+/// `simulation` section is held to the same number (`camchain-codegen`).
 pub const MAX_SAMPLES: f64 = 1e6;
+
+/// The most output times, (t_end − t0) / dt_out, of a run that keeps no samples: a run
+/// whose monitor only streams them ([`crate::Monitor::keep_samples`] false, what
+/// `camchain simulate` does when its CSV goes to a file) or a metrics run (what a sweep
+/// runs; its output times matter only with `MetricsOptions::grid`). Its memory does not
+/// grow with its length, so this is no memory bound but one on the work and the output: a
+/// billion samples take a quarter of an hour at the cheapest microsecond each (hours for
+/// most models) and, written to a CSV, some hundred gigabytes; more is almost surely a
+/// mistyped `dt_out` or `t_end`.
+pub const MAX_STREAMED_SAMPLES: f64 = 1e9;
 
 /// Accepted steps allowed in one call of `step`/`step_with`, or per output interval of
 /// `simulate`, before `SimError::TooManySteps`.
@@ -46,7 +59,7 @@ impl fmt::Display for InvalidSetting {
 impl std::error::Error for InvalidSetting {}
 
 impl SimSettings {
-    /// Checks the settings for a run that starts at `t0`:
+    /// Checks the settings for a run that starts at `t0` and keeps its samples:
     /// [`validate_integration`](Self::validate_integration), then
     /// [`validate_output`](Self::validate_output).
     ///
@@ -55,6 +68,17 @@ impl SimSettings {
     pub fn validate(&self, t0: f64) -> Result<(), InvalidSetting> {
         self.validate_integration()?;
         self.validate_output(t0)
+    }
+
+    /// [`validate`](Self::validate) for a run that keeps no samples (streamed to its
+    /// monitor, or a metrics run): at most [`MAX_STREAMED_SAMPLES`] output times instead of
+    /// [`MAX_SAMPLES`].
+    ///
+    /// # Errors
+    /// The first setting out of range, with its field and value.
+    pub fn validate_streamed(&self, t0: f64) -> Result<(), InvalidSetting> {
+        self.validate_integration()?;
+        self.validate_streamed_output(t0)
     }
 
     /// The integration settings alone (what `step_with` needs): a positive, finite `dt`;
@@ -71,13 +95,28 @@ impl SimSettings {
         Ok(())
     }
 
-    /// The output settings of a run from `t0`: a positive, finite `dt_out`, a finite
-    /// `t_end` ≥ t0, at most [`MAX_SAMPLES`] samples and, for RK4, at most
-    /// [`MAX_STEPS_PER_CALL`] steps per output interval.
+    /// The output settings of a run from `t0` that keeps its samples: a positive, finite
+    /// `dt_out`, a finite `t_end` ≥ t0, at most [`MAX_SAMPLES`] samples and, for RK4, at
+    /// most [`MAX_STEPS_PER_CALL`] steps per output interval.
     ///
     /// # Errors
     /// The first setting out of range.
     pub fn validate_output(&self, t0: f64) -> Result<(), InvalidSetting> {
+        self.output_within(t0, MAX_SAMPLES, "a run keeps")
+    }
+
+    /// [`validate_output`](Self::validate_output) for a run that keeps no samples: at most
+    /// [`MAX_STREAMED_SAMPLES`] output times.
+    ///
+    /// # Errors
+    /// The first setting out of range.
+    pub fn validate_streamed_output(&self, t0: f64) -> Result<(), InvalidSetting> {
+        self.output_within(t0, MAX_STREAMED_SAMPLES, "a run streams")
+    }
+
+    /// The output checks with at most `cap` samples (`whose`: what the cap is of, for the
+    /// message).
+    fn output_within(&self, t0: f64, cap: f64, whose: &str) -> Result<(), InvalidSetting> {
         positive("dt_out", self.dt_out)?;
         if !(self.t_end.is_finite() && self.t_end >= t0) {
             return Err(invalid(
@@ -89,12 +128,12 @@ impl SimSettings {
             ));
         }
         let samples = (self.t_end - t0) / self.dt_out;
-        if samples > MAX_SAMPLES {
+        if samples > cap {
             return Err(invalid(
                 "t_end/dt_out",
                 format!(
                     "t_end = {} s with dt_out = {} s gives {samples:.3e} samples, more than the \
-                     {MAX_SAMPLES:e} a run keeps: a larger dt_out or a smaller t_end",
+                     {cap:e} {whose}: a larger dt_out or a smaller t_end",
                     self.t_end, self.dt_out
                 ),
             ));
@@ -211,6 +250,31 @@ mod tests {
         assert_eq!(s.validate(0.0), Ok(()));
         s.dt = 1e-12;
         assert_eq!(s.validate(0.0).map_err(|e| e.field), Err("dt"));
+    }
+
+    #[test]
+    fn streamed_runs_have_their_own_cap() {
+        // Ten million samples: more than a run keeps, far fewer than one streams.
+        let mut s = settings(IntegratorKind::Dop853);
+        s.t_end = 1e5;
+        let kept = s.validate(0.0).unwrap_err();
+        assert_eq!(kept.field, "t_end/dt_out");
+        assert!(kept.message.contains("the 1e6 a run keeps"), "{kept}");
+        assert_eq!(s.validate_streamed(0.0), Ok(()));
+        // At the cap and beyond it.
+        s.t_end = MAX_STREAMED_SAMPLES * s.dt_out;
+        assert_eq!(s.validate_streamed(0.0), Ok(()));
+        s.t_end *= 1.001;
+        let streamed = s.validate_streamed(0.0).unwrap_err();
+        assert_eq!(streamed.field, "t_end/dt_out");
+        assert!(
+            streamed.message.contains("the 1e9 a run streams"),
+            "{streamed}"
+        );
+        // Everything else is checked as for a kept run.
+        s.t_end = 1e5;
+        s.rtol = 1.0;
+        assert_eq!(s.validate_streamed(0.0).map_err(|e| e.field), Err("rtol"));
     }
 
     #[test]

@@ -27,8 +27,12 @@ pub use crate::stepping::{State, Stats};
 /// Samples at the output times and the work done.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Trajectory {
-    /// Samples in time order.
+    /// Samples in time order: all of them, or only the last when the run's monitor keeps
+    /// none ([`Monitor::keep_samples`]).
     pub samples: Vec<Sample>,
+    /// How many samples the run computed (at the output times, plus the last accepted state
+    /// after a failure), kept or not: `samples.len()` when every sample is kept.
+    pub sample_count: usize,
     /// Contact events in time order: sign changes of the normal forces (runs of the
     /// adaptive integrators with full samples), lift-offs and impacts (unilateral runs).
     pub events: Vec<ContactEvent>,
@@ -38,12 +42,13 @@ pub struct Trajectory {
 
 /// A simulation that stopped early: the error and everything computed until then.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("simulation stopped after {} samples: {error}", partial.samples.len())]
+#[error("simulation stopped after {} samples: {error}", partial.sample_count)]
 pub struct SimFailure {
     /// Why the simulation stopped.
     pub error: SimError,
     /// Samples at the output times reached, plus one at the last accepted state when it
-    /// lies past the last output time; work counters until the failure.
+    /// lies past the last output time (only the last of them when the monitor keeps none);
+    /// work counters until the failure.
     pub partial: Trajectory,
 }
 
@@ -253,8 +258,10 @@ pub trait Simulate: Dynamics {
     /// The general run: `law` bilateral or one-sided, `monitor` shown every sample as soon as
     /// it is computed and called after every accepted step (progress, interrupts: a monitor
     /// that returns `Observed::Break(())` stops the run within one step, with
-    /// [`SimError::Interrupted`] and everything computed so far). Every other `simulate`
-    /// method is this one with a fixed law or monitor.
+    /// [`SimError::Interrupted`] and everything computed so far). A monitor that keeps no
+    /// samples ([`Monitor::keep_samples`]) gets a trajectory with the last sample only, and a
+    /// run whose memory does not grow with its length. Every other `simulate` method is this
+    /// one with a fixed law or monitor.
     fn simulate_monitored(
         &self,
         state: State,
@@ -279,7 +286,8 @@ fn run<D: Dynamics + ?Sized>(
     monitor: &mut dyn Monitor,
 ) -> Result<Trajectory, Box<SimFailure>> {
     let mut record = Recorder::new(monitor, settings, state.t);
-    if settings.dt_out > 0.0 && settings.t_end.is_finite() && state.t.is_finite() {
+    let keep = record.keeps_samples();
+    if keep && settings.dt_out > 0.0 && settings.t_end.is_finite() && state.t.is_finite() {
         // One sample per output time plus the start, capped (the count itself is checked
         // below; a reservation for a run that then fails the checks is harmless).
         let expected = output_intervals(state.t, settings).saturating_add(1);
@@ -288,7 +296,7 @@ fn run<D: Dynamics + ?Sized>(
     let outcome = match law {
         ContactLaw::Bilateral => {
             let mut state = state;
-            let outcome = validate_run(model, &state, settings).and_then(|()| {
+            let outcome = validate_run(model, &state, settings, keep).and_then(|()| {
                 if settings.integrator.is_adaptive() {
                     run_dense(model, &mut state, settings, level, &mut record)
                 } else {
@@ -296,7 +304,7 @@ fn run<D: Dynamics + ?Sized>(
                 }
             });
             if outcome.is_err() {
-                append_last_state(model, &mut state, &mut record.samples, level);
+                append_last_state(model, &mut state, &mut record, level);
             }
             outcome
         }
@@ -306,6 +314,7 @@ fn run<D: Dynamics + ?Sized>(
     };
     let trajectory = Trajectory {
         samples: record.samples,
+        sample_count: record.count,
         events: record.events,
         stats: record.stats,
     };
@@ -380,13 +389,13 @@ fn run_dense<D: Dynamics + ?Sized>(
 fn append_last_state<D: Dynamics + ?Sized>(
     model: &D,
     state: &mut State,
-    samples: &mut Vec<Sample>,
+    record: &mut Recorder,
     level: SampleLevel,
 ) {
-    let newer = samples.last().is_none_or(|last| state.t > last.t);
+    let newer = record.samples.last().is_none_or(|last| state.t > last.t);
     if newer && !state.modified_since_last_step() {
         if let Ok(sample) = sample_in_place(model, state, level) {
-            samples.push(sample);
+            record.keep_sample(sample);
         }
     }
 }

@@ -320,8 +320,14 @@ pub(crate) fn validate_integration(settings: &SimSettings) -> Result<(), SimErro
     settings.validate_integration().map_err(setting_error)
 }
 
-fn validate_output(settings: &SimSettings, t0: f64) -> Result<(), SimError> {
-    settings.validate_output(t0).map_err(setting_error)
+/// The output settings of a run from `t0` that keeps its samples (`keep`) or streams them.
+fn validate_output(settings: &SimSettings, t0: f64, keep: bool) -> Result<(), SimError> {
+    if keep {
+        settings.validate_output(t0)
+    } else {
+        settings.validate_streamed_output(t0)
+    }
+    .map_err(setting_error)
 }
 
 fn setting_error(e: crate::settings::InvalidSetting) -> SimError {
@@ -541,16 +547,18 @@ pub(crate) fn add_phase_counters(stats: &mut Stats, state: &State, before: [Coun
     add_counters_since(stats, &state.engine, before);
 }
 
-/// The checks every run makes before it starts.
+/// The checks every run makes before it starts; `keep`: the run keeps its samples (at most
+/// `MAX_SAMPLES` of them) rather than streaming them or keeping none.
 pub(crate) fn validate_run<D: Dynamics + ?Sized>(
     model: &D,
     state: &State,
     settings: &SimSettings,
+    keep: bool,
 ) -> Result<(), SimError> {
     check_belongs(model, state)
         .and_then(|()| check_finite_state(state))
         .and_then(|()| validate_integration(settings))
-        .and_then(|()| validate_output(settings, state.t))
+        .and_then(|()| validate_output(settings, state.t, keep))
 }
 
 /// The counters of the three integrators of an engine.

@@ -249,9 +249,9 @@ fn validate_unilateral<D: Dynamics + ?Sized>(
     model: &D,
     state: &State,
     settings: &SimSettings,
-    restitution: f64,
+    (restitution, keep): (f64, bool),
 ) -> Result<(), SimError> {
-    validate_run(model, state, settings)?;
+    validate_run(model, state, settings, keep)?;
     let invalid = |message: String| Err(SimError::InvalidSettings { message });
     if !model.info().loops.is_empty() {
         return invalid(format!(
@@ -292,7 +292,8 @@ pub(crate) fn run_phases<D: Dynamics + ?Sized>(
     restitution: f64,
     record: &mut Recorder,
 ) -> Result<(), SimError> {
-    validate_unilateral(model, &state, settings, restitution)?;
+    let keep = record.keeps_samples();
+    validate_unilateral(model, &state, settings, (restitution, keep))?;
     let detached = Detached::new(model);
     let tolerance = landing_tolerance(settings, state.length_scale());
     let n = model.info().n();

@@ -159,9 +159,10 @@ pub fn plan(args: &SweepArgs) -> Result<Plan, CliError> {
         None => Shard::ALL,
     };
     let settings = args.settings(&defaults);
+    // A sweep's runs keep no samples: held to the streamed runs' cap, not to a kept
+    // trajectory's.
     settings
-        .validate_integration()
-        .and_then(|()| settings.validate_output(0.0))
+        .validate_streamed(0.0)
         .map_err(|e| usage(format!("settings: {e}")))?;
     let jobs = match args.jobs {
         Some(0) => return Err(usage("--jobs must be at least 1".to_string())),

@@ -12,6 +12,7 @@ mod merge;
 mod repartition;
 mod signals;
 mod special_files;
+mod streaming;
 mod stress;
 mod sweep;
 mod trust;

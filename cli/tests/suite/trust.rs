@@ -147,8 +147,10 @@ fn a_typo_in_dt_out_or_t_end_is_refused_and_the_previous_run_survives() {
         let stderr = text(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{flag}: {stderr}");
         assert!(stderr.starts_with(&format!("error: {flag}: ")), "{stderr}");
+        // A run that streams its CSV keeps no trajectory (issue 25): held to the billion
+        // samples a streamed run may have.
         assert!(
-            stderr.contains("samples, more than the 1e6 a run keeps"),
+            stderr.contains("samples, more than the 1e9 a run streams"),
             "{stderr}"
         );
         assert_eq!(

@@ -956,3 +956,5 @@ fn invalid_settings_are_rejected() {
     ));
     assert!(state.set_dependent(&[0, 1]).is_err());
 }
+
+mod streamed;

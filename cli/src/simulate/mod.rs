@@ -8,6 +8,14 @@
 //! the destination stays as it was); Ctrl-C or SIGTERM stops the running simulation within
 //! one step, keeps the partial CSV, says where, and exits with 130 or 143. A run that fails
 //! does not stop the others; the command then exits with code 1.
+//!
+//! A run keeps no trajectory (issue 25): each sample goes, as it is computed, to the CSV
+//! stream, to the summary's [`Digest`] and, when figures are drawn, to their bounded copy
+//! ([`decimated`]); its memory does not grow with its length. Only a CSV written at the end
+//! (to standard output or a special file) keeps every sample, and is held to the runtime's
+//! cap on kept samples.
+
+mod decimated;
 
 use super::CliError;
 use super::args::SimulateArgs;
@@ -17,11 +25,12 @@ use super::output::{CsvSink, Saved};
 use super::plan::{Job, plan};
 use super::plots::Figure;
 use super::progress::Progress;
-use super::summary::{self, RunReport};
+use super::summary::{self, Digest, LiftOff, RunReport};
 use camchain_runtime::{
     Cancel, ContactLaw, Monitor, Observed, Progress as StepProgress, Sample, SimError, Simulate,
     Trajectory,
 };
+use decimated::Decimated;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -53,16 +62,24 @@ impl Console {
     }
 }
 
+/// What the figures of a complete run are drawn from.
+struct Drawn {
+    /// The decimated copy of its samples.
+    samples: Vec<Sample>,
+    /// Where each contact's normal force first turned negative.
+    lift_offs: Vec<Option<LiftOff>>,
+}
+
 /// A completed run, kept for the side-by-side figures.
 struct Done {
     job: usize,
-    trajectory: Trajectory,
+    drawn: Drawn,
 }
 
 /// How one run ended.
 enum Outcome {
-    /// Complete, with its trajectory.
-    Done(Trajectory),
+    /// Complete, with what its figures are drawn from.
+    Done(Drawn),
     /// Failed (reported).
     Failed,
     /// Stopped by Ctrl-C (reported).
@@ -81,10 +98,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     let mut done = Vec::new();
     for (index, job) in jobs.iter().enumerate() {
         match run_job(job, args, &console, &interrupt) {
-            Outcome::Done(trajectory) => done.push(Done {
-                job: index,
-                trajectory,
-            }),
+            Outcome::Done(drawn) => done.push(Done { job: index, drawn }),
             Outcome::Failed => failed = true,
             Outcome::Interrupted => return Err(interrupt.error()),
         }
@@ -154,12 +168,20 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     for warning in summary::assembly_warnings(info, &report, state.length_scale()) {
         console.warn(label, &warning);
     }
+    // A CSV written at the end needs every sample; one streamed to its file needs none.
+    let keep = sink.partial().is_none();
     let mut watcher = Watcher {
         progress: Progress::new(label, 0.0, settings.t_end, !args.quiet),
         sink: &mut sink,
         info,
         write_error: None,
         cancel: Cancel(interrupt.flag()),
+        digest: Digest::new(info),
+        figures: job
+            .figures
+            .as_ref()
+            .map(|_| Decimated::new(info.n_contacts())),
+        keep,
     };
     let law = match args.restitution(info.restitution) {
         Some(restitution) => ContactLaw::Unilateral { restitution },
@@ -169,6 +191,8 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
     let Watcher {
         progress,
         write_error,
+        digest,
+        figures: decimated,
         ..
     } = watcher;
     progress.finish();
@@ -192,8 +216,14 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
             ok = false;
         }
     }
+    let drawn = Drawn {
+        samples: decimated.map(Decimated::finish).unwrap_or_default(),
+        lift_offs: digest.lift_offs().to_vec(),
+    };
+    // The samples a CSV written at the end needed: written, and freed before the figures.
+    drop(trajectory.samples);
     if let Some(dir) = &job.figures {
-        match draw_run(job, &trajectory, dir, console) {
+        match draw_run(job, &drawn, dir, console) {
             Ok(paths) => written.extend(paths),
             Err(message) => {
                 eprintln!("error: {label}: {message}");
@@ -207,17 +237,19 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
         engine: &engine,
         info,
         settings,
-        samples: &trajectory.samples,
+        digest: &digest,
         events: &trajectory.events,
         stats: trajectory.stats,
         wall,
     }));
-    for warning in summary::result_warnings(
-        info,
-        &trajectory.samples,
-        matches!(law, ContactLaw::Unilateral { .. }),
-    ) {
+    for warning in
+        summary::result_warnings(info, &digest, matches!(law, ContactLaw::Unilateral { .. }))
+    {
         console.warn(label, &warning);
+    }
+    // The process's peak so far, as a sweep reports it: flat in the run's length.
+    if let Some(peak) = super::sweep::peak_memory_mb() {
+        console.say(&format!("  peak memory {peak:.1} MB\n"));
     }
     if !written.is_empty() {
         console.say(&format!(
@@ -226,25 +258,36 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
         ));
     }
     if ok {
-        Outcome::Done(trajectory)
+        Outcome::Done(drawn)
     } else {
         Outcome::Failed
     }
 }
 
-/// What a run shows and writes while it goes: each sample's CSV row and the progress; after
-/// every step, the progress and the interrupt flag.
+/// What a run shows and writes while it goes: each sample's CSV row, the progress, the
+/// summary's digest and the figures' copy; after every step, the progress and the interrupt
+/// flag.
 struct Watcher<'a> {
     progress: Progress,
     sink: &'a mut CsvSink,
     info: &'a camchain_runtime::ModelInfo,
     write_error: Option<String>,
     cancel: Cancel<'a>,
+    /// What the summary needs of the samples.
+    digest: Digest,
+    /// What the figures are drawn from, when they are.
+    figures: Option<Decimated>,
+    /// Whether the run keeps every sample (for a CSV written at the end).
+    keep: bool,
 }
 
 impl Monitor for Watcher<'_> {
     fn sample(&mut self, sample: &Sample) -> Observed {
         self.progress.update(sample.t);
+        self.digest.add(sample);
+        if let Some(figures) = &mut self.figures {
+            figures.add(sample);
+        }
         if let Err(e) = self.sink.row(self.info, sample) {
             let file = self.sink.partial().map(|p| p.display().to_string());
             self.write_error = Some(format!("cannot write {}: {e}", file.unwrap_or_default()));
@@ -260,6 +303,10 @@ impl Monitor for Watcher<'_> {
     fn step(&mut self, progress: &StepProgress) -> Observed {
         self.progress.update_step(progress.t, progress.h);
         self.cancel.step(progress)
+    }
+
+    fn keep_samples(&self) -> bool {
+        self.keep
     }
 }
 
@@ -284,7 +331,7 @@ fn report_failure(
         ),
         (None, false) => eprintln!("error: {label}: {error}"),
     }
-    let samples = trajectory.samples.len();
+    let samples = trajectory.sample_count;
     match saved {
         Ok(Saved::Partial(path)) => eprintln!(
             "{label}: the {samples} samples computed until then are in {}",
@@ -300,11 +347,12 @@ fn report_failure(
     }
 }
 
-fn view<'a>(job: &'a Job, trajectory: &'a Trajectory) -> RunView<'a> {
+fn view<'a>(job: &'a Job, drawn: &'a Drawn) -> RunView<'a> {
     RunView {
         label: &job.model.label,
         info: job.model.engine.dynamics().info(),
-        samples: &trajectory.samples,
+        samples: &drawn.samples,
+        lift_offs: &drawn.lift_offs,
         geometry: job.model.geometry.as_ref().ok(),
     }
 }
@@ -312,11 +360,11 @@ fn view<'a>(job: &'a Job, trajectory: &'a Trajectory) -> RunView<'a> {
 /// The figures of one run; a note when the snapshots cannot be drawn.
 fn draw_run(
     job: &Job,
-    trajectory: &Trajectory,
+    drawn: &Drawn,
     dir: &Path,
     console: &Console,
 ) -> Result<Vec<PathBuf>, String> {
-    let run = view(job, trajectory);
+    let run = view(job, drawn);
     let mut figures: Vec<(Figure, &str)> =
         vec![(figures::histories(&run, &job.coords), "histories")];
     match figures::snapshots(&run) {
@@ -373,8 +421,8 @@ fn draw_pairs(
             args.coords.iter().map(|c| c.trim().to_string()).collect()
         };
         let figure = figures::comparison(
-            &view(&jobs[a.job], &a.trajectory),
-            &view(&jobs[b.job], &b.trajectory),
+            &view(&jobs[a.job], &a.drawn),
+            &view(&jobs[b.job], &b.drawn),
             &coords,
         );
         let suffix = if first.engine.is_numeric() {

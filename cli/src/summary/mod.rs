@@ -6,13 +6,25 @@
 //! work` stayed constant, the integrator's work (steps, rejected steps, right-hand sides,
 //! re-partitions) and the wall time, and warns when a normal force becomes negative: a
 //! real, one-sided follower would lift off the cam there.
+//!
+//! Everything it says of the samples comes from a [`Digest`], which takes them in one at a
+//! time as the run computes them: a run's summary costs memory that does not grow with its
+//! length.
+
+mod digest;
+#[cfg(test)]
+mod legacy;
+#[cfg(test)]
+mod tests;
+
+pub use digest::Digest;
 
 use super::args::integrator_name;
 use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::{
-    ContactInfo, CoordinateKind, FollowerKind, IntegratorKind, ModelInfo, ProfileKind, Sample,
-    SimSettings, Stats,
+    ContactInfo, CoordinateKind, FollowerKind, IntegratorKind, ModelInfo, ProfileKind, SimSettings,
+    Stats,
 };
 use std::fmt::Write;
 use std::time::Duration;
@@ -27,8 +39,8 @@ pub struct RunReport<'a> {
     pub info: &'a ModelInfo,
     /// The settings used.
     pub settings: &'a SimSettings,
-    /// The samples (all of them, or those computed before a failure).
-    pub samples: &'a [Sample],
+    /// What the summary needs of the run's samples, taken in as they were computed.
+    pub digest: &'a Digest,
     /// Contact events located during the run (adaptive integrators).
     pub events: &'a [ContactEvent],
     /// The integrator's work.
@@ -47,25 +59,6 @@ pub struct LiftOff {
     pub from_start: bool,
 }
 
-/// Where the normal force of contact `k` first turns negative, if it does.
-pub fn lift_off(samples: &[Sample], k: usize) -> Option<LiftOff> {
-    let force = |s: &Sample| s.normal_force.get(k).copied().unwrap_or(0.0);
-    let index = samples.iter().position(|s| force(s) < 0.0)?;
-    if index == 0 {
-        return Some(LiftOff {
-            t: samples[0].t,
-            from_start: true,
-        });
-    }
-    let (a, b) = (&samples[index - 1], &samples[index]);
-    let (fa, fb) = (force(a), force(b));
-    let t = a.t + (b.t - a.t) * fa / (fa - fb);
-    Some(LiftOff {
-        t,
-        from_start: false,
-    })
-}
-
 /// The unit of a coordinate.
 pub fn unit(kind: CoordinateKind) -> &'static str {
     match kind {
@@ -75,7 +68,7 @@ pub fn unit(kind: CoordinateKind) -> &'static str {
 }
 
 /// The unit of the load a drive exerts on a coordinate.
-fn drive_unit(kind: CoordinateKind) -> &'static str {
+pub(crate) fn drive_unit(kind: CoordinateKind) -> &'static str {
     match kind {
         CoordinateKind::Revolute => "N m",
         CoordinateKind::Prismatic => "N",
@@ -93,41 +86,6 @@ pub fn number(x: f64) -> String {
     } else {
         format!("{x:.3e}")
     }
-}
-
-fn range(samples: &[Sample], value: impl Fn(&Sample) -> f64) -> (f64, f64) {
-    samples
-        .iter()
-        .map(value)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        })
-}
-
-/// Contact k is closed in the sample (always in a bilateral run; not while a one-sided
-/// follower flies).
-fn touching(sample: &Sample, k: usize) -> bool {
-    sample.in_contact.get(k).copied().unwrap_or(true)
-}
-
-/// The range of `value` over the samples where contact k is closed; `None` if there is none.
-fn range_in_contact(
-    samples: &[Sample],
-    k: usize,
-    value: impl Fn(&Sample) -> f64,
-) -> Option<(f64, f64)> {
-    let closed: Vec<f64> = samples
-        .iter()
-        .filter(|s| touching(s, k))
-        .map(value)
-        .collect();
-    (!closed.is_empty()).then(|| {
-        closed
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            })
-    })
 }
 
 fn settings_text(settings: &SimSettings) -> String {
@@ -149,76 +107,6 @@ fn settings_text(settings: &SimSettings) -> String {
             settings.rtol, settings.atol
         ),
     }
-}
-
-/// The table rows (name with unit, min, max, max |·|).
-fn rows(info: &ModelInfo, samples: &[Sample]) -> Vec<(String, f64, f64)> {
-    let mut rows = Vec::new();
-    for (i, c) in info.coordinates.iter().enumerate() {
-        let (lo, hi) = range(samples, |s| s.q[i]);
-        rows.push((format!("{} [{}]", c.name, unit(c.kind)), lo, hi));
-    }
-    let axes: &[&str] = if info.spatial {
-        &["x", "y", "z"]
-    } else {
-        &["x", "y"]
-    };
-    for (k, contact) in info.contacts.iter().enumerate() {
-        let name = &contact.name;
-        for (a, axis) in axes.iter().enumerate() {
-            let (lo, hi) = range(samples, |s| s.contacts[k].position[a]);
-            rows.push((format!("{name}_{axis} [m]"), lo, hi));
-        }
-        let (lo, hi) = range(samples, |s| s.normal_force[k]);
-        rows.push((format!("{name}_normal_force [N]"), lo, hi));
-        // In contact only: a flying follower has no pressure angle or sliding speed, and a
-        // fixed cam drives nothing (no pressure angle either).
-        let angle = |s: &Sample| s.contacts[k].pressure_angle();
-        if let Some((lo, hi)) = range_in_contact(samples, k, angle).filter(|_| contact.cam_moves) {
-            rows.push((format!("{name}_pressure_angle [rad]"), lo, hi));
-        }
-        if let Some((lo, hi)) = range_in_contact(samples, k, |s| s.contacts[k].sliding_speed) {
-            rows.push((format!("{name}_sliding_speed [m/s]"), lo, hi));
-        }
-    }
-    // Each loop's reactions, unless there are too many loops to list (an N-four-bar): then
-    // the largest reaction over all of them.
-    if info.loops.len() > LISTED_LOOPS {
-        let (lo, hi) = range(samples, |s| {
-            s.lambda
-                .iter()
-                .skip(info.n_contacts())
-                .fold(0.0_f64, |m, l| m.max(l.abs()))
-        });
-        rows.push((
-            format!("largest loop reaction, {} loops [N]", info.loops.len()),
-            lo,
-            hi,
-        ));
-    }
-    for (first, l) in info
-        .loop_rows()
-        .take_while(|_| info.loops.len() <= LISTED_LOOPS)
-    {
-        for (e, equation) in l.equations.iter().enumerate() {
-            let unit = if equation.starts_with("turn") || equation.starts_with("tilt") {
-                "N m"
-            } else {
-                "N"
-            };
-            let (lo, hi) = range(samples, |s| {
-                -s.lambda.get(first + e).copied().unwrap_or(f64::NAN)
-            });
-            rows.push((format!("{}_{equation}_reaction [{unit}]", l.name), lo, hi));
-        }
-    }
-    for (i, c) in info.coordinates.iter().enumerate() {
-        if c.driven {
-            let (lo, hi) = range(samples, |s| s.drive[i]);
-            rows.push((format!("{}_drive [{}]", c.name, drive_unit(c.kind)), lo, hi));
-        }
-    }
-    rows
 }
 
 /// What a contact is, in words: `roller on a polar profile turned by cam_angle`.
@@ -243,60 +131,32 @@ pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
 /// One line per contact: its kind and where its pressure angle is largest (degrees, the
 /// designer's unit), over the samples in contact; a fixed cam drives nothing, and its line
 /// says that the pressure angle is not defined.
-fn contact_lines(info: &ModelInfo, samples: &[Sample]) -> Vec<String> {
+fn contact_lines(info: &ModelInfo, digest: &Digest) -> Vec<String> {
     let mut lines = Vec::new();
     for (k, contact) in info.contacts.iter().enumerate() {
-        let steepest = samples
-            .iter()
-            .filter(|s| touching(s, k))
-            .map(|s| (s, s.contacts[k].pressure_angle().abs()))
-            .filter(|(_, a)| a.is_finite())
-            .max_by(|a, b| a.1.total_cmp(&b.1));
         let mut line = format!("{}: {}", contact.name, contact_kind(info, contact));
         if !contact.cam_moves {
             line.push_str(
                 "; the cam is fixed: it drives no follower, so no pressure angle is defined",
             );
-        } else if let Some((s, angle)) = steepest {
+        } else if let Some(steepest) = digest.steepest(k) {
             let _ = write!(
                 line,
                 "; largest pressure angle {:.2}° at t = {} s",
-                angle.to_degrees(),
-                number(s.t)
+                steepest.angle.to_degrees(),
+                number(steepest.t)
             );
-            if let Some(i) = contact.cam_coordinate {
+            if let Some(cam_angle) = steepest.cam_angle {
                 let _ = write!(
                     line,
                     " (cam angle {:.1}°)",
-                    s.q[i].to_degrees().rem_euclid(360.0)
+                    cam_angle.to_degrees().rem_euclid(360.0)
                 );
             }
         }
         lines.push(line);
     }
     lines
-}
-
-/// The scale the energy drift is measured against: the largest kinetic energy plus the
-/// range of the potential energy over the run (the energy that moves around; the total
-/// itself has an arbitrary zero).
-pub fn energy_scale(samples: &[Sample]) -> f64 {
-    let kinetic = samples.iter().map(|s| s.energy.kinetic).fold(0.0, f64::max);
-    let potential = |s: &Sample| s.energy.gravity + s.energy.spring;
-    let (lo, hi) = range(samples, potential);
-    kinetic + (hi - lo).max(0.0)
-}
-
-/// max over the samples of |(E + D − W)(t) − (E + D − W)(0)|.
-pub fn energy_drift(samples: &[Sample]) -> f64 {
-    let balance = |s: &Sample| s.energy.total() + s.dissipated - s.driven_work;
-    let Some(first) = samples.first().map(balance) else {
-        return 0.0;
-    };
-    samples
-        .iter()
-        .map(|s| (balance(s) - first).abs())
-        .fold(0.0, f64::max)
 }
 
 /// The summary text (several lines, each ending in a newline).
@@ -306,23 +166,23 @@ pub fn render(report: &RunReport) -> String {
         engine,
         info,
         settings,
-        samples,
+        digest,
         events,
         stats,
         wall,
     } = report;
     let mut text = String::new();
-    let span = match (samples.first(), samples.last()) {
-        (Some(a), Some(b)) => format!("t = {} to {} s, {} samples", a.t, b.t, samples.len()),
-        _ => "no samples".into(),
+    let span = match digest.span() {
+        Some((first, last)) => format!("t = {first} to {last} s, {} samples", digest.count()),
+        None => "no samples".into(),
     };
     let _ = writeln!(
         text,
         "{label} — {engine}, {}, {span}",
         settings_text(settings)
     );
-    if !samples.is_empty() {
-        let rows = rows(info, samples);
+    if digest.count() > 0 {
+        let rows = digest.rows();
         // The names' column: 24 characters, wider when a name needs it.
         let width = rows
             .iter()
@@ -342,41 +202,27 @@ pub fn render(report: &RunReport) -> String {
                 number(lo.abs().max(hi.abs()))
             );
         }
-        for line in contact_lines(info, samples) {
+        for line in contact_lines(info, digest) {
             let _ = writeln!(text, "  {line}");
         }
         let mut checks = Vec::new();
         for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
             // In flight (one-sided contact, no dependent coordinate) h is the gap, not a
             // residual.
-            let max_h = samples
-                .iter()
-                .filter(|s| !s.dependent.is_empty())
-                .map(|s| s.h[k].abs())
-                .fold(0.0, f64::max);
-            checks.push(format!("max |{name}_h| {max_h:.2e} m"));
+            checks.push(format!("max |{name}_h| {:.2e} m", digest.max_h(k)));
         }
         if info.loops.len() > LISTED_LOOPS {
-            let max_h = samples
-                .iter()
-                .flat_map(|s| s.h.iter().skip(info.n_contacts()))
-                .fold(0.0_f64, |m, h| m.max(h.abs()));
+            let max_h = digest.loop_h().first().copied().unwrap_or(0.0);
             checks.push(format!(
                 "max |h| of the {} loops {max_h:.2e}",
                 info.loops.len()
             ));
+        } else {
+            for (l, max_h) in info.loops.iter().zip(digest.loop_h()) {
+                checks.push(format!("max |{}_h| {max_h:.2e}", l.name));
+            }
         }
-        for (first, l) in info
-            .loop_rows()
-            .take_while(|_| info.loops.len() <= LISTED_LOOPS)
-        {
-            let max_h = samples
-                .iter()
-                .flat_map(|s| s.h.iter().skip(first).take(l.equations.len()))
-                .fold(0.0_f64, |m, h| m.max(h.abs()));
-            checks.push(format!("max |{}_h| {max_h:.2e}", l.name));
-        }
-        let (drift, scale) = (energy_drift(samples), energy_scale(samples));
+        let (drift, scale) = (digest.energy_drift(), digest.energy_scale());
         let relative = if scale > 0.0 {
             format!(
                 " ({:.1e} of the energy scale {} J)",
@@ -400,14 +246,14 @@ pub fn render(report: &RunReport) -> String {
         stats.repartitions,
         wall_time(*wall)
     );
-    text.push_str(&render_repartitions(info, samples));
+    text.push_str(&render_repartitions(info, digest));
     if !events.is_empty() || settings.integrator.is_adaptive() {
         text.push_str(&render_events(info, events));
         return text;
     }
     // RK4 runs locate no events: the sign change is interpolated between outputs.
     for (k, name) in info.contacts.iter().map(|c| &c.name).enumerate() {
-        match lift_off(samples, k) {
+        match digest.lift_offs().get(k).copied().flatten() {
             Some(l) if l.from_start => {
                 let _ = writeln!(
                     text,
@@ -432,7 +278,7 @@ pub fn render(report: &RunReport) -> String {
 /// The changes of the dependent coordinates seen between consecutive samples, one line each
 /// (the first [`LISTED_EVENTS`], then a count): `between t = a and b s: {q2, q3} → {q1, q3}`.
 /// Empty when the partition never changed between outputs.
-pub fn render_repartitions(info: &ModelInfo, samples: &[Sample]) -> String {
+pub fn render_repartitions(info: &ModelInfo, digest: &Digest) -> String {
     // What left the dependent set and what joined it (the whole sets of an 80-equation
     // model would fill the screen).
     let names = |from: &[usize], to: &[usize]| -> String {
@@ -444,30 +290,25 @@ pub fn render_repartitions(info: &ModelInfo, samples: &[Sample]) -> String {
         list.join(", ")
     };
     // A one-sided follower's take-off and landing change the dependent set too; they are
-    // events, not re-partitions.
-    let closed = |s: &Sample| s.in_contact.iter().all(|&c| c);
-    let changes: Vec<(f64, f64, String, String)> = samples
-        .windows(2)
-        .filter(|w| closed(&w[0]) && closed(&w[1]) && w[0].dependent != w[1].dependent)
-        .map(|w| {
-            let (a, b) = (&w[0].dependent, &w[1].dependent);
-            (w[0].t, w[1].t, names(a, b), names(b, a))
-        })
-        .collect();
+    // events, not re-partitions (the digest counts only changes between samples in contact).
+    let (listed, count) = digest.repartitions();
     let mut text = String::new();
-    for (a, b, left, joined) in changes.iter().take(LISTED_EVENTS) {
+    for change in listed {
+        let (a, b) = change.between;
         let _ = writeln!(
             text,
-            "  re-partitioned between t = {} and {} s: {left} now independent, {joined} dependent",
-            number(*a),
-            number(*b)
+            "  re-partitioned between t = {} and {} s: {} now independent, {} dependent",
+            number(a),
+            number(b),
+            names(&change.from, &change.to),
+            names(&change.to, &change.from)
         );
     }
-    if changes.len() > LISTED_EVENTS {
+    if count > LISTED_EVENTS {
         let _ = writeln!(
             text,
             "  … and {} more re-partitions between outputs",
-            changes.len() - LISTED_EVENTS
+            count - LISTED_EVENTS
         );
     }
     text
@@ -632,23 +473,16 @@ pub fn assembly_warnings(
 /// negative at the start or for most of the run (the cam pulls the follower), over the
 /// samples in contact. A one-sided run is not warned about: its follower lifts off where the
 /// force would turn negative, as it should.
-pub fn result_warnings(info: &ModelInfo, samples: &[Sample], one_sided: bool) -> Vec<String> {
+pub fn result_warnings(info: &ModelInfo, digest: &Digest, one_sided: bool) -> Vec<String> {
     let mut out = Vec::new();
-    let Some(first) = samples.first() else {
-        return out;
-    };
-    if one_sided {
+    if digest.count() == 0 || one_sided {
         return out;
     }
     for (k, contact) in info.contacts.iter().enumerate() {
         let name = &contact.name;
-        let in_contact: Vec<&Sample> = samples.iter().filter(|s| touching(s, k)).collect();
-        let negative = in_contact
-            .iter()
-            .filter(|s| s.normal_force[k] < 0.0)
-            .count();
-        let share = negative as f64 / in_contact.len().max(1) as f64;
-        let at_start = first.normal_force.get(k).is_some_and(|f| *f < 0.0);
+        let (negative, in_contact) = digest.negative_share(k);
+        let share = negative as f64 / in_contact.max(1) as f64;
+        let at_start = digest.negative_at_start(k);
         if at_start || share > 0.5 {
             out.push(format!(
                 "the normal force on {name} is negative {} ({:.0} % of the samples): the cam \
@@ -677,135 +511,5 @@ fn material_side(profile: ProfileKind) -> &'static str {
             "the cam lies on the left of its curve as s increases (inside a curve traced \
              counterclockwise) and pushes to the right"
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use camchain_runtime::{ContactGeometry, Energy};
-
-    fn sample(t: f64, force: f64) -> Sample {
-        Sample {
-            t,
-            q: vec![0.0],
-            qd: vec![0.0],
-            qdd: vec![0.0],
-            lambda: vec![0.0],
-            normal_force: vec![force],
-            h: vec![0.0],
-            contacts: vec![ContactGeometry::default()],
-            drive: vec![0.0],
-            energy: Energy::default(),
-            dissipated: 0.0,
-            driven_work: 0.0,
-            dependent: vec![0].into(),
-            in_contact: vec![true],
-        }
-    }
-
-    #[test]
-    fn lift_off_is_interpolated() {
-        let samples = [sample(0.0, 2.0), sample(1.0, 1.0), sample(2.0, -3.0)];
-        let l = lift_off(&samples, 0).unwrap();
-        assert!(!l.from_start && (l.t - 1.25).abs() < 1e-15);
-        assert!(lift_off(&samples[..2], 0).is_none());
-        assert!(lift_off(&samples[2..], 0).unwrap().from_start);
-    }
-
-    /// A driven eccentric with one-sided contact: `cam_angle` driven, `lift` dependent in
-    /// contact and free in flight.
-    fn one_sided_info(cam_moves: bool) -> ModelInfo {
-        let coordinate = |name: &str, driven| camchain_runtime::CoordinateInfo {
-            name: name.into(),
-            kind: camchain_runtime::CoordinateKind::Revolute,
-            driven,
-        };
-        let mut contact = camchain_runtime::ContactInfo::knife("face");
-        contact.cam_moves = cam_moves;
-        ModelInfo {
-            name: "m".into(),
-            description: String::new(),
-            coordinates: vec![coordinate("cam_angle", true), coordinate("lift", false)],
-            contacts: vec![contact],
-            loops: Vec::new(),
-            spatial: false,
-            initial: camchain_runtime::InitialGuess {
-                q: vec![0.0; 2],
-                qd: vec![0.0; 2],
-                hold: vec![false; 2],
-                given_q: vec![false; 2],
-                given_qd: vec![false; 2],
-            },
-            defaults: SimSettings {
-                t_end: 1.0,
-                dt_out: 0.1,
-                integrator: IntegratorKind::Dop853,
-                dt: 1e-3,
-                rtol: 1e-9,
-                atol: 1e-12,
-            },
-            restitution: None,
-            parameters: Vec::new(),
-        }
-    }
-
-    /// A sample of the one-sided eccentric at t: in contact (lift dependent) or flying.
-    fn phase_sample(t: f64, force: f64, flying: bool) -> Sample {
-        let mut s = sample(t, force);
-        s.q = vec![0.0, 0.0];
-        s.qd = vec![0.0, 0.0];
-        s.dependent = if flying { vec![] } else { vec![1] }.into();
-        s.in_contact = vec![!flying];
-        s
-    }
-
-    #[test]
-    fn a_one_sided_run_is_summarised_honestly() {
-        // Issue 24: take-offs and landings were listed as re-partitions with a blank name,
-        // the pressure angle was taken over flight samples and the cam was said to pull.
-        let info = one_sided_info(true);
-        let samples = [
-            phase_sample(0.0, -0.07, false),
-            phase_sample(0.1, 0.0, true),
-            phase_sample(0.2, 12.0, false),
-            phase_sample(0.3, 0.0, true),
-        ];
-        assert_eq!(render_repartitions(&info, &samples), "");
-        assert!(result_warnings(&info, &samples, true).is_empty());
-        // The same samples of a bilateral run that starts pulling are warned about.
-        assert_eq!(result_warnings(&info, &samples, false).len(), 1);
-        // A real re-partition between two samples in contact is still listed, by name.
-        let mut moved = phase_sample(0.4, 10.0, false);
-        moved.dependent = vec![0].into();
-        let text = render_repartitions(&info, &[phase_sample(0.3, 10.0, false), moved]);
-        assert!(
-            text.contains("lift now independent, cam_angle dependent"),
-            "{text}"
-        );
-    }
-
-    #[test]
-    fn a_fixed_cam_has_no_pressure_angle() {
-        let samples = [phase_sample(0.0, 5.0, false), phase_sample(0.1, 6.0, false)];
-        let fixed = contact_lines(&one_sided_info(false), &samples).join("\n");
-        assert!(fixed.contains("no pressure angle is defined"), "{fixed}");
-        let names: Vec<String> = rows(&one_sided_info(false), &samples)
-            .into_iter()
-            .map(|r| r.0)
-            .collect();
-        assert!(
-            !names.iter().any(|n| n.contains("pressure_angle")),
-            "{names:?}"
-        );
-        let moving = contact_lines(&one_sided_info(true), &samples).join("\n");
-        assert!(moving.contains("largest pressure angle"), "{moving}");
-    }
-
-    #[test]
-    fn numbers_are_compact() {
-        assert_eq!(number(0.0), "0");
-        assert_eq!(number(-1.5), "-1.500000");
-        assert_eq!(number(6.94e-17), "6.940e-17");
     }
 }
