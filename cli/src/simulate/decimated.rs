@@ -140,14 +140,14 @@ impl Decimated {
         }
         if marked && self.changes < PINNED {
             self.changes += 1;
-            if let Some((i, previous)) = &self.last {
-                if self.pinned.last().is_none_or(|(j, _)| j != i) {
-                    self.pinned.push((*i, previous.clone()));
-                }
+            if let Some((i, previous)) = &self.last
+                && self.pinned.last().is_none_or(|(j, _)| j != i)
+            {
+                self.pinned.push((*i, previous.clone()));
             }
             self.pinned.push((index, thinned(s, self.contacts)));
         }
-        if index % self.stride == 0 {
+        if index.is_multiple_of(self.stride) {
             self.regular.push((index, thinned(s, self.contacts)));
             if self.regular.len() > self.capacity {
                 self.stride *= 2;

@@ -265,16 +265,18 @@ impl Digest {
     fn add_crossings(&mut self, s: &Sample) {
         let closed = s.in_contact.iter().all(|&c| c);
         let previous = self.previous.take();
-        if let Some(p) = &previous {
-            if p.closed && closed && p.dependent != s.dependent {
-                self.repartition_count += 1;
-                if self.repartitions.len() < LISTED_EVENTS {
-                    self.repartitions.push(Repartition {
-                        between: (p.t, s.t),
-                        from: p.dependent.clone(),
-                        to: s.dependent.clone(),
-                    });
-                }
+        if let Some(p) = &previous
+            && p.closed
+            && closed
+            && p.dependent != s.dependent
+        {
+            self.repartition_count += 1;
+            if self.repartitions.len() < LISTED_EVENTS {
+                self.repartitions.push(Repartition {
+                    between: (p.t, s.t),
+                    from: p.dependent.clone(),
+                    to: s.dependent.clone(),
+                });
             }
         }
         for k in 0..self.contacts {
