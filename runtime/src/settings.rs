@@ -122,8 +122,9 @@ impl SimSettings {
             return Err(invalid(
                 "t_end",
                 format!(
-                    "must be finite and not before the start t = {t0} s, got {}",
-                    self.t_end
+                    "must be finite and not before the start t = {} s, got {}",
+                    compact(t0),
+                    compact(self.t_end)
                 ),
             ));
         }
@@ -134,7 +135,8 @@ impl SimSettings {
                 format!(
                     "t_end = {} s with dt_out = {} s gives {samples:.3e} samples, more than the \
                      {cap:e} {whose}: a larger dt_out or a smaller t_end",
-                    self.t_end, self.dt_out
+                    compact(self.t_end),
+                    compact(self.dt_out)
                 ),
             ));
         }
@@ -199,6 +201,16 @@ fn in_range(
     }
 }
 
+/// A number as written by a person: plain for ordinary magnitudes (`30`, `0.01`), in
+/// scientific notation beyond them (`1e308`, not three hundred digits).
+fn compact(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() || (1e-4..1e7).contains(&value.abs()) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,6 +224,22 @@ mod tests {
             rtol: 1e-10,
             atol: 1e-12,
         }
+    }
+
+    #[test]
+    fn a_huge_t_end_is_printed_in_a_few_characters() {
+        let mut s = settings(IntegratorKind::Dop853);
+        s.t_end = 1e308;
+        let message = s.validate(0.0).expect_err("too many samples").to_string();
+        assert!(message.contains("t_end = 1e308 s"), "{message}");
+        assert!(message.len() < 300, "{message}");
+        s.t_end = 30.0;
+        s.dt_out = 1e-9;
+        let message = s.validate(0.0).expect_err("too many samples").to_string();
+        assert!(
+            message.contains("t_end = 30 s with dt_out = 1e-9 s"),
+            "{message}"
+        );
     }
 
     #[test]

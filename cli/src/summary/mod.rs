@@ -432,6 +432,13 @@ pub fn assembly_warnings(
     length_scale: f64,
 ) -> Vec<String> {
     let mut out = Vec::new();
+    // What assembly solved for: the contacts' points onto their cams, the loops closed.
+    let purpose = match (info.n_contacts(), info.loops.len()) {
+        (0, _) => "to close the loops",
+        (1, 0) => "to put the contact point on its cam",
+        (_, 0) => "to put the contact points on their cams",
+        _ => "to put the contact points on their cams and close the loops",
+    };
     for c in report.changes.iter().filter(|c| c.given) {
         let coordinate = &info.coordinates[c.coordinate];
         let field = if c.velocity {
@@ -456,8 +463,8 @@ pub fn assembly_warnings(
                 };
                 ((c.to - c.from).abs() > limit).then(|| {
                     format!(
-                        "{field} = {from} had to move to {to} {} (by {}) to put the contact \
-                         point on its cam: check the guess and initial.hold",
+                        "{field} = {from} had to move to {to} {} (by {}) {purpose}: check \
+                         the guess and initial.hold",
                         unit(coordinate.kind),
                         number(c.to - c.from)
                     )

@@ -413,3 +413,34 @@ fn numbers_are_compact() {
     assert_eq!(number(-1.5), "-1.500000");
     assert_eq!(number(6.94e-17), "6.940e-17");
 }
+
+#[test]
+fn a_model_without_a_cam_is_warned_about_its_loops_not_a_contact_point() {
+    // A coordinate moved far by assembly: the warning says what assembly solved for.
+    let report = |_: &ModelInfo| AssemblyReport {
+        changes: vec![camchain_runtime::assembly::AssemblyChange {
+            coordinate: 1,
+            velocity: false,
+            from: 0.0,
+            to: 2.0,
+            cause: ChangeCause::Constraint,
+            given: true,
+        }],
+        root: RootChoice::default(),
+        redundant: Vec::new(),
+    };
+    let mut loops_only = synthetic_info(1);
+    loops_only.contacts.clear();
+    let warnings = assembly_warnings(&loops_only, &report(&loops_only), 1.0);
+    assert!(
+        warnings.len() == 1 && warnings[0].contains("to close the loops"),
+        "{warnings:?}"
+    );
+    assert!(!warnings[0].contains("cam"), "{warnings:?}");
+    let both = synthetic_info(1);
+    let warnings = assembly_warnings(&both, &report(&both), 1.0);
+    assert!(
+        warnings[0].contains("on their cams and close the loops"),
+        "{warnings:?}"
+    );
+}
