@@ -118,6 +118,13 @@ pub const DEFAULT_RUNTIME_PATH: &str = "::camchain::runtime";
 /// Output target meaning "the function's value" (written last, without a semicolon).
 const RETURN: &str = "return";
 
+/// The deepest an expression is written inline: a node whose operands, written inline, would
+/// nest deeper gets a `let` binding of its own even when used once. A term of a long chain
+/// (a sum through every body) would otherwise be one expression as deep as the chain, and
+/// parsing, formatting and compiling the generated code all recurse on that depth. Binding
+/// a term changes no value: the same operations run in the same order.
+const MAX_INLINE_DEPTH: u32 = 32;
+
 /// Prefix of the statements that become section comments after formatting.
 const SECTION_MACRO: &str = "__section__";
 
@@ -938,13 +945,29 @@ fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionSpec> {
 /// The coordinates summed in an angle `q_a + q_b + …` (sorted variable indices), if `id` is
 /// such a sum.
 fn angle_vars(g: &Graph, id: Id, out: &mut Vec<u32>) -> bool {
-    match g.node(id) {
-        Node::Var(k) => {
-            out.push(k);
-            true
+    let mut ok = true;
+    angle_terms(g, id, |k| out.push(k), &mut ok);
+    ok
+}
+
+/// Calls `leaf` with the variable index of every term of the sum of variables `id`, left to
+/// right, and clears `ok` (stopping there) at the first term that is not a variable. An
+/// absolute joint angle of a planar chain is a sum through every joint below it, so the
+/// walk keeps its own stack instead of recursing.
+fn angle_terms(g: &Graph, id: Id, mut leaf: impl FnMut(u32), ok: &mut bool) {
+    let mut stack = vec![id];
+    while let Some(id) = stack.pop() {
+        match g.node(id) {
+            Node::Var(k) => leaf(k),
+            Node::Add(a, b) => {
+                stack.push(b);
+                stack.push(a);
+            }
+            _ => {
+                *ok = false;
+                return;
+            }
         }
-        Node::Add(a, b) => angle_vars(g, a, out) && angle_vars(g, b, out),
-        _ => false,
     }
 }
 
@@ -1020,22 +1043,16 @@ fn trig_name_of(f: Func, angle: &str) -> Option<String> {
 
 /// `q1_q2` for the angle q1 + q2 (the coordinates summed, in the expression's order).
 fn angle_name(g: &Graph, angle: Id) -> Option<String> {
-    fn parts(g: &Graph, id: Id, out: &mut Vec<String>) -> Option<()> {
-        match g.node(id) {
-            Node::Var(k) => {
-                out.push(sanitize(g.var_names().get(k as usize)?));
-                Some(())
-            }
-            Node::Add(a, b) => {
-                parts(g, a, out)?;
-                parts(g, b, out)
-            }
-            _ => None,
-        }
-    }
     let mut names = Vec::new();
-    parts(g, angle, &mut names)?;
-    Some(names.join("_"))
+    let mut ok = true;
+    angle_terms(
+        g,
+        angle,
+        |k| names.push(g.var_names().get(k as usize)),
+        &mut ok,
+    );
+    let names: Option<Vec<String>> = names.into_iter().map(|n| n.map(|n| sanitize(n))).collect();
+    names.filter(|_| ok).map(|n| n.join("_"))
 }
 
 /// sin or cos of the angle `vars` from two known angles P, R with vars = P − R or P + R.
@@ -2258,14 +2275,22 @@ impl<'g> Emitter<'g> {
             taken.insert(source.clone());
         }
         let mut section: Option<String> = None;
+        // How deep each node's text would nest if written inline (0 once it has a name).
+        let mut depth = vec![0u32; self.g.len()];
         for i in self.emission_order() {
             let id = id_at(self.g, i);
             if matches!(self.g.node(id), Node::Var(_)) && !self.given.contains_key(&id) {
                 used_vars.insert(id);
             }
-            if !self.wants_binding(id) || self.names.contains_key(&id) {
+            if self.names.contains_key(&id) {
                 continue;
             }
+            depth[i] = self.inline_depth(id, &depth);
+            let too_deep = depth[i] > MAX_INLINE_DEPTH && !matches!(self.g.node(id), Node::Neg(_));
+            if !self.wants_binding(id) && !too_deep {
+                continue;
+            }
+            depth[i] = 0;
             let this_section = self.g.section_of(id).map(str::to_string);
             if this_section != section {
                 if let Some(s) = &this_section {
@@ -2306,6 +2331,27 @@ impl<'g> Emitter<'g> {
             self.names.insert(id, name);
         }
         (text, used_vars)
+    }
+
+    /// How deeply the text of `id` would nest if written inline: one more than its deepest
+    /// operand written inline (`depth` holds the operands', 0 for a named one).
+    fn inline_depth(&self, id: Id, depth: &[u32]) -> u32 {
+        if self.given.contains_key(&id) {
+            return 1;
+        }
+        let operands = match self.g.node(id) {
+            Node::Const(_) | Node::Var(_) => return 1,
+            Node::Add(a, b) | Node::Mul(a, b) | Node::Div(a, b) | Node::Powf(a, b) => [a, b],
+            Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Table(_, _, a) => [a, a],
+        };
+        let of = |c: Id| {
+            if self.names.contains_key(&c) {
+                0
+            } else {
+                depth[c.index()]
+            }
+        };
+        1 + of(operands[0]).max(of(operands[1]))
     }
 
     /// The reachable nodes, children before parents, each section's nodes kept together

@@ -8,6 +8,7 @@ mod chain;
 #[path = "../common/mod.rs"]
 mod common;
 mod contacts;
+mod deep_chains;
 mod derivation;
 mod emit;
 mod features;
