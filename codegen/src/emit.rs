@@ -97,6 +97,13 @@ pub struct EmitOptions {
     /// The directory the files a model names (its tables of points) are read from: the model
     /// file's own. `None`: the directory of the path messages show.
     pub files_dir: Option<std::path::PathBuf>,
+    /// The most nodes the derivation's expression graph may hold ([`crate::expr::NODE_LIMIT`]
+    /// by default): a model that needs more is refused with an error saying so, before it
+    /// takes more memory. Raise it on a machine with memory to spare (about 100 bytes a node).
+    pub node_limit: usize,
+    /// The longest generated module, in bytes before formatting ([`MAX_CODE_BYTES`] by
+    /// default): a model whose code would be longer is refused with an error saying so.
+    pub code_limit: usize,
 }
 
 impl Default for EmitOptions {
@@ -107,6 +114,8 @@ impl Default for EmitOptions {
             embedded_source: None,
             parameters: crate::model::ParameterMode::AsDeclared,
             files_dir: None,
+            node_limit: crate::expr::NODE_LIMIT,
+            code_limit: MAX_CODE_BYTES,
         }
     }
 }
@@ -135,16 +144,34 @@ pub fn generate(model: &Model, source: &str) -> Result<Generated, String> {
 }
 
 /// Generates the module for `model`; `source` is the model file as shown in the header.
+///
+/// A model too large to derive ([`crate::derive::TooLarge`]), or whose code would be longer
+/// than [`EmitOptions::code_limit`], is an error saying so.
 pub fn generate_with(
     model: &Model,
     source: &str,
     options: &EmitOptions,
 ) -> Result<Generated, String> {
-    let mut d = Derivation::new(model);
+    let d = Derivation::checked_with_limit(model, options.node_limit).map_err(|e| e.to_string())?;
+    generate_from(model, d, source, options)
+}
+
+/// [`generate_with`] from the model's derivation ([`Derivation::checked_with_limit`]), which
+/// emission extends (the sines and cosines it shares, the terms it caches) within its node
+/// limit.
+pub fn generate_from(
+    model: &Model,
+    mut d: Derivation,
+    source: &str,
+    options: &EmitOptions,
+) -> Result<Generated, String> {
     let specs = function_specs(model, &mut d);
     let parametric = model.runtime_parameters().next().is_some();
     let kinematics_specs = contact_kinematics_specs(model, &mut d, parametric);
     let mut fused = FusedTerms::new(&mut d);
+    if let Some(e) = d.too_large(model) {
+        return Err(e.to_string());
+    }
     let runtime = RuntimeParameters::new(model, &d, &all_roots(&d, &specs, &fused));
     if let Some(rp) = &runtime {
         // A value of the parameters alone is computed once per parameter set, not cached.
@@ -186,6 +213,7 @@ pub fn generate_with(
             None => emit_function_full(&d, spec, "", true, &derived("self."), &[], warm),
         };
         functions.push_str(&text);
+        within_code_limit(functions.len(), options.code_limit)?;
         op_counts.push((spec.name.clone(), count));
     }
     for (spec, given) in &fused_specs {
@@ -207,6 +235,7 @@ pub fn generate_with(
         };
         let (text, count) = emit_function_full(&d, spec, "", true, &given, memo, &warm);
         functions.push_str(&text);
+        within_code_limit(functions.len(), options.code_limit)?;
         op_counts.push((spec.name.clone(), count));
     }
     let _ = writeln!(
@@ -274,6 +303,7 @@ pub fn generate_with(
     );
     file.push_str(&helpers);
     file.push_str(&op_count_table(&op_counts));
+    within_code_limit(file.len(), options.code_limit)?;
     let syntax =
         syn::parse_file(&file).map_err(|e| format!("generated code does not parse: {e}"))?;
     let formatted = prettyplease::unparse(&syntax);
@@ -287,6 +317,31 @@ pub fn generate_with(
         ),
         op_counts,
     })
+}
+
+/// The longest generated module, before formatting: 32 MiB. Formatting parses the whole
+/// module into a syntax tree of some 50 bytes per byte of text (a spatial chain of 200
+/// bodies, `codegen/tests/common/chain.rs`, is 17.6 MB of text and takes 1.0 GB in all), and
+/// no compiler builds a much longer module in reasonable time; a model whose code would be
+/// longer is refused before it is formatted.
+pub const MAX_CODE_BYTES: usize = 32 << 20;
+
+/// An error when the generated text (`len` bytes) has grown past `limit`
+/// ([`EmitOptions::code_limit`]).
+fn within_code_limit(len: usize, limit: usize) -> Result<(), String> {
+    if len <= limit {
+        return Ok(());
+    }
+    let shown = if limit % (1 << 20) == 0 {
+        format!("{} MiB", limit >> 20)
+    } else {
+        format!("{limit} bytes")
+    };
+    Err(format!(
+        "the model is too large to generate code for: its generated code is longer than \
+         {shown} (the limit, which bounds the memory formatting it takes): split the \
+         mechanism or use fewer bodies"
+    ))
 }
 
 /// Every tabulated function of the graph as constants and a function `eval_<name>(s)` returning

@@ -126,7 +126,19 @@ pub struct Graph {
     implicits: HashMap<u32, Implicit>,
     /// The tabulated functions [`Node::Table`] refers to.
     tables: Vec<Table>,
+    /// The most nodes the graph takes ([`NODE_LIMIT`] when 0).
+    node_limit: usize,
+    /// Set when a node was asked for beyond the limit (see [`Graph::exhausted`]).
+    exhausted: bool,
 }
+
+/// The most nodes an expression graph holds: 4 194 304 (2²²), about 500 MB with its index.
+/// The largest built-in model needs about 7 500 and a spatial chain of 200 bodies
+/// (`codegen/tests/common/chain.rs`) 1.3 million; a model that needs more (a planar chain of
+/// 1000 bodies reaches the limit within its mass matrix) is refused with an error on its file
+/// instead of exhausting the machine's memory. Variables do not count: there is one per
+/// coordinate, rate and parameter.
+pub const NODE_LIMIT: usize = 1 << 22;
 
 /// Where Newton starts on an [`Implicit`] variable when no earlier solution is at hand.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,9 +200,35 @@ fn const_bits(value: f64) -> u64 {
 }
 
 impl Graph {
-    /// An empty graph.
+    /// An empty graph holding at most [`NODE_LIMIT`] nodes.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty graph holding at most `limit` nodes besides its variables (at least 1).
+    pub fn with_node_limit(limit: usize) -> Self {
+        Graph {
+            node_limit: limit.max(1),
+            ..Self::default()
+        }
+    }
+
+    /// The most nodes the graph holds besides its variables.
+    pub fn node_limit(&self) -> usize {
+        if self.node_limit == 0 {
+            NODE_LIMIT
+        } else {
+            self.node_limit
+        }
+    }
+
+    /// True when a node was asked for beyond [`Graph::node_limit`]. The graph then stops
+    /// growing: every new operation or constant is the constant NaN (so a derivation that
+    /// outgrows it finishes quickly, in bounded memory, with meaningless terms), and the
+    /// expressions built since must not be used: the derivation is refused
+    /// ([`crate::Derivation::checked`]).
+    pub fn exhausted(&self) -> bool {
+        self.exhausted
     }
 
     /// Number of nodes.
@@ -217,6 +255,19 @@ impl Graph {
         if let Some(&id) = self.index.get(&node) {
             return id;
         }
+        if self.nodes.len() >= self.node_limit() && !matches!(node, Node::Var(_)) {
+            self.exhausted = true;
+            let poison = Node::Const(f64::NAN.to_bits());
+            if let Some(&id) = self.index.get(&poison) {
+                return id;
+            }
+            return self.push(poison);
+        }
+        self.push(node)
+    }
+
+    /// Appends a node (not yet in the graph) to the current section.
+    fn push(&mut self, node: Node) -> Id {
         let id = Id(self.nodes.len() as u32);
         self.nodes.push(node);
         let section = self

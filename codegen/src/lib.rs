@@ -79,7 +79,7 @@ pub fn check_source_in(
     files: schema::Files,
 ) -> Result<Model, ModelError> {
     let model = schema::parse_model_from(source, display, &[], ParameterMode::AsDeclared, files)?;
-    check_assembly(&model, source, display)?;
+    derive_and_assemble(&model, source, display, expr::NODE_LIMIT)?;
     Ok(model)
 }
 
@@ -92,12 +92,31 @@ pub fn located_warnings(model: &Model, source: &str, display: &Path) -> Vec<Mode
         .collect()
 }
 
-/// The initial state of a validated model assembles onto its cams (located at `initial`).
-fn check_assembly(model: &Model, source: &str, display: &Path) -> Result<(), ModelError> {
-    let derivation = Derivation::new(model);
+/// The derivation of a validated model ([`Derivation::checked_with_limit`]: a model too large
+/// to derive is an error on its file), once its initial state is known to assemble onto its cams
+/// (located at `initial`).
+fn derive_and_assemble(
+    model: &Model,
+    source: &str,
+    display: &Path,
+    node_limit: usize,
+) -> Result<Derivation, ModelError> {
+    let derivation = Derivation::checked_with_limit(model, node_limit)
+        .map_err(|e| unlocated(display, e.to_string()))?;
     assembly::assemble_located(model, &derivation)
-        .map(|_| ())
-        .map_err(|(field, message)| schema::field_error(display, source, &field, message))
+        .map_err(|(field, message)| schema::field_error(display, source, &field, message))?;
+    Ok(derivation)
+}
+
+/// An error on the file as a whole (line 0: not located).
+fn unlocated(display: &Path, message: String) -> ModelError {
+    ModelError {
+        file: display.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message,
+    }
 }
 
 /// Validates and checks the text of a model file and generates its Rust module: parsing and
@@ -127,13 +146,8 @@ pub fn generate_source(
             ),
         ));
     }
-    check_assembly(&model, source, display)?;
+    let derivation = derive_and_assemble(&model, source, display, options.node_limit)?;
     let shown = display.to_string_lossy().replace('\\', "/");
-    emit::generate_with(&model, &shown, options).map_err(|message| ModelError {
-        file: display.to_path_buf(),
-        line: 0,
-        column: 0,
-        field: String::new(),
-        message,
-    })
+    emit::generate_from(&model, derivation, &shown, options)
+        .map_err(|message| unlocated(display, message))
 }

@@ -1,6 +1,8 @@
-//! Deep chains: no pass recurses on the depth of the expression graph, so a long chain
-//! derives and emits in a small stack. (Before, `camchain ops` on a 1000-body planar chain
-//! died of a stack overflow.)
+//! Deep chains and large models: no pass recurses on the depth of the expression graph, so a
+//! long chain derives and emits in a small stack; and a model too large for the machine is
+//! refused with an error naming its file, its size and the limit, in bounded memory. (Before,
+//! `camchain ops` on a 1000-body planar chain ran for 108 s, took 5.4 GB and died of a stack
+//! overflow.)
 
 use crate::chain::planar_chain_ron;
 use camchain_codegen::expr::Graph;
@@ -131,4 +133,82 @@ fn a_deep_chain_generates_in_a_small_stack_with_shallow_expressions() {
     // much deeper than that (a few levels more for a statement's own brackets).
     let depth = paren_depth(&generated.code);
     assert!(depth <= 40, "parentheses nested {depth} deep");
+}
+
+#[test]
+fn a_thousand_body_chain_is_refused_with_the_file_and_the_limit() {
+    // The default limit (4 194 304 nodes) refuses it after some 6 s of work and 500 MB; a
+    // lower one, the same way, sooner.
+    let options = EmitOptions {
+        node_limit: 250_000,
+        ..EmitOptions::default()
+    };
+    let e = in_small_stack(move || {
+        generate_source(
+            &planar_chain_ron(1000),
+            Path::new("models/planar1000.ron"),
+            &options,
+        )
+        .expect_err("refused")
+    });
+    let message = e.to_string();
+    for part in [
+        "models/planar1000.ron: ",
+        "too large to derive",
+        "its 1000 bodies",
+        "more than 250000 expression nodes (the limit",
+    ] {
+        assert!(message.contains(part), "{part:?} not in {message}");
+    }
+}
+
+#[test]
+fn a_model_whose_code_is_too_long_is_refused_before_it_is_formatted() {
+    // A 16-body planar chain's module is about 250 kB; with a limit of 100 kB it is refused
+    // (the default, 32 MiB, refuses a 600-body planar chain and a 300-body spatial one).
+    let options = EmitOptions {
+        code_limit: 100_000,
+        ..EmitOptions::default()
+    };
+    let e = generate_source(
+        &planar_chain_ron(16),
+        Path::new("models/planar16.ron"),
+        &options,
+    )
+    .expect_err("refused");
+    let message = e.to_string();
+    for part in [
+        "models/planar16.ron: ",
+        "too large to generate code for",
+        "longer than 100000 bytes (the limit",
+    ] {
+        assert!(message.contains(part), "{part:?} not in {message}");
+    }
+    // Within the default it is generated.
+    generate_source(
+        &planar_chain_ron(16),
+        Path::new("models/planar16.ron"),
+        &EmitOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn a_graph_stops_growing_at_its_node_limit() {
+    let mut g = Graph::with_node_limit(100);
+    let x = g.var("x");
+    let mut e = x;
+    for k in 0..1000 {
+        let c = g.constant(f64::from(k));
+        let p = g.mul(e, x);
+        e = g.add(p, c);
+    }
+    assert!(g.exhausted());
+    // The limit, and one constant NaN that stands for every node asked for beyond it.
+    assert_eq!(g.len(), 101);
+    assert!(g.eval(&[e], &[0.5])[0].is_nan());
+    // Variables are not counted: one more is still made.
+    let y = g.var("y");
+    assert_eq!(g.var_names()[1], "y");
+    assert_eq!(g.eval(&[y], &[0.5, 2.0])[0], 2.0);
 }
