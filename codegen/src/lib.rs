@@ -52,9 +52,11 @@ pub fn generate_file(path: &Path, display: &Path) -> Result<Generated, ModelErro
     generate_source(&source, display, &EmitOptions::default())
 }
 
-/// Reads a model file; a failure is a [`ModelError`] on `display` (line 0: not located).
+/// Reads a model file of at most [`schema::MAX_FILE_BYTES`] ([`schema::read_text`]: a longer
+/// regular file is refused unread, a device without end once it has given that much); a
+/// failure is a [`ModelError`] on `display` (line 0: not located).
 pub fn read_model_file(path: &Path, display: &Path) -> Result<String, ModelError> {
-    std::fs::read_to_string(path).map_err(|e| ModelError {
+    schema::read_text(path).map_err(|e| ModelError {
         file: display.to_path_buf(),
         line: 0,
         column: 0,

@@ -12,6 +12,7 @@ mod deep_chains;
 mod derivation;
 mod emit;
 mod features;
+mod file_sizes;
 mod fuzz;
 mod linear_pass;
 mod parameters;
