@@ -106,6 +106,20 @@ mod tests {
         assert_eq!(from_file, built);
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn a_device_without_end_is_refused_as_a_model_file() {
+        // Before, `camchain ops /dev/zero` read until memory ran out; now the reader stops
+        // after the 16 MiB a model file may hold.
+        match render(&["/dev/zero".to_string()]) {
+            Err(CliError::Failed(message)) => assert!(
+                message.starts_with("/dev/zero: ") && message.contains("more than 16 MiB"),
+                "{message}"
+            ),
+            _ => panic!("refused"),
+        }
+    }
+
     #[test]
     fn an_unknown_model_is_a_usage_error() {
         assert!(matches!(

@@ -9,7 +9,7 @@ use super::CliError;
 use super::kinematics::Geometry;
 use camchain_codegen::ParameterMode;
 use camchain_codegen::model::Model;
-use camchain_codegen::schema::{Files, parse_model_from};
+use camchain_codegen::schema::{Files, parse_model_from, read_text};
 use camchain_models as models;
 use camchain_reference::NumericModel;
 use camchain_runtime::Dynamics;
@@ -141,7 +141,7 @@ pub fn load_with(
     }
     let (source, file, files) = if looks_like_path(arg) {
         let file = PathBuf::from(arg);
-        let source = std::fs::read_to_string(&file).map_err(|e| {
+        let source = read_text(&file).map_err(|e| {
             CliError::Failed(format!("cannot read model file {}: {e}", file.display()))
         })?;
         (source, file, Files::BesideModel)
@@ -252,7 +252,8 @@ fn read_model(file: &Path) -> Result<(Model, Vec<String>), CliError> {
             file.display()
         )));
     }
-    let source = std::fs::read_to_string(file)
+    // Bounded: a device or a huge file is refused, not read until memory runs out.
+    let source = read_text(file)
         .map_err(|e| CliError::Failed(format!("cannot read model file {}: {e}", file.display())))?;
     // The same `file:line:column: field: message` as the build and `camchain ops`.
     let model = camchain_codegen::check_source(&source, file)
@@ -288,6 +289,34 @@ mod tests {
             numeric.engine.dynamics().info(),
             generated.engine.dynamics().info()
         );
+    }
+
+    #[test]
+    fn a_model_file_beyond_the_size_limit_is_refused_unread() {
+        // A sparse file of 1 GiB: refused from its length, on every path that reads a model
+        // file (the numeric reference, and with run-time parameter values).
+        let dir = std::env::temp_dir().join(format!("camchain-cli-huge-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a temporary directory");
+        let path = dir.join("huge.ron");
+        std::fs::File::create(&path)
+            .and_then(|f| f.set_len(1 << 30))
+            .expect("a sparse file");
+        let arg = path.to_string_lossy().into_owned();
+        let values = [("k".to_string(), 1.0)];
+        for result in [
+            load(&arg, false),
+            load(&arg, true),
+            load_with(&arg, true, &values),
+        ] {
+            match result {
+                Err(CliError::Failed(message)) => assert!(
+                    message.contains(&arg) && message.contains("more than 16 MiB"),
+                    "{message}"
+                ),
+                _ => panic!("refused"),
+            }
+        }
+        std::fs::remove_dir_all(&dir).expect("cleaned up");
     }
 
     #[test]

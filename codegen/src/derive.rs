@@ -85,18 +85,69 @@ fn profile_check(g: &mut Graph, model: &Model, s: &Symbols, k: usize) -> Profile
     }
 }
 
+/// A model whose derivation outgrew the expression graph's node limit
+/// ([`crate::expr::NODE_LIMIT`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the model is too large to derive: its {bodies} bodies need more than {limit} expression \
+     nodes (the limit, which bounds the memory and time the derivation takes): split the \
+     mechanism or use fewer bodies"
+)]
+pub struct TooLarge {
+    /// The node limit reached.
+    pub limit: usize,
+    /// The model's bodies.
+    pub bodies: usize,
+}
+
 impl Derivation {
     /// Derives every term of `model` (with the linear combinations collected).
+    ///
+    /// A model that needs more than [`crate::expr::NODE_LIMIT`] nodes gives a derivation of
+    /// meaningless terms (its graph [`exhausted`](Graph::exhausted)), in bounded time and
+    /// memory: code that may meet such models derives with [`Derivation::checked`].
     pub fn new(model: &Model) -> Self {
-        let mut d = Self::uncollected(model);
-        d.collect_linear();
+        Self::limited(model, crate::expr::NODE_LIMIT)
+    }
+
+    /// [`Derivation::new`], refused when the model needs more than
+    /// [`crate::expr::NODE_LIMIT`] nodes.
+    pub fn checked(model: &Model) -> Result<Self, TooLarge> {
+        Self::checked_with_limit(model, crate::expr::NODE_LIMIT)
+    }
+
+    /// [`Derivation::checked`] with a node limit of `limit` instead.
+    pub fn checked_with_limit(model: &Model, limit: usize) -> Result<Self, TooLarge> {
+        let d = Self::limited(model, limit);
+        match d.too_large(model) {
+            Some(e) => Err(e),
+            None => Ok(d),
+        }
+    }
+
+    /// The error to report when the graph outgrew its limit, if it did.
+    pub fn too_large(&self, model: &Model) -> Option<TooLarge> {
+        self.graph.exhausted().then(|| TooLarge {
+            limit: self.graph.node_limit(),
+            bodies: model.bodies.len(),
+        })
+    }
+
+    fn limited(model: &Model, limit: usize) -> Self {
+        let mut d = Self::uncollected_in(model, Graph::with_node_limit(limit));
+        if !d.graph.exhausted() {
+            d.collect_linear();
+        }
         d
     }
 
     /// The derivation before [`linear::collect_linear`]: what the recursions build, for
     /// comparisons (the pass must never cost operations).
     pub fn uncollected(model: &Model) -> Self {
-        let mut g = Graph::new();
+        Self::uncollected_in(model, Graph::new())
+    }
+
+    fn uncollected_in(model: &Model, mut g: Graph) -> Self {
         let symbols = Symbols::new(&mut g, model);
         let kin = forward(&mut g, model, &symbols);
         let contacts = contact_terms(&mut g, model, &kin, &symbols);

@@ -265,6 +265,11 @@ fn mass_matrix(g: &mut Graph, model: &Model, s: &Symbols, kin: &[BodyKinematics]
     let mut composite: Vec<Option<Inertia>> = vec![None; n];
     let mut mass = vec![vec![g.zero(); n]; n];
     for i in (0..n).rev() {
+        if g.exhausted() {
+            // The model is refused (its graph outgrew the node limit): M has N² terms, and
+            // the rest of them would only take time.
+            break;
+        }
         g.set_section(format!(
             "{}: composite inertia and column {} of M",
             model.bodies[i].name, model.bodies[i].joint.coordinate

@@ -14,6 +14,8 @@
 use crate::profile::Func;
 use std::collections::{HashMap, HashSet};
 
+mod calculus;
+
 /// Handle of a node in a [`Graph`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Id(u32);
@@ -124,7 +126,19 @@ pub struct Graph {
     implicits: HashMap<u32, Implicit>,
     /// The tabulated functions [`Node::Table`] refers to.
     tables: Vec<Table>,
+    /// The most nodes the graph takes ([`NODE_LIMIT`] when 0).
+    node_limit: usize,
+    /// Set when a node was asked for beyond the limit (see [`Graph::exhausted`]).
+    exhausted: bool,
 }
+
+/// The most nodes an expression graph holds: 4 194 304 (2²²), about 500 MB with its index.
+/// The largest built-in model needs about 7 500 and a spatial chain of 200 bodies
+/// (`codegen/tests/common/chain.rs`) 1.3 million; a model that needs more (a planar chain of
+/// 1000 bodies reaches the limit within its mass matrix) is refused with an error on its file
+/// instead of exhausting the machine's memory. Variables do not count: there is one per
+/// coordinate, rate and parameter.
+pub const NODE_LIMIT: usize = 1 << 22;
 
 /// Where Newton starts on an [`Implicit`] variable when no earlier solution is at hand.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -186,9 +200,35 @@ fn const_bits(value: f64) -> u64 {
 }
 
 impl Graph {
-    /// An empty graph.
+    /// An empty graph holding at most [`NODE_LIMIT`] nodes.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty graph holding at most `limit` nodes besides its variables (at least 1).
+    pub fn with_node_limit(limit: usize) -> Self {
+        Graph {
+            node_limit: limit.max(1),
+            ..Self::default()
+        }
+    }
+
+    /// The most nodes the graph holds besides its variables.
+    pub fn node_limit(&self) -> usize {
+        if self.node_limit == 0 {
+            NODE_LIMIT
+        } else {
+            self.node_limit
+        }
+    }
+
+    /// True when a node was asked for beyond [`Graph::node_limit`]. The graph then stops
+    /// growing: every new operation or constant is the constant NaN (so a derivation that
+    /// outgrows it finishes quickly, in bounded memory, with meaningless terms), and the
+    /// expressions built since must not be used: the derivation is refused
+    /// ([`crate::Derivation::checked`]).
+    pub fn exhausted(&self) -> bool {
+        self.exhausted
     }
 
     /// Number of nodes.
@@ -215,6 +255,19 @@ impl Graph {
         if let Some(&id) = self.index.get(&node) {
             return id;
         }
+        if self.nodes.len() >= self.node_limit() && !matches!(node, Node::Var(_)) {
+            self.exhausted = true;
+            let poison = Node::Const(f64::NAN.to_bits());
+            if let Some(&id) = self.index.get(&poison) {
+                return id;
+            }
+            return self.push(poison);
+        }
+        self.push(node)
+    }
+
+    /// Appends a node (not yet in the graph) to the current section.
+    fn push(&mut self, node: Node) -> Id {
         let id = Id(self.nodes.len() as u32);
         self.nodes.push(node);
         let section = self
@@ -633,161 +686,6 @@ impl Graph {
         acc
     }
 
-    /// ∂e/∂x for a variable node `x`, memoised within the call.
-    pub fn diff(&mut self, e: Id, x: Id) -> Id {
-        let mut memo = HashMap::new();
-        self.diff_memo(e, x, &mut memo)
-    }
-
-    /// ∂e/∂x for many expressions sharing one memo table (cheaper for Jacobians).
-    pub fn diff_many(&mut self, es: &[Id], x: Id) -> Vec<Id> {
-        let mut memo = HashMap::new();
-        es.iter()
-            .map(|&e| self.diff_memo(e, x, &mut memo))
-            .collect()
-    }
-
-    fn diff_memo(&mut self, e: Id, x: Id, memo: &mut HashMap<Id, Id>) -> Id {
-        if let Some(&d) = memo.get(&e) {
-            return d;
-        }
-        let d = self.diff_node(e, x, memo);
-        memo.insert(e, d);
-        d
-    }
-
-    fn diff_node(&mut self, e: Id, x: Id, memo: &mut HashMap<Id, Id>) -> Id {
-        match self.node(e) {
-            Node::Const(_) => self.zero(),
-            Node::Var(_) => {
-                if e == x {
-                    self.one()
-                } else if let Some(def) = self.implicit_of(e).cloned() {
-                    self.diff_implicit(e, &def, x, memo)
-                } else {
-                    self.zero()
-                }
-            }
-            Node::Add(a, b) => {
-                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
-                self.add(da, db)
-            }
-            Node::Mul(a, b) => {
-                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
-                let t1 = self.mul(da, b);
-                let t2 = self.mul(a, db);
-                self.add(t1, t2)
-            }
-            Node::Neg(a) => {
-                let da = self.diff_memo(a, x, memo);
-                self.neg(da)
-            }
-            Node::Div(a, b) => {
-                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
-                let t1 = self.div(da, b);
-                let q = self.div(e, b);
-                let t2 = self.mul(q, db);
-                self.sub(t1, t2)
-            }
-            Node::Powi(a, n) => {
-                let da = self.diff_memo(a, x, memo);
-                let p = self.powi(a, n - 1);
-                let np = self.scale(f64::from(n), p);
-                self.mul(np, da)
-            }
-            Node::Powf(a, b) => {
-                let (da, db) = (self.diff_memo(a, x, memo), self.diff_memo(b, x, memo));
-                let ln_a = self.call(Func::Ln, a);
-                let t1 = self.mul(db, ln_a);
-                let ba = self.div(b, a);
-                let t2 = self.mul(ba, da);
-                let inner = self.add(t1, t2);
-                self.mul(e, inner)
-            }
-            Node::Call(f, a) => {
-                let da = self.diff_memo(a, x, memo);
-                if self.is_zero(da) {
-                    return self.zero();
-                }
-                let outer = self.derivative_of_call(f, a, e);
-                self.mul(outer, da)
-            }
-            Node::Table(t, order, a) => {
-                let da = self.diff_memo(a, x, memo);
-                if self.is_zero(da) {
-                    return self.zero();
-                }
-                let outer = self.table(t, order + 1, a);
-                self.mul(outer, da)
-            }
-        }
-    }
-
-    /// ds/dx of the implicit variable `s` = −(Σ ∂ψ/∂p_i · dp_i/dx) / ψ'(s), the partial
-    /// derivatives taken at (s; inputs).
-    fn diff_implicit(&mut self, s: Id, def: &Implicit, x: Id, memo: &mut HashMap<Id, Id>) -> Id {
-        let mut numerator = self.zero();
-        for (&p, &input) in def.placeholders.iter().zip(&def.inputs) {
-            let d_input = self.diff_memo(input, x, memo);
-            if self.is_zero(d_input) {
-                continue;
-            }
-            let partial = self.diff(def.residual, p);
-            let partial = self.at_solution(partial, def, s);
-            let term = self.mul(partial, d_input);
-            numerator = self.add(numerator, term);
-        }
-        if self.is_zero(numerator) {
-            return numerator;
-        }
-        let slope = self.at_solution(def.derivative, def, s);
-        let ratio = self.div(numerator, slope);
-        self.neg(ratio)
-    }
-
-    /// An expression of (s; p) with the placeholders replaced by the inputs and s by the
-    /// implicit variable itself.
-    pub fn at_solution(&mut self, e: Id, def: &Implicit, s: Id) -> Id {
-        let mut e = self.substitute(e, def.unknown, s);
-        for (&p, &input) in def.placeholders.iter().zip(&def.inputs) {
-            e = self.substitute(e, p, input);
-        }
-        e
-    }
-
-    /// f'(a) for the node e = f(a).
-    fn derivative_of_call(&mut self, f: Func, a: Id, e: Id) -> Id {
-        let one = self.one();
-        match f {
-            Func::Sin => self.cos(a),
-            Func::Cos => {
-                let s = self.sin(a);
-                self.neg(s)
-            }
-            Func::Tan => {
-                let t2 = self.powi(e, 2);
-                self.add(one, t2)
-            }
-            Func::Exp => e,
-            Func::Ln => self.div(one, a),
-            Func::Sqrt => {
-                let two_e = self.scale(2.0, e);
-                self.div(one, two_e)
-            }
-            Func::Sinh => self.call(Func::Cosh, a),
-            Func::Cosh => self.call(Func::Sinh, a),
-            Func::Tanh => {
-                let t2 = self.powi(e, 2);
-                self.sub(one, t2)
-            }
-            Func::Atan => {
-                let a2 = self.powi(a, 2);
-                let den = self.add(one, a2);
-                self.div(one, den)
-            }
-        }
-    }
-
     /// Rewrites `roots` with every node of `map` replaced by its image, in one pass over the
     /// graph in id (topological) order: nodes whose children did not change keep their id.
     pub fn replace_nodes(&mut self, roots: &mut [Id], map: &HashMap<Id, Id>) {
@@ -824,97 +722,6 @@ impl Graph {
             Node::Powi(a, n) => self.powi(new(a), n),
             Node::Call(f, a) => self.call(f, new(a)),
             Node::Table(t, order, a) => self.table(t, order, new(a)),
-        }
-    }
-
-    /// e with the variable `x` replaced by the expression `by`.
-    pub fn substitute(&mut self, e: Id, x: Id, by: Id) -> Id {
-        let mut memo = HashMap::new();
-        self.subst_memo(e, x, by, &mut memo)
-    }
-
-    fn subst_memo(&mut self, e: Id, x: Id, by: Id, memo: &mut HashMap<Id, Id>) -> Id {
-        if e == x {
-            return by;
-        }
-        if let Some(&r) = memo.get(&e) {
-            return r;
-        }
-        let r = match self.node(e) {
-            Node::Var(_) if self.implicit_of(e).is_some() => self.subst_implicit(e, x, by, memo),
-            Node::Const(_) | Node::Var(_) => e,
-            Node::Add(a, b) => {
-                let (a, b) = (
-                    self.subst_memo(a, x, by, memo),
-                    self.subst_memo(b, x, by, memo),
-                );
-                self.add(a, b)
-            }
-            Node::Mul(a, b) => {
-                let (a, b) = (
-                    self.subst_memo(a, x, by, memo),
-                    self.subst_memo(b, x, by, memo),
-                );
-                self.mul(a, b)
-            }
-            Node::Neg(a) => {
-                let a = self.subst_memo(a, x, by, memo);
-                self.neg(a)
-            }
-            Node::Div(a, b) => {
-                let (a, b) = (
-                    self.subst_memo(a, x, by, memo),
-                    self.subst_memo(b, x, by, memo),
-                );
-                self.div(a, b)
-            }
-            Node::Powi(a, n) => {
-                let a = self.subst_memo(a, x, by, memo);
-                self.powi(a, n)
-            }
-            Node::Powf(a, b) => {
-                let (a, b) = (
-                    self.subst_memo(a, x, by, memo),
-                    self.subst_memo(b, x, by, memo),
-                );
-                self.powf(a, b)
-            }
-            Node::Call(f, a) => {
-                let a = self.subst_memo(a, x, by, memo);
-                self.call(f, a)
-            }
-            Node::Table(t, order, a) => {
-                let a = self.subst_memo(a, x, by, memo);
-                self.table(t, order, a)
-            }
-        };
-        memo.insert(e, r);
-        r
-    }
-
-    /// An implicit variable whose inputs contain `x`: the same definition on the substituted
-    /// inputs (a new variable), or the variable itself when nothing changes.
-    fn subst_implicit(&mut self, e: Id, x: Id, by: Id, memo: &mut HashMap<Id, Id>) -> Id {
-        let Some(mut def) = self.implicit_of(e).cloned() else {
-            return e;
-        };
-        let inputs: Vec<Id> = def
-            .inputs
-            .iter()
-            .map(|&i| self.subst_memo(i, x, by, memo))
-            .collect();
-        if inputs == def.inputs {
-            return e;
-        }
-        def.inputs = inputs;
-        let name = format!("{}_{}", self.vars[self.var_index_of(e)], self.len());
-        self.implicit(&name, def)
-    }
-
-    fn var_index_of(&self, id: Id) -> usize {
-        match self.node(id) {
-            Node::Var(k) => k as usize,
-            _ => 0,
         }
     }
 

@@ -52,9 +52,11 @@ pub fn generate_file(path: &Path, display: &Path) -> Result<Generated, ModelErro
     generate_source(&source, display, &EmitOptions::default())
 }
 
-/// Reads a model file; a failure is a [`ModelError`] on `display` (line 0: not located).
+/// Reads a model file of at most [`schema::MAX_FILE_BYTES`] ([`schema::read_text`]: a longer
+/// regular file is refused unread, a device without end once it has given that much); a
+/// failure is a [`ModelError`] on `display` (line 0: not located).
 pub fn read_model_file(path: &Path, display: &Path) -> Result<String, ModelError> {
-    std::fs::read_to_string(path).map_err(|e| ModelError {
+    schema::read_text(path).map_err(|e| ModelError {
         file: display.to_path_buf(),
         line: 0,
         column: 0,
@@ -79,7 +81,7 @@ pub fn check_source_in(
     files: schema::Files,
 ) -> Result<Model, ModelError> {
     let model = schema::parse_model_from(source, display, &[], ParameterMode::AsDeclared, files)?;
-    check_assembly(&model, source, display)?;
+    derive_and_assemble(&model, source, display, expr::NODE_LIMIT)?;
     Ok(model)
 }
 
@@ -92,12 +94,31 @@ pub fn located_warnings(model: &Model, source: &str, display: &Path) -> Vec<Mode
         .collect()
 }
 
-/// The initial state of a validated model assembles onto its cams (located at `initial`).
-fn check_assembly(model: &Model, source: &str, display: &Path) -> Result<(), ModelError> {
-    let derivation = Derivation::new(model);
+/// The derivation of a validated model ([`Derivation::checked_with_limit`]: a model too large
+/// to derive is an error on its file), once its initial state is known to assemble onto its cams
+/// (located at `initial`).
+fn derive_and_assemble(
+    model: &Model,
+    source: &str,
+    display: &Path,
+    node_limit: usize,
+) -> Result<Derivation, ModelError> {
+    let derivation = Derivation::checked_with_limit(model, node_limit)
+        .map_err(|e| unlocated(display, e.to_string()))?;
     assembly::assemble_located(model, &derivation)
-        .map(|_| ())
-        .map_err(|(field, message)| schema::field_error(display, source, &field, message))
+        .map_err(|(field, message)| schema::field_error(display, source, &field, message))?;
+    Ok(derivation)
+}
+
+/// An error on the file as a whole (line 0: not located).
+fn unlocated(display: &Path, message: String) -> ModelError {
+    ModelError {
+        file: display.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message,
+    }
 }
 
 /// Validates and checks the text of a model file and generates its Rust module: parsing and
@@ -127,13 +148,8 @@ pub fn generate_source(
             ),
         ));
     }
-    check_assembly(&model, source, display)?;
+    let derivation = derive_and_assemble(&model, source, display, options.node_limit)?;
     let shown = display.to_string_lossy().replace('\\', "/");
-    emit::generate_with(&model, &shown, options).map_err(|message| ModelError {
-        file: display.to_path_buf(),
-        line: 0,
-        column: 0,
-        field: String::new(),
-        message,
-    })
+    emit::generate_from(&model, derivation, &shown, options)
+        .map_err(|message| unlocated(display, message))
 }

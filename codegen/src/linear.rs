@@ -89,35 +89,43 @@ struct Context<'a> {
 }
 
 /// Adds `coef · id` to `form`, descending into linear nodes used only here.
+///
+/// A sum through every body of a long chain is as deep as the chain, so the descent keeps
+/// its own stack instead of recursing; it visits the terms in the same order as a recursive
+/// descent would (left operand first, each completely), so the constant is summed, and the
+/// products are listed, in the same order.
 fn expand(g: &Graph, id: Id, coef: f64, cx: &Context, form: &mut LinearForm, top: bool) {
-    if let Some(k) = g.as_const(id) {
-        form.constant += coef * k;
-        return;
-    }
-    let single = top || cx.uses[id.index()] == 1;
-    if single && !top {
-        if let Node::Mul(a, b) = g.node(id) {
-            if g.as_const(a).is_none() {
-                form.products.push((coef, a, b));
-                return;
+    let mut stack = vec![(id, coef, top)];
+    while let Some((id, coef, top)) = stack.pop() {
+        if let Some(k) = g.as_const(id) {
+            form.constant += coef * k;
+            continue;
+        }
+        let single = top || cx.uses[id.index()] == 1;
+        if single && !top {
+            if let Node::Mul(a, b) = g.node(id) {
+                if g.as_const(a).is_none() {
+                    form.products.push((coef, a, b));
+                    continue;
+                }
             }
         }
-    }
-    if !single || !is_linear(g, id) {
-        *form.terms.entry(cx.image[id.index()]).or_insert(0.0) += coef;
-        return;
-    }
-    match g.node(id) {
-        Node::Add(a, b) => {
-            expand(g, a, coef, cx, form, false);
-            expand(g, b, coef, cx, form, false);
+        if !single || !is_linear(g, id) {
+            *form.terms.entry(cx.image[id.index()]).or_insert(0.0) += coef;
+            continue;
         }
-        Node::Neg(a) => expand(g, a, -coef, cx, form, false),
-        Node::Mul(k, x) => {
-            let k = g.as_const(k).unwrap_or(1.0);
-            expand(g, x, coef * k, cx, form, false);
+        match g.node(id) {
+            Node::Add(a, b) => {
+                stack.push((b, coef, false));
+                stack.push((a, coef, false));
+            }
+            Node::Neg(a) => stack.push((a, -coef, false)),
+            Node::Mul(k, x) => {
+                let k = g.as_const(k).unwrap_or(1.0);
+                stack.push((x, coef * k, false));
+            }
+            _ => unreachable!("is_linear admits only Add, Neg and Mul by a constant"),
         }
-        _ => unreachable!("is_linear admits only Add, Neg and Mul by a constant"),
     }
 }
 
@@ -246,16 +254,19 @@ fn signed_sum(g: &mut Graph, terms: impl Iterator<Item = (Id, bool)>) -> Id {
 
 /// A factor without its constant coefficient and sign: k·x → (k, x), −x → (−1, x).
 fn peel(g: &Graph, id: Id) -> (f64, Id) {
-    match g.node(id) {
-        Node::Neg(x) => {
-            let (k, y) = peel(g, x);
-            (-k, y)
+    let (mut k, mut id) = (1.0, id);
+    loop {
+        match g.node(id) {
+            Node::Neg(x) => {
+                k = -k;
+                id = x;
+            }
+            Node::Mul(c, x) if g.as_const(c).is_some() => {
+                k *= g.as_const(c).unwrap_or(1.0);
+                id = x;
+            }
+            _ => return (k, id),
         }
-        Node::Mul(k, x) if g.as_const(k).is_some() => {
-            let (k2, y) = peel(g, x);
-            (g.as_const(k).unwrap_or(1.0) * k2, y)
-        }
-        _ => (1.0, id),
     }
 }
 

@@ -38,9 +38,11 @@
 
 mod csv;
 mod raw;
+mod read;
 mod scan;
 mod validate;
 
+pub use read::{MAX_FILE_BYTES, read_text};
 pub use validate::ranges;
 
 use crate::error::ModelError;
@@ -49,9 +51,9 @@ use ron::extensions::Extensions;
 use scan::Document;
 use std::path::Path;
 
-/// Reads and validates a model file.
+/// Reads (at most [`MAX_FILE_BYTES`]) and validates a model file.
 pub fn load_model(path: &Path) -> Result<Model, ModelError> {
-    let source = std::fs::read_to_string(path).map_err(|e| ModelError {
+    let source = read_text(path).map_err(|e| ModelError {
         file: path.to_path_buf(),
         line: 0,
         column: 0,

@@ -40,3 +40,35 @@ pub fn chain_ron(n: usize) -> String {
         last = n - 1
     )
 }
+
+/// The RON text of an N-body planar pendulum chain: every joint revolute about z, links of
+/// 0.2 m with the centre of mass at mid-length, a spring-damper in every joint, gravity
+/// along −y, no contact. Its absolute joint angles are sums through every joint below, so
+/// its expressions are as deep as the chain is long.
+#[allow(dead_code)] // used by the test suite, not by the scaling example
+pub fn planar_chain_ron(n: usize) -> String {
+    let mut bodies = String::new();
+    for i in 0..n {
+        let parent = if i == 0 {
+            "ground".to_string()
+        } else {
+            format!("b{}", i - 1)
+        };
+        let anchor = if i == 0 {
+            "(0.0, 0.0, 0.0)"
+        } else {
+            "(0.2, 0.0, 0.0)"
+        };
+        bodies.push_str(&format!(
+            "        (name: \"b{i}\", parent: \"{parent}\", mass: 1.0, com: (0.1, 0.0, 0.0), \
+             inertia: Izz(0.003), joint: (kind: Revolute, axis: (0.0, 0.0, 1.0), \
+             anchor: {anchor}, coordinate: \"q{i}\", spring: (stiffness: 10.0, damping: 0.5, \
+             rest: 0.0))),\n"
+        ));
+    }
+    format!(
+        "(\n    name: \"planar{n}\",\n    description: \"A planar chain of {n} bodies.\",\n    \
+         gravity: (0.0, -9.81, 0.0),\n    bodies: [\n{bodies}    ],\n    \
+         simulation: (t_end: 1.0, dt_out: 0.01),\n)\n"
+    )
+}

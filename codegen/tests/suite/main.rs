@@ -8,9 +8,11 @@ mod chain;
 #[path = "../common/mod.rs"]
 mod common;
 mod contacts;
+mod deep_chains;
 mod derivation;
 mod emit;
 mod features;
+mod file_sizes;
 mod fuzz;
 mod linear_pass;
 mod parameters;

@@ -21,9 +21,9 @@ use super::{Checked, Context, Profile};
 use crate::error::ModelError;
 use crate::model::ModelFile;
 use crate::profile::{Scalar, Tabulated};
-use crate::schema::Files;
 use crate::schema::csv;
 use crate::schema::raw::{self, TableEnds, TableForm};
+use crate::schema::{Files, read_text};
 use camchain_runtime::spline::{CLOSURE_TOLERANCE, Ends, Spline, SplineError};
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
@@ -477,10 +477,10 @@ fn read_file(cx: &Context, field: &str, written: &str) -> Checked<(String, PathB
     let beside = cx.at.file.parent().unwrap_or(Path::new(""));
     let shown = beside.join(written);
     let (text, path) = match cx.files {
-        Files::BesideModel => (std::fs::read_to_string(&shown), shown.clone()),
+        Files::BesideModel => (read_text(&shown), shown.clone()),
         Files::In(dir) => {
             let path = dir.join(written);
-            (std::fs::read_to_string(&path), path)
+            (read_text(&path), path)
         }
         Files::Embedded(list) => match list.iter().find(|(name, _)| *name == written) {
             Some((_, text)) => (Ok((*text).to_string()), PathBuf::new()),
