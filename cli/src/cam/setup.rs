@@ -57,7 +57,7 @@ pub fn load(arg: &str) -> Result<Subject, CliError> {
     match &loaded.engine {
         Engine::Numeric(numeric) => {
             let path = PathBuf::from(arg);
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let text = camchain_codegen::schema::read_text(&path).map_err(|e| {
                 CliError::Failed(format!("cannot read model file {}: {e}", path.display()))
             })?;
             Ok(Subject {

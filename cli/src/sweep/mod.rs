@@ -249,7 +249,7 @@ fn resolve_model(args: &SweepArgs) -> Result<Resolved, CliError> {
         ));
     }
     let path = Path::new(arg);
-    let source = fs::read_to_string(path)
+    let source = camchain_codegen::schema::read_text(path)
         .map_err(|e| CliError::Failed(format!("cannot read {}: {e}", path.display())))?;
     let label = path
         .file_stem()
