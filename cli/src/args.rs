@@ -6,6 +6,7 @@
 //! runtime's.
 
 use camchain_runtime::{IntegratorKind, SimSettings};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -368,8 +369,8 @@ pub struct IntegrationArgs {
     /// Integrator, in any letter case as in model files: rk4 (fixed step --dt), dopri5 or
     /// dop853 (adaptive, --rtol/--atol, first step --dt; dop853 is the fastest at tight
     /// tolerances) [default: the model's]
-    #[arg(long, value_enum, value_name = "NAME", ignore_case = true)]
-    pub integrator: Option<IntegratorArg>,
+    #[arg(long, value_name = "NAME", ignore_case = true, value_parser = integrator_parser())]
+    pub integrator: Option<IntegratorKind>,
 
     /// Step in seconds: fixed step of rk4, first step of dopri5 and dop853 [default: the
     /// model's]
@@ -392,9 +393,7 @@ impl IntegrationArgs {
         SimSettings {
             t_end: self.t_end.unwrap_or(defaults.t_end),
             dt_out: self.dt_out.unwrap_or(defaults.dt_out),
-            integrator: self
-                .integrator
-                .map_or(defaults.integrator, IntegratorArg::kind),
+            integrator: self.integrator.unwrap_or(defaults.integrator),
             dt: self.dt.unwrap_or(defaults.dt),
             rtol: self.rtol.unwrap_or(defaults.rtol),
             atol: self.atol.unwrap_or(defaults.atol),
@@ -553,36 +552,22 @@ impl SimulateArgs {
     }
 }
 
-/// The integrators the command line offers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum IntegratorArg {
-    /// Classical Runge–Kutta 4 with the fixed step --dt.
-    Rk4,
-    /// Adaptive Dormand–Prince 5(4) with error control by --rtol and --atol.
-    Dopri5,
-    /// Adaptive Dormand–Prince 8(5,3) with error control by --rtol and --atol; the
-    /// fastest for tight tolerances.
-    Dop853,
-}
-
-impl IntegratorArg {
-    /// The runtime's integrator.
-    pub fn kind(self) -> IntegratorKind {
-        match self {
-            IntegratorArg::Rk4 => IntegratorKind::Rk4,
-            IntegratorArg::Dopri5 => IntegratorKind::Dopri5,
-            IntegratorArg::Dop853 => IntegratorKind::Dop853,
-        }
-    }
+/// `--integrator`: the runtime's integrators by name, in any letter case, each with its help
+/// line.
+fn integrator_parser() -> impl TypedValueParser<Value = IntegratorKind> {
+    PossibleValuesParser::new(
+        IntegratorKind::ALL
+            .iter()
+            .map(|k| PossibleValue::new(k.name()).help(k.spec().about)),
+    )
+    .try_map(|name| {
+        IntegratorKind::parse(&name).ok_or_else(|| format!("unknown integrator `{name}`"))
+    })
 }
 
 /// Name of an integrator as the command line spells it.
 pub fn integrator_name(kind: IntegratorKind) -> &'static str {
-    match kind {
-        IntegratorKind::Rk4 => "rk4",
-        IntegratorKind::Dopri5 => "dopri5",
-        IntegratorKind::Dop853 => "dop853",
-    }
+    kind.name()
 }
 
 /// A coefficient of restitution: a number in [0, 1].

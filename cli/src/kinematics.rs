@@ -12,6 +12,7 @@
 
 use camchain_codegen::model::{Contact, Follower, JointKind, Model, Profile};
 use camchain_codegen::profile::Scalar;
+use camchain_runtime::kinds::Outline as FollowerOutline;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
 type Vec3 = Vector3<f64>;
@@ -92,7 +93,8 @@ struct CamShape {
     outline: Outline,
     /// The base circle's radius (a polar profile's least radius), about the frame's origin.
     base_radius: Option<f64>,
-    follower: FollowerShape,
+    /// The follower's kind and dimensions (its outline is drawn).
+    follower: Follower,
     /// The marker: the knife edge, the roller's centre, a point of the flat face.
     marker: usize,
     /// The follower's body.
@@ -110,14 +112,6 @@ enum Outline {
     Closed(Vec<(f64, f64)>),
     /// An open curve along its range.
     Open(Vec<(f64, f64)>),
-}
-
-#[derive(Debug, Clone, Copy)]
-enum FollowerShape {
-    Knife,
-    Roller(f64),
-    /// The face's normal in the follower body's frame.
-    Flat(Vec3),
 }
 
 /// One contact's drawing at one instant, in plane coordinates.
@@ -186,11 +180,7 @@ impl CamShape {
             }
             Outline::Explicit(_) => 0.05,
         };
-        let follower = match contact.follower {
-            Follower::Knife => FollowerShape::Knife,
-            Follower::Roller { radius } => FollowerShape::Roller(radius),
-            Follower::Flat { normal } => FollowerShape::Flat(Vec3::from(normal)),
-        };
+        let follower = contact.follower;
         CamShape {
             body: contact.cam_body,
             origin: Vec3::from(contact.origin),
@@ -369,19 +359,29 @@ impl Geometry {
     ) -> Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)> {
         let (body, position) = self.markers.get(cam.marker)?;
         let rotation = rotations.get(*body)?;
-        let centre = origins[*body] + rotation * position;
+        let marker = origins[*body] + rotation * position;
+        let radius = cam.follower.radius().copied().unwrap_or(0.0);
+        // A circular outline's centre: the marker, or the radius away from it.
+        let centre = match cam.follower.centre_direction() {
+            Some(direction) => marker + rotation * Vec3::from(direction) * radius,
+            None => marker,
+        };
         let (u, v) = (self.plane.x_axis, self.plane.y_axis);
         let project = |p: Vec3| self.plane.project(&p.into());
-        Some(match cam.follower {
-            FollowerShape::Knife => (Vec::new(), Vec::new()),
-            FollowerShape::Roller(r) => (
-                circle(centre, u, v, r, 90)
+        let normal = cam
+            .follower
+            .normal()
+            .map_or(Vec3::zeros(), |n| Vec3::from(*n));
+        Some(match cam.follower.kind().outline() {
+            FollowerOutline::Point => (Vec::new(), Vec::new()),
+            FollowerOutline::Circle => (
+                circle(centre, u, v, radius, 90)
                     .into_iter()
                     .map(project)
                     .collect(),
                 Vec::new(),
             ),
-            FollowerShape::Flat(normal) => {
+            FollowerOutline::Line => {
                 let n = rotations[cam.follower_body] * normal;
                 let along = self.plane_axis().cross(&n);
                 let half = cam.face_half_length * along;

@@ -19,7 +19,7 @@
 use crate::contact::relative::{Labels, PointMotion, point_motion};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
-use crate::model::{ClosureKind, ClosurePoint, Field, JointKind, Model};
+use crate::model::{ClosurePoint, Field, JointKind, LoopKind, Model};
 
 /// One scalar equation of a loop: h, J, c.
 #[derive(Debug, Clone)]
@@ -209,7 +209,7 @@ pub fn closure_terms(
             g.set_section(format!(
                 "loop {}: the cut {} joint, h, J, c",
                 closure.name,
-                closure.kind.kind_name()
+                closure.kind.name()
             ));
             let motions = [0, 1].map(|side| side_motion(g, model, kin, s, l, side));
             let [a, b] = [0, 1].map(|side| Carried::point(g, s, &motions[side]));
@@ -217,9 +217,9 @@ pub fn closure_terms(
             vec3::label(g, gap.value, &format!("loop_{}_gap", closure.name));
             let [body_a, body_b] = closure.sides.map(|p: ClosurePoint| p.body);
             let rows = match (closure.kind, closure.planar) {
-                (ClosureKind::Revolute, true) => (0..2).map(|k| gap.component(g, k)).collect(),
-                (ClosureKind::Spherical, _) => (0..3).map(|k| gap.component(g, k)).collect(),
-                (ClosureKind::Revolute, false) => {
+                (LoopKind::Revolute, true) => (0..2).map(|k| gap.component(g, k)).collect(),
+                (LoopKind::Spherical, _) => (0..3).map(|k| gap.component(g, k)).collect(),
+                (LoopKind::Revolute, false) => {
                     let mut rows: Vec<Row> = (0..3).map(|k| gap.component(g, k)).collect();
                     let axis =
                         Carried::direction(g, model, kin, body_a, closure.axis_a, &motions[0]);
@@ -229,7 +229,7 @@ pub fn closure_terms(
                     }
                     rows
                 }
-                (ClosureKind::Prismatic, _) => {
+                (LoopKind::Prismatic, _) => {
                     let [d, z] = [closure.axis, [0.0, 0.0, 1.0]];
                     let normal = [
                         z[1] * d[2] - z[2] * d[1],
@@ -241,13 +241,13 @@ pub fn closure_terms(
                         Carried::direction(g, model, kin, body_a, closure.axis_a, &motions[0]);
                     vec![gap.dot(g, &n), along.dot(g, &n)]
                 }
-                (ClosureKind::PointOnLine, true) => {
+                (LoopKind::PointOnLine, true) => {
                     let d = closure.axis;
                     let normal = [-d[1], d[0], 0.0];
                     let n = Carried::direction(g, model, kin, body_b, normal, &motions[1]);
                     vec![gap.dot(g, &n)]
                 }
-                (ClosureKind::PointOnLine, false) => normal_pair(closure.axis)
+                (LoopKind::PointOnLine, false) => normal_pair(closure.axis)
                     .into_iter()
                     .map(|e| {
                         let n = Carried::direction(g, model, kin, body_b, e, &motions[1]);

@@ -33,6 +33,7 @@
 //! tabulated leaf) and its numbers (`f64`): one generic implementation over [`Number`].
 
 use crate::profile::{Func, Scalar, Tabulated};
+use camchain_runtime::kinds::{FollowerKind, Outline};
 use camchain_runtime::motion_law::MotionProgram;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 use std::sync::Arc;
@@ -149,15 +150,6 @@ pub enum Motion<N> {
     },
 }
 
-/// The follower's shape, as the design sees it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Shape {
-    /// A point (or a roller: the same construction with its radius).
-    Point,
-    /// A flat face.
-    Flat,
-}
-
 /// The dimensions of a design: numbers, or expressions of the run-time parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Geometry<N> {
@@ -176,8 +168,9 @@ pub struct Senses {
     pub turning: f64,
     /// κ: +1 when an oscillating follower's arm turns counterclockwise as it rises.
     pub swing: f64,
-    /// Point (knife or roller) or flat face.
-    pub shape: Shape,
+    /// The follower's kind: its outline decides the construction (a point or a circle:
+    /// the pitch curve; a line: the face's envelope).
+    pub shape: FollowerKind,
 }
 
 /// The follower at one cam angle, design-frame components.
@@ -209,15 +202,15 @@ fn base_direction<N: Number>(g: &Geometry<N>, senses: Senses) -> V<N> {
     };
     let d = dot(pivot, pivot).sqrt();
     let inward = scale(&(N::constant(-1.0) / d.clone()), pivot);
-    let (cos, sin) = match senses.shape {
-        Shape::Point => {
+    let (cos, sin) = match senses.shape.outline() {
+        Outline::Point | Outline::Circle => {
             let rp = g.base_radius.clone() + g.roller.clone();
             let cos = (d.clone() * d.clone() + arm.clone() * arm.clone() - rp.clone() * rp)
                 / (N::constant(2.0) * d * arm.clone());
             let sin = (N::constant(1.0) - cos.clone() * cos.clone()).sqrt();
             (cos, sin)
         }
-        Shape::Flat => {
+        Outline::Line => {
             let sin = (g.base_radius.clone() + face_offset.clone()) / d;
             let cos = (N::constant(1.0) - sin.clone() * sin.clone()).sqrt();
             (cos, sin)
@@ -232,8 +225,8 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
     let kappa = senses.swing;
     let one = N::constant(1.0);
     let zero = N::constant(0.0);
-    match (senses.shape, &g.motion) {
-        (Shape::Point, _) => {
+    match (senses.shape.outline(), &g.motion) {
+        (Outline::Point | Outline::Circle, _) => {
             let (p, dp, motion) = match &g.motion {
                 Motion::Translating { offset } => {
                     let rp = g.base_radius.clone() + g.roller.clone();
@@ -263,7 +256,7 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
                 motion,
             }
         }
-        (Shape::Flat, Motion::Translating { .. }) => {
+        (Outline::Line, Motion::Translating { .. }) => {
             // n = (0, 1), d = R_b + s, ω = −σ: Q = (σ s′, R_b + s).
             let contact = [signed(sigma, ds.clone()), g.base_radius.clone() + s.clone()];
             Placed {
@@ -274,7 +267,7 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
             }
         }
         (
-            Shape::Flat,
+            Outline::Line,
             Motion::Oscillating {
                 pivot, face_offset, ..
             },
@@ -402,8 +395,8 @@ impl CamDesign {
     /// derivatives `l`, by the closed forms of the module's documentation.
     fn radii(&self, l: &[f64; 4]) -> (f64, f64) {
         let (g, sigma, kappa) = (&self.geometry, self.senses.turning, self.senses.swing);
-        match (self.senses.shape, &g.motion) {
-            (Shape::Point, motion) => {
+        match (self.senses.shape.outline(), &g.motion) {
+            (Outline::Point | Outline::Circle, motion) => {
                 let (p, dp, ddp) = match motion {
                     Motion::Translating { offset } => {
                         let rp = g.base_radius + g.roller;
@@ -428,12 +421,12 @@ impl CamDesign {
                 let pitch = -sigma * speed2 * speed2.sqrt() / (cross(&t, &dt) - sigma * speed2);
                 (pitch - g.roller, pitch)
             }
-            (Shape::Flat, Motion::Translating { .. }) => {
+            (Outline::Line, Motion::Translating { .. }) => {
                 let r = g.base_radius + l[0] + l[2];
                 (r, f64::NAN)
             }
             (
-                Shape::Flat,
+                Outline::Line,
                 Motion::Oscillating {
                     pivot, face_offset, ..
                 },
@@ -556,12 +549,12 @@ mod tests {
         let point = |turning, swing| Senses {
             turning,
             swing,
-            shape: Shape::Point,
+            shape: FollowerKind::Roller,
         };
         let flat = |turning, swing| Senses {
             turning,
             swing,
-            shape: Shape::Flat,
+            shape: FollowerKind::Flat,
         };
         let translating = |roller, offset| Geometry {
             base_radius: 0.04,

@@ -10,7 +10,7 @@
 use crate::contact::ContactTerms;
 use crate::derive::Derivation;
 use crate::expr::{Graph, Id, Node, OpCount};
-use crate::model::{IntegratorChoice, JointKind, Model};
+use crate::model::{JointKind, Model};
 use crate::profile::{Func, TabulatedFunction};
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
@@ -686,11 +686,7 @@ fn info_static(model: &Model) -> String {
         .contacts
         .iter()
         .map(|c| {
-            let follower = match c.follower {
-                crate::model::Follower::Knife => "Knife",
-                crate::model::Follower::Roller { .. } => "Roller",
-                crate::model::Follower::Flat { .. } => "Flat",
-            };
+            let follower = c.follower.kind().keyword();
             let profile = match c.profile {
                 crate::model::Profile::Explicit { .. } => "Explicit",
                 crate::model::Profile::Polar { .. } => "Polar",
@@ -715,12 +711,7 @@ fn info_static(model: &Model) -> String {
         .loops
         .iter()
         .map(|l| {
-            let kind = match l.kind {
-                crate::model::ClosureKind::Revolute => "Revolute",
-                crate::model::ClosureKind::Spherical => "Spherical",
-                crate::model::ClosureKind::Prismatic => "Prismatic",
-                crate::model::ClosureKind::PointOnLine => "PointOnLine",
-            };
+            let kind = l.kind.keyword();
             let equations: Vec<String> =
                 l.equations().iter().map(|e| format!("{e:?}.to_string()")).collect();
             format!(
@@ -731,11 +722,7 @@ fn info_static(model: &Model) -> String {
         })
         .collect();
     let s = &model.simulation;
-    let integrator = match s.integrator {
-        IntegratorChoice::Rk4 => "Rk4",
-        IntegratorChoice::Dopri5 => "Dopri5",
-        IntegratorChoice::Dop853 => "Dop853",
-    };
+    let integrator = s.integrator.keyword();
     format!(
         "/// Static description of the model.\n\
          {ALLOW_LITERALS}\n\

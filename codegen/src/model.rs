@@ -6,6 +6,8 @@
 //! parsed profile and drive expressions.
 
 use crate::profile::Scalar;
+pub use camchain_runtime::{FollowerKind, IntegratorKind, LoopKind};
+use serde::Deserialize;
 
 /// Kind of one-degree-of-freedom joint between a body and its parent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -98,10 +100,15 @@ pub struct Marker {
     pub position: [f64; 3],
 }
 
-/// The shape a follower presents to its cam (docs/model-format.md, "Contacts").
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Follower {
+/// The shape a follower presents to its cam (docs/model-format.md, "Contacts"): its kind
+/// ([`FollowerKind`], the project's one list of follower kinds, with their names) and the
+/// kind's dimensions. `N` is how a dimension is given: a number (`f64`, the validated
+/// model) or, in the model file as read, a number or a run-time parameter's name.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Follower<N = f64> {
     /// The marker itself touches the profile: the paper's knife edge (eq. 1–3).
+    #[default]
     Knife,
     /// A circle of radius `radius` (m, > 0) centred on the marker: its centre stays on the
     /// profile's offset (pitch) curve. A cylinder whose axis is parallel to the cam's, or a
@@ -109,7 +116,7 @@ pub enum Follower {
     /// slip: its spin does not enter the dynamics.
     Roller {
         /// Radius (m).
-        radius: f64,
+        radius: N,
     },
     /// A flat face through the marker, tangent to the profile; the contact point slides
     /// along it. `normal` is the face's unit normal in the follower body's frame, pointing
@@ -117,17 +124,68 @@ pub enum Follower {
     /// relative to the cam only about the cam's axis.
     Flat {
         /// Unit normal, follower body frame.
-        normal: [f64; 3],
+        normal: [N; 3],
     },
 }
 
-impl Follower {
+impl<N> Follower<N> {
+    /// The follower's kind.
+    pub fn kind(&self) -> FollowerKind {
+        match self {
+            Follower::Knife => FollowerKind::Knife,
+            Follower::Roller { .. } => FollowerKind::Roller,
+            Follower::Flat { .. } => FollowerKind::Flat,
+        }
+    }
+
+    /// The radius of a circular outline (a roller's), if the kind has one.
+    pub fn radius(&self) -> Option<&N> {
+        match self {
+            Follower::Roller { radius } => Some(radius),
+            Follower::Knife | Follower::Flat { .. } => None,
+        }
+    }
+
+    /// The face's normal (follower body frame), if the kind has a face.
+    pub fn normal(&self) -> Option<&[N; 3]> {
+        match self {
+            Follower::Flat { normal } => Some(normal),
+            Follower::Knife | Follower::Roller { .. } => None,
+        }
+    }
+
+    /// The same follower with its dimensions converted: `radius` takes the radius,
+    /// `normal` the face's normal (each with its field's name under `follower`).
+    pub fn try_map<M, E>(
+        &self,
+        radius: impl FnOnce(&N, &'static str) -> Result<M, E>,
+        normal: impl FnOnce(&[N; 3], &'static str) -> Result<[M; 3], E>,
+    ) -> Result<Follower<M>, E> {
+        Ok(match self {
+            Follower::Knife => Follower::Knife,
+            Follower::Roller { radius: r } => Follower::Roller {
+                radius: radius(r, "radius")?,
+            },
+            Follower::Flat { normal: n } => Follower::Flat {
+                normal: normal(n, "normal")?,
+            },
+        })
+    }
+
     /// `knife`, `roller` or `flat`: the kind's name in messages and output.
     pub fn kind_name(&self) -> &'static str {
+        self.kind().name()
+    }
+}
+
+impl Follower<f64> {
+    /// Where a circular outline is centred: `None` on the marker (a roller, whose centre the
+    /// marker is); `Some(u)`, a unit vector of the follower body's frame, when the centre is
+    /// the radius away from the marker along `u`. The derivation, the reference and the
+    /// drawings place the circle through this alone.
+    pub fn centre_direction(&self) -> Option<[f64; 3]> {
         match self {
-            Follower::Knife => "knife",
-            Follower::Roller { .. } => "roller",
-            Follower::Flat { .. } => "flat",
+            Follower::Knife | Follower::Roller { .. } | Follower::Flat { .. } => None,
         }
     }
 }
@@ -241,37 +299,6 @@ impl Contact {
     }
 }
 
-/// The joint a loop is cut at (docs/model-format.md, "Loops"; docs/method.md §11): the tree
-/// is what remains of the mechanism once one joint per loop is removed, and the cut joint
-/// comes back as equations h(q) = 0 between a point A (`a`) of one body and a point B (`b`)
-/// of another.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ClosureKind {
-    /// A pin: A and B coincide (planar: 2 equations; spatial: 3, and the pin's axis carried
-    /// by A stays along the one carried by B, 2 more).
-    Revolute,
-    /// A ball joint: A and B coincide (3 equations; planar models use [`Self::Revolute`]).
-    Spherical,
-    /// A slider (planar only): A stays on the line through B along `axis` (B's frame) and
-    /// A's body does not turn relative to B's (2 equations).
-    Prismatic,
-    /// A pin in a slot: A stays on the line through B along `axis` (B's frame); planar: 1
-    /// equation, spatial: 2.
-    PointOnLine,
-}
-
-impl ClosureKind {
-    /// `revolute`, `spherical`, `prismatic` or `point_on_line`.
-    pub fn kind_name(self) -> &'static str {
-        match self {
-            ClosureKind::Revolute => "revolute",
-            ClosureKind::Spherical => "spherical",
-            ClosureKind::Prismatic => "prismatic",
-            ClosureKind::PointOnLine => "point_on_line",
-        }
-    }
-}
-
 /// A point fixed on a body, or on the ground, where a loop is cut.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClosurePoint {
@@ -288,7 +315,7 @@ pub struct Closure {
     /// Unique name among contacts and loops (CSV columns `loop_<name>_<equation>`).
     pub name: String,
     /// The cut joint's kind.
-    pub kind: ClosureKind,
+    pub kind: LoopKind,
     /// A and B.
     pub sides: [ClosurePoint; 2],
     /// Unit vector in B's body frame: the pin's axis (spatial revolute), the line of a
@@ -307,26 +334,8 @@ impl Closure {
     /// `normal_2`) for A − B across the line, `turn` for A's direction across B's line,
     /// `tilt_1`, `tilt_2` for A's axis across B's.
     pub fn equations(&self) -> &'static [&'static str] {
-        match (self.kind, self.planar) {
-            (ClosureKind::Revolute, true) => &["x", "y"],
-            (ClosureKind::Revolute, false) => &["x", "y", "z", "tilt_1", "tilt_2"],
-            (ClosureKind::Spherical, _) => &["x", "y", "z"],
-            (ClosureKind::Prismatic, _) => &["normal", "turn"],
-            (ClosureKind::PointOnLine, true) => &["normal"],
-            (ClosureKind::PointOnLine, false) => &["normal_1", "normal_2"],
-        }
+        self.kind.equations(self.planar)
     }
-}
-
-/// Integrator named in the model's default settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum IntegratorChoice {
-    /// Classical fixed-step Runge–Kutta 4.
-    Rk4,
-    /// Adaptive embedded Dormand–Prince 5(4).
-    Dopri5,
-    /// Adaptive Dormand–Prince 8(5,3) with dense output.
-    Dop853,
 }
 
 /// Default simulation settings stored with the model.
@@ -337,7 +346,7 @@ pub struct Simulation {
     /// Output interval (s), > 0.
     pub dt_out: f64,
     /// Integrator.
-    pub integrator: IntegratorChoice,
+    pub integrator: IntegratorKind,
     /// Fixed step for RK4 / initial step for adaptive integrators (s), > 0.
     pub dt: f64,
     /// Relative tolerance of adaptive integrators.

@@ -291,7 +291,7 @@ impl<'a> Locator<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{IntegratorChoice, JointKind};
+    use crate::model::{IntegratorKind, JointKind};
     use std::path::PathBuf;
 
     /// A small valid model; every value of interest is on its own line (numbers below).
@@ -399,7 +399,7 @@ mod tests {
         // link2 is driven, so it counts as held even though `hold` lists only q1.
         assert_eq!(m.initial.hold, vec![true, true]);
         assert_eq!(m.simulation.t_end, 5.0);
-        assert_eq!(m.simulation.integrator, IntegratorChoice::Rk4);
+        assert_eq!(m.simulation.integrator, IntegratorKind::Rk4);
         assert_eq!(m.simulation.dt_out, 0.01);
         assert_eq!(m.simulation.rtol, 1e-10);
     }
@@ -770,7 +770,7 @@ mod tests {
         for name in ["Dop853", "dop853", "DOP853"] {
             let source = edited("integrator: Rk4", &format!("integrator: {name}"));
             let m = parse_model(&source, &file()).unwrap_or_else(|e| panic!("{name}: {e}"));
-            assert_eq!(m.simulation.integrator, IntegratorChoice::Dop853, "{name}");
+            assert_eq!(m.simulation.integrator, IntegratorKind::Dop853, "{name}");
         }
         assert_rejected(
             "integrator: Rk4",

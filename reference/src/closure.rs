@@ -7,7 +7,7 @@
 
 use crate::numeric::{Motion, Pose, vec3};
 use camchain_codegen::closure::normal_pair;
-use camchain_codegen::model::{Closure, ClosureKind};
+use camchain_codegen::model::{Closure, LoopKind};
 use nalgebra::Vector3;
 
 type Vec3 = Vector3<f64>;
@@ -90,24 +90,24 @@ impl ClosureConst {
         let components = |k: usize| (0..k).map(|i| (gap, Item::Axis(i))).collect::<Vec<_>>();
         let d = closure.axis;
         let equations = match (closure.kind, closure.planar) {
-            (ClosureKind::Revolute, true) => components(2),
-            (ClosureKind::Spherical, _) => components(3),
-            (ClosureKind::Revolute, false) => {
+            (LoopKind::Revolute, true) => components(2),
+            (LoopKind::Spherical, _) => components(3),
+            (LoopKind::Revolute, false) => {
                 let mut e = components(3);
                 for perpendicular in normal_pair(d) {
                     e.push((along_a(closure.axis_a), along_b(perpendicular)));
                 }
                 e
             }
-            (ClosureKind::Prismatic, _) => {
+            (LoopKind::Prismatic, _) => {
                 let normal = [-d[1], d[0], 0.0];
                 vec![
                     (gap, along_b(normal)),
                     (along_a(closure.axis_a), along_b(normal)),
                 ]
             }
-            (ClosureKind::PointOnLine, true) => vec![(gap, along_b([-d[1], d[0], 0.0]))],
-            (ClosureKind::PointOnLine, false) => normal_pair(d)
+            (LoopKind::PointOnLine, true) => vec![(gap, along_b([-d[1], d[0], 0.0]))],
+            (LoopKind::PointOnLine, false) => normal_pair(d)
                 .into_iter()
                 .map(|e| (gap, along_b(e)))
                 .collect(),

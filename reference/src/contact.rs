@@ -41,7 +41,8 @@ thread_local! {
 pub(crate) struct ContactConst {
     /// Unique among the contacts built by this process (the key of a reused search).
     id: u64,
-    /// The follower's body and its point (the marker) in that body's frame.
+    /// The follower's body and its point (the marker, or a circular outline's centre) in that
+    /// body's frame.
     body: usize,
     marker: Vec3,
     /// The follower body's own joint.
@@ -122,7 +123,15 @@ impl ContactConst {
         Self {
             id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             body: marker.body,
-            marker: vec3(&marker.position),
+            // The follower point: the marker, or the centre of a circular outline the radius
+            // away from it (a curved face's apex is the marker).
+            marker: match contact.follower.centre_direction() {
+                Some(direction) => {
+                    vec3(&marker.position)
+                        + vec3(&direction) * contact.follower.radius().copied().unwrap_or(0.0)
+                }
+                None => vec3(&marker.position),
+            },
             own_joint: model.bodies[marker.body].joint.kind,
             cam_body: contact.cam_body,
             origin: vec3(&contact.origin),

@@ -21,15 +21,11 @@ use crate::closure::{ClosureConst, ClosureEval};
 use crate::contact::{ContactConst, Evaluated};
 use crate::jet::{eval_jet, eval_with};
 use camchain_codegen::ModelError;
-use camchain_codegen::model::{
-    Body, Closure, ClosureKind, Contact, Follower, IntegratorChoice, JointKind, Model,
-    ParameterMode, Profile,
-};
+use camchain_codegen::model::{Body, Closure, Contact, JointKind, Model, ParameterMode, Profile};
 use camchain_codegen::schema::{Files, load_model, parse_model_from};
 use camchain_runtime::{
     ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
-    Energy, FollowerKind, InitialGuess, IntegratorKind, LoopInfo, LoopKind, ModelInfo,
-    ParameterInfo, ProfileKind, SimSettings,
+    Energy, InitialGuess, LoopInfo, ModelInfo, ParameterInfo, ProfileKind, SimSettings,
 };
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use std::path::Path;
@@ -61,7 +57,7 @@ pub fn model_info(model: &Model) -> ModelInfo {
         defaults: SimSettings {
             t_end: model.simulation.t_end,
             dt_out: model.simulation.dt_out,
-            integrator: integrator_kind(model.simulation.integrator),
+            integrator: model.simulation.integrator,
             dt: model.simulation.dt,
             rtol: model.simulation.rtol,
             atol: model.simulation.atol,
@@ -85,11 +81,7 @@ pub fn model_info(model: &Model) -> ModelInfo {
 pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
     ContactInfo {
         name: c.name.clone(),
-        follower: match c.follower {
-            Follower::Knife => FollowerKind::Knife,
-            Follower::Roller { .. } => FollowerKind::Roller,
-            Follower::Flat { .. } => FollowerKind::Flat,
-        },
+        follower: c.follower.kind(),
         profile: match c.profile {
             Profile::Explicit { .. } => ProfileKind::Explicit,
             Profile::Polar { .. } => ProfileKind::Polar,
@@ -106,12 +98,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
 pub fn loop_info(closure: &Closure) -> LoopInfo {
     LoopInfo {
         name: closure.name.clone(),
-        kind: match closure.kind {
-            ClosureKind::Revolute => LoopKind::Revolute,
-            ClosureKind::Spherical => LoopKind::Spherical,
-            ClosureKind::Prismatic => LoopKind::Prismatic,
-            ClosureKind::PointOnLine => LoopKind::PointOnLine,
-        },
+        kind: closure.kind,
         equations: closure.equations().iter().map(|e| e.to_string()).collect(),
     }
 }
@@ -124,14 +111,6 @@ fn coordinate_info(body: &Body) -> CoordinateInfo {
             JointKind::Prismatic => CoordinateKind::Prismatic,
         },
         driven: body.joint.prescribed.is_some(),
-    }
-}
-
-fn integrator_kind(choice: IntegratorChoice) -> IntegratorKind {
-    match choice {
-        IntegratorChoice::Rk4 => IntegratorKind::Rk4,
-        IntegratorChoice::Dopri5 => IntegratorKind::Dopri5,
-        IntegratorChoice::Dop853 => IntegratorKind::Dop853,
     }
 }
 
@@ -673,8 +652,11 @@ impl Dynamics for NumericModel {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use camchain_codegen::model::{Initial, Joint, Marker, Prescribed, Simulation, SpringDamper};
+    use camchain_codegen::model::{
+        Follower, Initial, Joint, Marker, Prescribed, Simulation, SpringDamper,
+    };
     use camchain_codegen::profile::{Func, Scalar};
+    use camchain_runtime::IntegratorKind;
     use nalgebra::DMatrix;
     use std::f64::consts::PI;
 
@@ -744,7 +726,7 @@ mod tests {
             simulation: Simulation {
                 t_end: 1.0,
                 dt_out: 0.01,
-                integrator: IntegratorChoice::Dopri5,
+                integrator: IntegratorKind::Dopri5,
                 dt: 1e-3,
                 rtol: 1e-8,
                 atol: 1e-10,

@@ -9,6 +9,8 @@
 //! code generator derived symbolically; the contact equations then use the envelope theorem
 //! (docs/method.md §9), so no derivative of s is ever needed.
 
+use crate::kinds::{FollowerKind, Outline};
+
 /// Newton iterations from one start before it counts as failed.
 pub const MAX_ITERATIONS: usize = 40;
 
@@ -84,15 +86,14 @@ fn scan(range: (f64, f64), objective: &impl Fn(f64) -> f64) -> f64 {
     best.1
 }
 
-/// The shape the profile must admit (for [`followable`]).
+/// The follower as the profile must admit it (for [`followable`]): its kind, whose outline
+/// decides the rule, and the radius of a circular outline.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Shape {
-    /// A knife edge: any smooth profile.
-    Knife,
-    /// A roller of this radius (m): no hollow tighter than it.
-    Roller(f64),
-    /// A flat face: a strictly convex profile.
-    Flat,
+pub struct Shape {
+    /// The follower's kind.
+    pub kind: FollowerKind,
+    /// The radius (m) of an [`Outline::Circle`] (a roller's); ignored for other outlines.
+    pub radius: f64,
 }
 
 /// Where a problem [`followable`] finds is reported in the model file.
@@ -176,23 +177,24 @@ fn followable_unnamed(
         return Ok(());
     };
     let radius_of_curvature = 1.0 / hollow.curvature;
-    match shape {
-        Shape::Roller(radius) if hollow.curvature > 0.0 && radius >= radius_of_curvature => Err((
+    let (radius, label) = (shape.radius, shape.kind.label());
+    match shape.kind.outline() {
+        Outline::Circle if hollow.curvature > 0.0 && radius >= radius_of_curvature => Err((
             Place::Radius,
             format!(
-                "the roller (radius {radius} m) is larger than the profile's hollow at \
+                "the {label} (radius {radius} m) is larger than the profile's hollow at \
                  {variable} = {:.6}, whose radius of curvature is {radius_of_curvature:.6e} m: \
-                 the roller cannot reach the bottom of it (undercutting); use a roller smaller \
+                 the {label} cannot reach the bottom of it (undercutting); use a {label} smaller \
                  than {radius_of_curvature:.6e} m or a flatter profile",
                 hollow.at
             ),
         )),
         // The face rests on one point only where the profile is strictly convex: a straight
         // stretch would carry it along a whole segment.
-        Shape::Flat if hollow.curvature > -FLAT_CURVATURE => Err((
+        Outline::Line if hollow.curvature > -FLAT_CURVATURE => Err((
             Place::Follower,
             format!(
-                "a flat face needs a strictly convex profile, but at {variable} = {:.6} the \
+                "a {label} needs a strictly convex profile, but at {variable} = {:.6} the \
                  profile is {} (curvature {:.6e} 1/m): the face would bridge it",
                 hollow.at,
                 if hollow.curvature > 0.0 {
@@ -203,7 +205,7 @@ fn followable_unnamed(
                 hollow.curvature
             ),
         )),
-        _ => Ok(()),
+        Outline::Point | Outline::Circle | Outline::Line => Ok(()),
     }
 }
 

@@ -9,6 +9,8 @@
 //! Matrices are dense row-major slices so that generated code can write them without
 //! allocation.
 
+pub use crate::kinds::{FollowerKind, IntegratorKind, LoopKind};
+
 /// Kind of a generalised coordinate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CoordinateKind {
@@ -27,26 +29,6 @@ pub struct CoordinateInfo {
     pub kind: CoordinateKind,
     /// True when the joint's motion is prescribed (a driven joint).
     pub driven: bool,
-}
-
-/// Integrator choice.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum IntegratorKind {
-    /// Classical fixed-step Runge–Kutta 4 (step `dt`).
-    Rk4,
-    /// Adaptive embedded Dormand–Prince 5(4) with error control on (u, u̇); dense output
-    /// of order 4 between steps.
-    Dopri5,
-    /// Adaptive Dormand–Prince 8(5,3) with error control on (u, u̇); dense output of
-    /// order 7 between steps. The fastest choice for tight tolerances.
-    Dop853,
-}
-
-impl IntegratorKind {
-    /// True for the adaptive integrators (tolerances, error control, dense output).
-    pub fn is_adaptive(self) -> bool {
-        matches!(self, IntegratorKind::Dopri5 | IntegratorKind::Dop853)
-    }
 }
 
 /// Simulation settings (the model file's defaults, overridable by the caller).
@@ -80,17 +62,6 @@ pub struct InitialGuess {
     pub given_q: Vec<bool>,
     /// `given_qd[i]`: the model file gives velocity i's guess.
     pub given_qd: Vec<bool>,
-}
-
-/// The shape of a contact's follower.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum FollowerKind {
-    /// A point of the follower (the paper's knife edge).
-    Knife,
-    /// A roller (a circle centred on the follower point).
-    Roller,
-    /// A flat face through the follower point.
-    Flat,
 }
 
 /// The form of a contact's cam profile.
@@ -133,19 +104,6 @@ impl ContactInfo {
             cam_moves: false,
         }
     }
-}
-
-/// The kind of joint a loop is cut at (docs/method.md §11).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum LoopKind {
-    /// A pin: the two points coincide (planar: 2 equations; spatial: 5 with the axes).
-    Revolute,
-    /// A ball joint: the two points coincide (3 equations).
-    Spherical,
-    /// A planar slider: a point on a line, no relative turn (2 equations).
-    Prismatic,
-    /// A pin in a slot: a point on a line (planar: 1 equation; spatial: 2).
-    PointOnLine,
 }
 
 /// Static description of one loop closure: its rows of h follow the contacts' and the

@@ -39,6 +39,7 @@ pub mod dynamics;
 pub mod error;
 pub mod events;
 pub mod integrators;
+pub mod kinds;
 pub mod metrics;
 pub mod motion_law;
 pub mod parameters;

@@ -8,7 +8,8 @@
 //! function is flat, an error δ in the angle costs only ~δ² in the value), and a peak at a
 //! joint is taken on the side where it is reached.
 
-use camchain_codegen::design::{self, CamDesign, DesignPoint, Motion, Shape};
+use camchain_codegen::design::{self, CamDesign, DesignPoint, Motion};
+use camchain_runtime::kinds::Outline;
 use camchain_runtime::motion_law::Jump;
 
 /// A value and the cam angle where it occurs.
@@ -120,8 +121,8 @@ impl Analysis {
             theta: curvature.min.theta,
             value: -1.0 / curvature.min.value,
         });
-        let undercut = match design.senses.shape {
-            Shape::Point if design.geometry.roller > 0.0 => {
+        let undercut = match design.senses.shape.outline() {
+            Outline::Circle => {
                 let (theta, k) = design.least(samples, |p| -1.0 / p.pitch_radius);
                 (k < 0.0).then(|| Undercut {
                     pitch: Extreme {
@@ -131,13 +132,13 @@ impl Analysis {
                     margin: -1.0 / k - design.geometry.roller,
                 })
             }
-            _ => None,
+            Outline::Point | Outline::Line => None,
         };
-        let face = match design.senses.shape {
-            Shape::Flat => Some(FaceWidth {
+        let face = match design.senses.shape.outline() {
+            Outline::Line => Some(FaceWidth {
                 offset: range(design, samples, |p| face_offset(design, p)),
             }),
-            Shape::Point => None,
+            Outline::Point | Outline::Circle => None,
         };
         Analysis {
             speed,
@@ -172,10 +173,11 @@ mod tests {
     use super::*;
     use camchain_codegen::design::{Geometry, Senses};
     use camchain_codegen::profile::Tabulated;
+    use camchain_runtime::FollowerKind;
     use camchain_runtime::motion_law::{Law, MotionProgram, Segment};
     use std::f64::consts::PI;
 
-    fn cycloidal(shape: Shape, roller: f64) -> CamDesign {
+    fn cycloidal(shape: FollowerKind, roller: f64) -> CamDesign {
         let third = 2.0 * PI / 3.0;
         let program = MotionProgram::new(&[
             Segment {
@@ -216,7 +218,7 @@ mod tests {
 
     #[test]
     fn peaks_are_the_textbook_ones_and_a_flat_face_has_a_width() {
-        let design = cycloidal(Shape::Point, 0.01);
+        let design = cycloidal(FollowerKind::Roller, 0.01);
         let a = Analysis::new(&design, 10.0, 360);
         let (h, beta, w) = (0.01, 2.0 * PI / 3.0, 10.0);
         // Closed forms 2hω/β and 2πhω²/β², refined to rounding.
@@ -226,7 +228,7 @@ mod tests {
         // The in-line roller's pressure angle is symmetric, the cam convex on the dwells.
         assert!((a.pressure.max.value + a.pressure.min.value).abs() < 1e-9);
         assert!(a.convex.is_some() && a.undercut.is_some());
-        let flat = Analysis::new(&cycloidal(Shape::Flat, 0.0), 10.0, 360);
+        let flat = Analysis::new(&cycloidal(FollowerKind::Flat, 0.0), 10.0, 360);
         // A translating flat face: the contact is s′ off the axis: ±2h/β at most.
         let width = flat.face.expect("a face").offset;
         assert!((width.max.value - 2.0 * h / beta).abs() < 1e-12);

@@ -17,7 +17,8 @@ use super::report::{degrees, turn_of, units};
 use crate::kinematics::CamPicture;
 use crate::plots::{Figure, Frame, LinePanel, MechanismPanel, Panel, Series};
 use crate::summary::number;
-use camchain_codegen::design::{self, CamDesign, Shape};
+use camchain_codegen::design::{self, CamDesign};
+use camchain_runtime::kinds::Outline;
 use plotters::style::RGBColor;
 use std::f64::consts::TAU;
 
@@ -331,8 +332,8 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
         }],
     )];
     let mut visible: Vec<(f64, f64)> = outline.iter().chain(&base).copied().collect();
-    let roller = design.senses.shape == Shape::Point && g.roller > 0.0;
-    if roller {
+    let outline = design.senses.shape.outline();
+    if outline == Outline::Circle {
         let prime = circle(g.base_radius + g.roller);
         frames.push(frame("pitch curve".into(), BLUE, vec![line(pitch.clone())]));
         frames.push(frame(
@@ -346,7 +347,7 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
             .map(|(x, y)| (cx + x, cy + y))
             .collect();
         frames.push(frame(
-            "roller at θ = 0".into(),
+            format!("{} at θ = 0", design.senses.shape.label()),
             RED,
             vec![line(rim.clone())],
         ));
@@ -354,7 +355,7 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
         visible.extend(pitch.iter().copied());
         visible.extend(rim);
     }
-    if design.senses.shape == Shape::Flat {
+    if outline == Outline::Line {
         // The face at θ = 0 (the cam frame is the design frame there), as wide as needed.
         let start = analysis.points.first();
         if let (Some(p), Some(face)) = (start, &analysis.face) {
@@ -376,10 +377,10 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
             visible.extend(ends);
         }
     }
-    if design.senses.shape == Shape::Point && !roller {
+    if outline == Outline::Point {
         let (cx, cy) = pitch.first().copied().unwrap_or((0.0, 0.0));
         frames.push(frame(
-            "knife at θ = 0".into(),
+            format!("{} at θ = 0", design.senses.shape.name()),
             RED,
             vec![line(
                 circle(0.01 * g.base_radius)
@@ -396,13 +397,13 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
     } else {
         "clockwise"
     };
-    let circles = match design.senses.shape {
-        Shape::Point if g.roller > 0.0 => format!(
+    let circles = match outline {
+        Outline::Circle => format!(
             "base circle {:.6} m, prime circle {:.6} m",
             g.base_radius,
             g.base_radius + g.roller
         ),
-        _ => format!("base circle {:.6} m", g.base_radius),
+        Outline::Point | Outline::Line => format!("base circle {:.6} m", g.base_radius),
     };
     column(
         format!("{name}: cam profile in the cam frame"),

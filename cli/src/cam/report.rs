@@ -4,7 +4,8 @@
 use super::analysis::{Analysis, Extreme, Range};
 use super::dynamics::{JumpSpeed, OneSided, Prediction, Turn};
 use crate::summary::number;
-use camchain_codegen::design::{CamDesign, Motion, Shape};
+use camchain_codegen::design::{CamDesign, Motion};
+use camchain_runtime::kinds::Outline;
 use camchain_runtime::motion_law::Law;
 use std::f64::consts::TAU;
 use std::fmt::Write as _;
@@ -65,10 +66,10 @@ pub fn design_summary(
     let mut text = String::new();
     let g = &design.geometry;
     let u = units(design);
-    let follower = match (design.senses.shape, g.roller > 0.0) {
-        (Shape::Flat, _) => "flat face".to_string(),
-        (Shape::Point, true) => format!("roller (radius {})", metres(g.roller)),
-        (Shape::Point, false) => "knife edge".to_string(),
+    let kind = design.senses.shape;
+    let follower = match kind.outline() {
+        Outline::Circle => format!("{} (radius {})", kind.label(), metres(g.roller)),
+        Outline::Point | Outline::Line => kind.label().to_string(),
     };
     let motion = match &g.motion {
         Motion::Translating { offset } if *offset == 0.0 => {
@@ -90,9 +91,11 @@ pub fn design_summary(
             } else {
                 "clockwise"
             };
-            let face = match design.senses.shape {
-                Shape::Flat => format!(", the face {} from the pivot's line", metres(*face_offset)),
-                Shape::Point => format!(", arm {}", metres(*arm)),
+            let face = match kind.outline() {
+                Outline::Line => {
+                    format!(", the face {} from the pivot's line", metres(*face_offset))
+                }
+                Outline::Point | Outline::Circle => format!(", arm {}", metres(*arm)),
             };
             format!(
                 "oscillating about the pivot ({}, {}) m{face}, swinging {swing} as it rises",
@@ -107,9 +110,9 @@ pub fn design_summary(
     } else {
         "clockwise"
     };
-    let prime = match design.senses.shape {
-        Shape::Point => g.base_radius + g.roller,
-        Shape::Flat => g.base_radius,
+    let prime = match kind.outline() {
+        Outline::Point | Outline::Circle => g.base_radius + g.roller,
+        Outline::Line => g.base_radius,
     };
     let _ = writeln!(
         text,

@@ -23,8 +23,7 @@ use super::args::integrator_name;
 use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::{
-    ContactInfo, CoordinateKind, FollowerKind, IntegratorKind, ModelInfo, ProfileKind, SimSettings,
-    Stats,
+    ContactInfo, CoordinateKind, IntegratorKind, ModelInfo, ProfileKind, SimSettings, Stats,
 };
 use std::fmt::Write;
 use std::time::Duration;
@@ -111,11 +110,7 @@ fn settings_text(settings: &SimSettings) -> String {
 
 /// What a contact is, in words: `roller on a polar profile turned by cam_angle`.
 pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
-    let follower = match contact.follower {
-        FollowerKind::Knife => "knife edge",
-        FollowerKind::Roller => "roller",
-        FollowerKind::Flat => "flat face",
-    };
+    let follower = contact.follower.label();
     let profile = match contact.profile {
         ProfileKind::Explicit => "an explicit profile y = f(x)",
         ProfileKind::Polar => "a polar profile r(θ)",

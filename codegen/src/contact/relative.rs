@@ -263,12 +263,24 @@ pub fn relative(
         vec3::label(g, y_axis, &format!("{name}_cam_y_axis"));
     }
     let mut columns = vec![[g.zero(); 2]; n];
-    let local = s.field3(
+    let marker_local = s.field3(
         g,
         model,
         |k| Field::Marker(contact.marker, k),
         marker.position,
     );
+    // The follower point: the marker, or the centre of a circular outline placed the radius
+    // away from it (a curved face, whose apex the marker is).
+    let local = match contact.follower.centre_direction() {
+        Some(direction) => {
+            let radius = contact.follower.radius().copied().unwrap_or(0.0);
+            let rho = s.field(g, model, Field::Radius(index), radius);
+            let direction = vec3::constant(g, direction);
+            let offset = vec3::scale(g, rho, direction);
+            vec3::add(g, marker_local, offset)
+        }
+        None => marker_local,
+    };
     let follower = point_motion(
         g,
         model,

@@ -403,17 +403,17 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
             }
             RuntimeCheck::Followable(k, at) => {
                 let contact = &model.contacts[*k];
-                let shape = match contact.follower {
-                    crate::model::Follower::Knife => "rt::contact::Shape::Knife".to_string(),
-                    crate::model::Follower::Roller { .. } => {
+                let radius = match contact.follower.radius() {
+                    Some(_) => {
                         need(Field::Radius(*k));
-                        format!(
-                            "rt::contact::Shape::Roller({})",
-                            value_of(Field::Radius(*k))
-                        )
+                        value_of(Field::Radius(*k))
                     }
-                    crate::model::Follower::Flat { .. } => "rt::contact::Shape::Flat".to_string(),
+                    None => "0.0".to_string(),
                 };
+                let shape = format!(
+                    "rt::contact::Shape {{ kind: rt::FollowerKind::{}, radius: {radius} }}",
+                    contact.follower.kind().keyword()
+                );
                 let (a, b) = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
                 let places: Vec<String> = at.iter().map(|a| location_from(a, file)).collect();
                 let _ = writeln!(
@@ -535,10 +535,11 @@ fn constant_value(model: &Model, field: Field) -> f64 {
         Field::LoopPoint(l, side, k) => model.loops[l].sides[side].point[k],
         Field::InitialQ(i) => model.initial.q[i],
         Field::InitialQd(i) => model.initial.qd[i],
-        Field::Radius(c) => match model.contacts[c].follower {
-            crate::model::Follower::Roller { radius } => radius,
-            _ => f64::NAN,
-        },
+        Field::Radius(c) => model.contacts[c]
+            .follower
+            .radius()
+            .copied()
+            .unwrap_or(f64::NAN),
         Field::Drive(_) | Field::Profile(_) | Field::ProfileY(_) | Field::Load(_) => f64::NAN,
     }
 }

@@ -4,9 +4,12 @@
 //! [`super::validate`]. The type names appear in ron's messages ("unexpected field named
 //! `foo` in `Joint`"), so they are named after the file's concepts.
 
+use camchain_runtime::kinds::Kind;
+use camchain_runtime::{IntegratorKind, LoopKind};
 use serde::de::{EnumAccess, MapAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::fmt;
+use std::marker::PhantomData;
 
 /// Three numbers `(x, y, z)`, each a number or a parameter expression.
 pub(super) type Vec3 = [Number; 3];
@@ -199,7 +202,7 @@ pub(super) struct Marker {
 #[serde(deny_unknown_fields)]
 pub(super) struct Loop {
     pub name: String,
-    pub kind: LoopKind,
+    pub kind: Keyword<LoopKind>,
     pub a: LoopSide,
     pub b: LoopSide,
     /// B's axis or line, B's body frame.
@@ -217,15 +220,6 @@ pub(super) struct LoopSide {
     pub body: String,
     #[serde(default)]
     pub point: Vec3,
-}
-
-/// The kind of a cut joint.
-#[derive(Debug, Clone, Copy, Deserialize)]
-pub(super) enum LoopKind {
-    Revolute,
-    Spherical,
-    Prismatic,
-    PointOnLine,
 }
 
 /// A contact: a follower (a marker and its shape) on a cam profile carried by a body.
@@ -260,19 +254,8 @@ pub(super) struct Contact {
     pub frame: Frame,
 }
 
-/// The follower's shape.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) enum Follower {
-    #[default]
-    Knife,
-    Roller {
-        radius: Number,
-    },
-    Flat {
-        normal: Vec3,
-    },
-}
+/// The follower's shape and dimensions, as written.
+pub(super) type Follower = crate::model::Follower<Number>;
 
 /// `parametric: (x: "…", y: "…")`.
 #[derive(Debug, Deserialize)]
@@ -431,51 +414,45 @@ pub(super) struct Initial {
     pub hold: Vec<String>,
 }
 
-/// An integrator, named in any letter case (`Dop853`, `dop853`, `DOP853`): the command line
-/// spells it `dop853`, the file traditionally `Dop853`, and both mean the same.
+/// A kind from the project's registry ([`camchain_runtime::kinds`]) written as a bare
+/// keyword (`Revolute`): exactly as registered, except integrators, which any letter case
+/// names (`Dop853`, `dop853`, `DOP853`: the command line spells them in lower case, the file
+/// traditionally as `Dop853`, and both mean the same).
 #[derive(Debug, Clone, Copy)]
-pub(super) enum Integrator {
-    Rk4,
-    Dopri5,
-    Dop853,
-}
+pub(super) struct Keyword<K>(pub K);
 
-/// The integrators' names, as the command line spells them.
-pub(super) const INTEGRATORS: [&str; 3] = ["rk4", "dopri5", "dop853"];
-
-impl<'de> Deserialize<'de> for Integrator {
+impl<'de, K: Kind> Deserialize<'de> for Keyword<K> {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        deserializer.deserialize_enum(
-            "Integrator",
-            &["Rk4", "Dopri5", "Dop853"],
-            IntegratorVisitor,
-        )
+        deserializer.deserialize_enum(K::FAMILY, K::KEYWORDS, KeywordVisitor(PhantomData))
     }
 }
 
-struct IntegratorVisitor;
+struct KeywordVisitor<K>(PhantomData<K>);
 
-impl<'de> Visitor<'de> for IntegratorVisitor {
-    type Value = Integrator;
+impl<'de, K: Kind> Visitor<'de> for KeywordVisitor<K> {
+    type Value = Keyword<K>;
 
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        write!(f, "an integrator: {}", INTEGRATORS.join(", "))
+        write!(f, "{}: {}", K::FAMILY, K::KEYWORDS.join(", "))
     }
 
-    fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Integrator, E> {
-        match name.to_ascii_lowercase().as_str() {
-            "rk4" => Ok(Integrator::Rk4),
-            "dopri5" => Ok(Integrator::Dopri5),
-            "dop853" => Ok(Integrator::Dop853),
+    fn visit_str<E: serde::de::Error>(self, name: &str) -> Result<Keyword<K>, E> {
+        if K::FAMILY == IntegratorKind::FAMILY {
+            let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
             // The located error appends ", found `<name>`".
-            _ => Err(E::custom(format!(
-                "unknown integrator (one of {}, in any letter case)",
-                INTEGRATORS.join(", ")
-            ))),
+            return K::parse(name).map(Keyword).ok_or_else(|| {
+                E::custom(format!(
+                    "unknown integrator (one of {}, in any letter case)",
+                    names.join(", ")
+                ))
+            });
         }
+        K::from_keyword(name)
+            .map(Keyword)
+            .ok_or_else(|| E::unknown_variant(name, K::KEYWORDS))
     }
 
-    fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Integrator, A::Error> {
+    fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Keyword<K>, A::Error> {
         let (name, variant): (Identifier, _) = data.variant()?;
         variant.unit_variant()?;
         self.visit_str(&name.0)
@@ -506,7 +483,7 @@ impl<'de> Deserialize<'de> for Identifier {
 pub(super) struct Simulation {
     pub t_end: f64,
     pub dt_out: f64,
-    pub integrator: Integrator,
+    pub integrator: Keyword<IntegratorKind>,
     pub dt: f64,
     pub rtol: f64,
     pub atol: f64,
@@ -518,7 +495,7 @@ impl Default for Simulation {
         Simulation {
             t_end: 10.0,
             dt_out: 0.01,
-            integrator: Integrator::Dop853,
+            integrator: Keyword(IntegratorKind::Dop853),
             dt: 1e-3,
             rtol: 1e-10,
             atol: 1e-12,

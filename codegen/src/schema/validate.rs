@@ -6,9 +6,8 @@ use super::Locator;
 use super::raw;
 use crate::error::ModelError;
 use crate::model::{
-    Body, Field, FieldLocation, Follower, Initial, IntegratorChoice, Joint, JointKind, JointLoad,
-    Marker, Model, Parameter, ParameterMode, Prescribed, Profile, RuntimeCheck, Simulation,
-    SpringDamper,
+    Body, Field, FieldLocation, Follower, Initial, Joint, JointKind, JointLoad, Marker, Model,
+    Parameter, ParameterMode, Prescribed, Profile, RuntimeCheck, Simulation, SpringDamper,
 };
 use crate::profile::{Scalar, parse_expression_with};
 use camchain_runtime::parameters::{Bound, checks};
@@ -224,10 +223,7 @@ fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usi
             .iter()
             .flat_map(|b| b.joint.axis.iter())
             .chain(file.contacts.iter().flat_map(|c| {
-                let face: &[raw::Number] = match &c.follower {
-                    raw::Follower::Flat { normal } => normal,
-                    _ => &[],
-                };
+                let face: &[raw::Number] = c.follower.normal().map_or(&[], |n| n);
                 c.frame
                     .x_axis
                     .iter()
@@ -1170,11 +1166,7 @@ pub mod ranges {
 
 fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulation> {
     let field = |name: &str| format!("simulation.{name}");
-    let integrator = match s.integrator {
-        raw::Integrator::Rk4 => IntegratorChoice::Rk4,
-        raw::Integrator::Dopri5 => IntegratorChoice::Dopri5,
-        raw::Integrator::Dop853 => IntegratorChoice::Dop853,
-    };
+    let integrator = s.integrator.0;
     let t_end = positive(at, &field("t_end"), "t_end", s.t_end)?;
     let dt_out = positive(at, &field("dt_out"), "dt_out", s.dt_out)?;
     let dt = positive(at, &field("dt"), "dt", s.dt)?;
@@ -1189,7 +1181,7 @@ fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulation> {
             ),
         ));
     }
-    let adaptive = !matches!(integrator, IntegratorChoice::Rk4);
+    let adaptive = integrator.is_adaptive();
     if !adaptive && dt_out / dt > ranges::MAX_RK4_STEPS {
         return Err(at.error(
             &field("dt"),

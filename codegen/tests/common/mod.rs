@@ -135,7 +135,7 @@ pub fn paper_concave() -> Model {
         simulation: Simulation {
             t_end: 10.0,
             dt_out: 0.01,
-            integrator: IntegratorChoice::Dopri5,
+            integrator: IntegratorKind::Dopri5,
             dt: 1e-3,
             rtol: 1e-10,
             atol: 1e-12,
@@ -271,7 +271,7 @@ pub fn spatial_tree() -> Model {
         simulation: Simulation {
             t_end: 1.0,
             dt_out: 0.01,
-            integrator: IntegratorChoice::Dopri5,
+            integrator: IntegratorKind::Dopri5,
             dt: 1e-3,
             rtol: 1e-9,
             atol: 1e-9,

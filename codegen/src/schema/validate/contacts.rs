@@ -13,6 +13,7 @@ use crate::schema::raw;
 use camchain_runtime::contact::{
     PROFILE_CHECK_SAMPLES, Place, Shape, followable as followable_checked,
 };
+use camchain_runtime::kinds::Outline;
 use std::collections::HashMap;
 
 pub(super) fn contacts(
@@ -68,7 +69,7 @@ pub(super) fn contacts(
             let contact = contact(cx, tree, i, c, marker, markers[marker].body)?;
             followable(at, i, &contact)?;
             recheck_at_run_time(cx, i, &contact);
-            if matches!(contact.follower, Follower::Flat { .. }) {
+            if contact.follower.normal().is_some() {
                 turns_about_the_cam_axis(at, i, &contact, bodies, markers)?;
             }
             Ok(contact)
@@ -292,24 +293,18 @@ fn profile(
 }
 
 fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
-    Ok(match f {
-        raw::Follower::Knife => Follower::Knife,
-        raw::Follower::Roller { radius } => Follower::Roller {
-            radius: cx.positive(
-                &format!("{path}.follower.radius"),
-                radius,
-                Field::Radius(i),
-                "the roller radius",
-            )?,
+    let what = f.kind().label();
+    f.try_map(
+        |radius, name| {
+            let field = format!("{path}.follower.{name}");
+            cx.positive(&field, radius, Field::Radius(i), "the follower's radius")
         },
-        raw::Follower::Flat { normal } => {
-            let field = format!("{path}.follower.normal");
+        |normal, name| {
+            let field = format!("{path}.follower.{name}");
             let v = cx.vector(&field, normal, None)?;
-            Follower::Flat {
-                normal: unit_vector(cx.at, &field, "the face normal", v)?,
-            }
-        }
-    })
+            unit_vector(cx.at, &field, &format!("the {what}'s {name}"), v)
+        },
+    )
 }
 
 /// The profile interval a contact may touch: given (finite, increasing), or [0, 2π] for a
@@ -339,16 +334,14 @@ fn contact_range(
     if covers.is_some() {
         return Ok(covers);
     }
-    let needs = match (profile, follower) {
+    let needs = match (profile, follower.kind().outline()) {
         (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
-        (Profile::Parametric { .. }, _) => Some("a parametric profile"),
-        (Profile::Explicit { .. }, Follower::Knife) => None,
-        (Profile::Explicit { .. }, Follower::Roller { .. }) => {
-            Some("a roller on an explicit profile")
-        }
-        (Profile::Explicit { .. }, Follower::Flat { .. }) => {
-            Some("a flat face on an explicit profile")
-        }
+        (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
+        (Profile::Explicit { .. }, Outline::Point) => None,
+        (Profile::Explicit { .. }, Outline::Circle | Outline::Line) => Some(format!(
+            "a {} on an explicit profile",
+            follower.kind().label()
+        )),
     };
     match needs {
         None => Ok(None),
@@ -372,10 +365,9 @@ fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
     };
     let path = format!("contacts[{i}]");
     let samples = profile_samples(&contact.profile, range, PROFILE_CHECK_SAMPLES);
-    let shape = match contact.follower {
-        Follower::Knife => Shape::Knife,
-        Follower::Roller { radius } => Shape::Roller(radius),
-        Follower::Flat { .. } => Shape::Flat,
+    let shape = Shape {
+        kind: contact.follower.kind(),
+        radius: contact.follower.radius().copied().unwrap_or(0.0),
     };
     followable_checked(&contact.name, contact.profile.variable(), shape, &samples).map_err(
         |(place, message)| {
@@ -400,9 +392,9 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
     let runtime_radius = table.is_runtime(Field::Radius(i));
     let runtime_profile =
         table.is_runtime(Field::Profile(i)) || table.is_runtime(Field::ProfileY(i));
-    let matters = match contact.follower {
-        Follower::Knife => matches!(contact.profile, Profile::Polar { .. }),
-        Follower::Roller { .. } | Follower::Flat { .. } => true,
+    let matters = match contact.follower.kind().outline() {
+        Outline::Point => matches!(contact.profile, Profile::Polar { .. }),
+        Outline::Circle | Outline::Line => true,
     };
     if contact.range.is_some() && matters && (runtime_radius || runtime_profile) {
         let path = format!("contacts[{i}]");
@@ -467,7 +459,7 @@ fn turns_about_the_cam_axis(
     bodies: &[Body],
     markers: &[Marker],
 ) -> Checked<()> {
-    let Follower::Flat { normal } = contact.follower else {
+    let Some(&normal) = contact.follower.normal() else {
         return Ok(());
     };
     let axis = contact.axis();

@@ -4,10 +4,11 @@
 //! [`crate::design`].
 
 use super::{Checked, Context, Follower, Profile, finite};
-use crate::design::{self, CamDesign, DESIGN_SAMPLES, Geometry, Motion, Senses, Shape};
+use crate::design::{self, CamDesign, DESIGN_SAMPLES, Geometry, Motion, Senses};
 use crate::model::Field;
 use crate::profile::{Scalar, Tabulated};
 use crate::schema::raw::{self, LawName, LawSegment, Turning};
+use camchain_runtime::kinds::Outline;
 use camchain_runtime::motion_law::{Law, LawError, MotionProgram, Segment};
 
 /// The default limit of the pressure angle: 30° for a translating follower, 35° for an
@@ -37,10 +38,7 @@ pub(super) fn law_profile(
             raw::Motion::Oscillating { swing, .. } => sense(*swing),
             raw::Motion::Translating { .. } => 1.0,
         },
-        shape: match follower {
-            Follower::Flat { .. } => Shape::Flat,
-            Follower::Knife | Follower::Roller { .. } => Shape::Point,
-        },
+        shape: follower.kind(),
     };
     let (folded, resolved) = geometry(cx, &field, law, index, follower)?;
     reachable(cx, path, &resolved, senses)?;
@@ -211,8 +209,8 @@ fn geometry(
             format!("the base circle's radius must be positive, not {}", base.1),
         ));
     }
-    let roller = match follower {
-        Follower::Roller { radius } => (
+    let roller = match follower.radius() {
+        Some(radius) => (
             cx.table
                 .symbolic
                 .borrow()
@@ -221,7 +219,7 @@ fn geometry(
                 .unwrap_or(Scalar::Const(*radius)),
             *radius,
         ),
-        Follower::Knife | Follower::Flat { .. } => (Scalar::Const(0.0), 0.0),
+        None => (Scalar::Const(0.0), 0.0),
     };
     let motion_field = format!("{field}.motion");
     let (folded, resolved) = match &law.motion {
@@ -242,7 +240,7 @@ fn geometry(
             let py = cx.dimension(&format!("{motion_field}.pivot[1]"), &pivot.1)?;
             let a = cx.dimension(&format!("{motion_field}.arm"), arm)?;
             let f = cx.dimension(&format!("{motion_field}.face_offset"), face_offset)?;
-            if a.1 <= 0.0 && !matches!(follower, Follower::Flat { .. }) {
+            if a.1 <= 0.0 && follower.kind().outline() != Outline::Line {
                 return Err(cx.at.error(
                     &format!("{motion_field}.arm"),
                     format!("the arm's length must be positive, not {}", a.1),
@@ -282,8 +280,10 @@ fn geometry(
 fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Checked<()> {
     let prime = g.base_radius + g.roller;
     let field = format!("{path}.law.motion");
-    match (&g.motion, senses.shape) {
-        (Motion::Translating { offset }, Shape::Point) if offset.abs() >= prime => {
+    match (&g.motion, senses.shape.outline()) {
+        (Motion::Translating { offset }, Outline::Point | Outline::Circle)
+            if offset.abs() >= prime =>
+        {
             Err(cx.at.error(
                 &format!("{field}.offset"),
                 format!(
@@ -293,7 +293,7 @@ fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Che
                 ),
             ))
         }
-        (Motion::Oscillating { pivot, arm, .. }, Shape::Point) => {
+        (Motion::Oscillating { pivot, arm, .. }, Outline::Point | Outline::Circle) => {
             let d = pivot[0].hypot(pivot[1]);
             if prime <= (d - arm).abs() || prime >= d + arm {
                 return Err(cx.at.error(
@@ -311,7 +311,7 @@ fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Che
             Motion::Oscillating {
                 pivot, face_offset, ..
             },
-            Shape::Flat,
+            Outline::Line,
         ) => {
             let d = pivot[0].hypot(pivot[1]);
             if g.base_radius + face_offset >= d || g.base_radius + face_offset <= 0.0 {
@@ -337,8 +337,9 @@ fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Che
 fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Checked<()> {
     let g = &design.geometry;
     let mm = |x: f64| format!("{:.3} mm", x * 1e3);
-    match design.senses.shape {
-        Shape::Point if g.roller > 0.0 => {
+    let label = design.senses.shape.label();
+    match design.senses.shape.outline() {
+        Outline::Circle if g.roller > 0.0 => {
             let (theta, radius) = design.least(DESIGN_SAMPLES, |p| {
                 if p.pitch_radius > 0.0 {
                     p.radius_of_curvature
@@ -351,9 +352,9 @@ fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Chec
                 return Err(cx.at.error(
                     &format!("{path}.follower.radius"),
                     format!(
-                        "contact `{name}`: the roller ({}) undercuts the cam designed for it: at \
+                        "contact `{name}`: the {label} ({}) undercuts the cam designed for it: at \
                          cam angle {:.3}° the pitch curve's radius of curvature is {}, smaller \
-                         than the roller's; take a larger base circle or a smaller roller",
+                         than the {label}'s; take a larger base circle or a smaller {label}",
                         mm(g.roller),
                         theta.to_degrees(),
                         mm(pitch)
@@ -362,8 +363,8 @@ fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Chec
             }
             Ok(())
         }
-        Shape::Point => Ok(()),
-        Shape::Flat => {
+        Outline::Point | Outline::Circle => Ok(()),
+        Outline::Line => {
             if let Motion::Oscillating { .. } = g.motion {
                 let (theta, rate) = design.least(DESIGN_SAMPLES, |p| {
                     (design.senses.swing * p.lift[1] - design.senses.turning).abs()

@@ -3,7 +3,7 @@
 //! equations than free coordinates, and a planar model's loops in its plane.
 
 use super::{BodyTree, Checked, Context, GROUND, identifier, unit_vector};
-use crate::model::{Body, Closure, ClosureKind, ClosurePoint, Contact, Field, Model};
+use crate::model::{Body, Closure, ClosurePoint, Contact, Field, LoopKind, Model};
 use crate::schema::raw;
 use std::collections::HashMap;
 
@@ -96,15 +96,10 @@ fn closure(
             ),
         ));
     }
-    let kind = match raw_loop.kind {
-        raw::LoopKind::Revolute => ClosureKind::Revolute,
-        raw::LoopKind::Spherical => ClosureKind::Spherical,
-        raw::LoopKind::Prismatic => ClosureKind::Prismatic,
-        raw::LoopKind::PointOnLine => ClosureKind::PointOnLine,
-    };
+    let kind = raw_loop.kind.0;
     let default_axis = match kind {
-        ClosureKind::Revolute | ClosureKind::Spherical => [0.0, 0.0, 1.0],
-        ClosureKind::Prismatic | ClosureKind::PointOnLine => [1.0, 0.0, 0.0],
+        LoopKind::Revolute | LoopKind::Spherical => [0.0, 0.0, 1.0],
+        LoopKind::Prismatic | LoopKind::PointOnLine => [1.0, 0.0, 0.0],
     };
     let axis = match &raw_loop.axis {
         Some(v) => {
@@ -122,7 +117,7 @@ fn closure(
     };
     if planar {
         in_plane(cx, l, raw_loop, kind, &sides, [axis, axis_a])?;
-    } else if kind == ClosureKind::Prismatic {
+    } else if kind == LoopKind::Prismatic {
         return Err(at.error(
             &format!("{path}.kind"),
             "a prismatic cut is planar only (2 equations); in a spatial model cut the loop at \
@@ -144,7 +139,7 @@ fn in_plane(
     cx: &Context,
     l: usize,
     raw_loop: &raw::Loop,
-    kind: ClosureKind,
+    kind: LoopKind,
     sides: &[ClosurePoint; 2],
     [axis, axis_a]: [[f64; 3]; 2],
 ) -> Checked<()> {
@@ -163,7 +158,7 @@ fn in_plane(
             ));
         }
     }
-    let needs_plane = matches!(kind, ClosureKind::Prismatic | ClosureKind::PointOnLine);
+    let needs_plane = matches!(kind, LoopKind::Prismatic | LoopKind::PointOnLine);
     for (field, v, given) in [
         ("axis", axis, raw_loop.axis.is_some()),
         ("axis_a", axis_a, raw_loop.axis_a.is_some()),
