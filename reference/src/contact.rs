@@ -17,6 +17,7 @@ use crate::jet::Jet2;
 use crate::numeric::{Motion, Pose, vec3};
 use crate::tape::Tape;
 use camchain_codegen::model::{Contact, Follower, JointKind, Model, Profile};
+use camchain_runtime::kinds::Outline;
 use camchain_runtime::{ContactGeometry, ContactKinematics};
 use nalgebra::Vector3;
 
@@ -203,9 +204,9 @@ impl ContactConst {
         let cam2 = |v: Vec3| [f.x.dot(&v), f.y.dot(&v)];
         // A flat face's normal (from the cam into the follower), its rate and acceleration
         // seen from the cam: d/dt (R_Cᵀ m) = R_Cᵀ (ṁ − ω_C × m).
-        let face = match self.follower {
-            Follower::Flat { normal } => -(poses[self.body].rot * vec3(&normal)),
-            _ => Vec3::zeros(),
+        let face = match (self.follower.kind().outline(), self.follower.normal()) {
+            (Outline::Line, Some(normal)) => -(poses[self.body].rot * vec3(normal)),
+            (Outline::Point | Outline::Circle | Outline::Line, _) => Vec3::zeros(),
         };
         let w_rel = follower.omega - w;
         let m_dot = w_rel.cross(&face);
@@ -362,10 +363,7 @@ impl ContactConst {
                     (h, jac, bias, x, n, stretch, x[0], kappa, t)
                 }
                 (Follower::Knife | Follower::Roller { .. }, _) => {
-                    let rho = match self.follower {
-                        Follower::Roller { radius } => radius,
-                        _ => 0.0,
-                    };
+                    let rho = self.follower.radius().copied().unwrap_or(0.0);
                     let p = seen.p;
                     let s = self.optimum(
                         p,

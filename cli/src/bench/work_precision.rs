@@ -185,18 +185,19 @@ fn ladder(
 ) -> Result<Vec<Point>, CliError> {
     let mut points = Vec::new();
     for (integrator, setting) in rungs(quick) {
-        let settings = match integrator {
-            IntegratorKind::Rk4 => SimSettings {
-                integrator,
-                dt: setting,
-                ..base.clone()
-            },
-            _ => SimSettings {
+        let settings = if integrator.is_adaptive() {
+            SimSettings {
                 integrator,
                 rtol: setting,
                 atol: setting,
                 ..base.clone()
-            },
+            }
+        } else {
+            SimSettings {
+                integrator,
+                dt: setting,
+                ..base.clone()
+            }
         };
         let run = simulate(model, start, &settings)?;
         let (max_error, end_error) = errors(&run, reference);

@@ -52,8 +52,11 @@ pub fn nearest(
         Profile::Parametric { .. } => Guess::Scan,
     };
     let what = match radius {
-        Some(_) => "the profile point nearest the roller's centre",
-        None => "the profile point under the knife edge",
+        Some(_) => format!(
+            "the profile point nearest the {}'s centre",
+            contact.follower.kind().label()
+        ),
+        None => "the profile point under the knife edge".to_string(),
     };
     let solution = g.implicit(
         &format!("{name}_parameter"),

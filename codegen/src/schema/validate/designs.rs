@@ -327,7 +327,7 @@ fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Che
             }
             Ok(())
         }
-        _ => Ok(()),
+        (Motion::Translating { .. }, Outline::Point | Outline::Circle | Outline::Line) => Ok(()),
     }
 }
 
