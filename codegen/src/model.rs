@@ -126,6 +126,16 @@ pub enum Follower<N = f64> {
         /// Unit normal, follower body frame.
         normal: [N; 3],
     },
+    /// A curved (mushroom) face: a circular arc of radius `radius` (m, > 0) whose apex is the
+    /// marker, its centre `radius` from the marker against `normal` (the face's unit normal
+    /// at the apex, follower body frame, pointing towards the cam, in the cam plane). The
+    /// face is rigid on the follower: the contact point slides on both surfaces.
+    Mushroom {
+        /// Radius of the face's arc (m).
+        radius: N,
+        /// Unit normal at the apex, follower body frame.
+        normal: [N; 3],
+    },
 }
 
 impl<N> Follower<N> {
@@ -135,13 +145,14 @@ impl<N> Follower<N> {
             Follower::Knife => FollowerKind::Knife,
             Follower::Roller { .. } => FollowerKind::Roller,
             Follower::Flat { .. } => FollowerKind::Flat,
+            Follower::Mushroom { .. } => FollowerKind::Mushroom,
         }
     }
 
     /// The radius of a circular outline (a roller's), if the kind has one.
     pub fn radius(&self) -> Option<&N> {
         match self {
-            Follower::Roller { radius } => Some(radius),
+            Follower::Roller { radius } | Follower::Mushroom { radius, .. } => Some(radius),
             Follower::Knife | Follower::Flat { .. } => None,
         }
     }
@@ -149,7 +160,7 @@ impl<N> Follower<N> {
     /// The face's normal (follower body frame), if the kind has a face.
     pub fn normal(&self) -> Option<&[N; 3]> {
         match self {
-            Follower::Flat { normal } => Some(normal),
+            Follower::Flat { normal } | Follower::Mushroom { normal, .. } => Some(normal),
             Follower::Knife | Follower::Roller { .. } => None,
         }
     }
@@ -169,6 +180,13 @@ impl<N> Follower<N> {
             Follower::Flat { normal: n } => Follower::Flat {
                 normal: normal(n, "normal")?,
             },
+            Follower::Mushroom {
+                radius: r,
+                normal: n,
+            } => Follower::Mushroom {
+                radius: radius(r, "radius")?,
+                normal: normal(n, "normal")?,
+            },
         })
     }
 
@@ -186,6 +204,7 @@ impl Follower<f64> {
     pub fn centre_direction(&self) -> Option<[f64; 3]> {
         match self {
             Follower::Knife | Follower::Roller { .. } | Follower::Flat { .. } => None,
+            Follower::Mushroom { normal, .. } => Some(normal.map(|c| -c)),
         }
     }
 }

@@ -362,7 +362,7 @@ impl ContactConst {
                     let (t, n, kappa) = self.frenet(&c);
                     (h, jac, bias, x, n, stretch, x[0], kappa, t)
                 }
-                (Follower::Knife | Follower::Roller { .. }, _) => {
+                (Follower::Knife | Follower::Roller { .. } | Follower::Mushroom { .. }, _) => {
                     let rho = self.follower.radius().copied().unwrap_or(0.0);
                     let p = seen.p;
                     let s = self.optimum(

@@ -142,6 +142,8 @@ registry! {
         Roller => FollowerSpec { name: "roller", label: "roller", outline: Outline::Circle, slides: false },
         /// A flat face through the follower point.
         Flat => FollowerSpec { name: "flat", label: "flat face", outline: Outline::Line, slides: true },
+        /// A curved (mushroom) face: a circular arc whose apex is the follower point.
+        Mushroom => FollowerSpec { name: "mushroom", label: "curved face", outline: Outline::Circle, slides: true },
     }
 }
 

@@ -79,6 +79,9 @@ pub fn contact_terms(
                     nearest::nearest(g, model, s, index, rel, Some(*radius))
                 }
                 (Follower::Flat { normal }, _) => flat::flat(g, model, kin, s, index, rel, *normal),
+                (Follower::Mushroom { radius, .. }, _) => {
+                    nearest::nearest(g, model, s, index, rel, Some(*radius))
+                }
             }
         })
         .collect()

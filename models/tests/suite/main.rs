@@ -17,6 +17,7 @@ mod generated_vs_numeric;
 mod integrators;
 mod loops;
 mod metrics;
+mod mushroom;
 mod parameters;
 mod random_compiled;
 mod simulation;

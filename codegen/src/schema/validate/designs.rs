@@ -31,6 +31,18 @@ pub(super) fn law_profile(
     follower: &Follower,
 ) -> Checked<(Profile, CamDesign)> {
     let field = format!("{path}.law");
+    if follower.centre_direction().is_some() {
+        // A design places the follower point (the marker) on its pitch curve: a circle
+        // centred off the marker (a curved face's apex is the marker) has no such point.
+        return Err(cx.at.error(
+            &format!("{path}.follower"),
+            format!(
+                "a cam designed from a law needs a knife edge, a roller or a flat face: a {} \
+                 is not designed for yet (give the profile instead)",
+                follower.kind().label()
+            ),
+        ));
+    }
     let program = program(cx, &field, &law.segments)?;
     let senses = Senses {
         turning: sense(law.turning),
