@@ -5,12 +5,9 @@
 //! q̈ = 0. An equation is a product X·Y of two such vectors, differentiated by the product
 //! rule: J_j = Ẋ(e_j)·Y + X·Ẏ(e_j), c = Ẍ°·Y + 2 Ẋ·Ẏ + X·Ÿ°.
 
-use crate::numeric::{Motion, Pose, vec3};
+use crate::motion::{Motion, Pose, Vec3, vec3};
 use camchain_codegen::closure::normal_pair;
 use camchain_codegen::model::{Closure, LoopKind};
-use nalgebra::Vector3;
-
-type Vec3 = Vector3<f64>;
 
 /// A vector of a loop: a point or a direction carried by a body (`None`: the ground), or
 /// the gap between the loop's two points.

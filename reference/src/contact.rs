@@ -14,14 +14,11 @@
 //!   normal (the generator uses the planar form).
 
 use crate::jet::Jet2;
-use crate::numeric::{Motion, Pose, vec3};
+use crate::motion::{Motion, Pose, Vec3, vec3};
 use crate::tape::Tape;
 use camchain_codegen::model::{Contact, Follower, JointKind, Model, Profile};
 use camchain_runtime::kinds::Outline;
 use camchain_runtime::{ContactGeometry, ContactKinematics};
-use nalgebra::Vector3;
-
-type Vec3 = Vector3<f64>;
 
 /// Samples of the range compared before the golden-section refinement.
 const SCAN: usize = 512;

@@ -26,6 +26,7 @@
 mod closure;
 mod contact;
 pub mod jet;
+mod motion;
 mod numeric;
 pub mod spline;
 pub mod tape;

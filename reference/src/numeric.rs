@@ -20,6 +20,7 @@
 use crate::closure::{ClosureConst, ClosureEval};
 use crate::contact::{ContactConst, Evaluated};
 use crate::jet::{eval_jet, eval_with};
+use crate::motion::{Mat3, Motion, Pose, Vec3, vec3};
 use camchain_codegen::ModelError;
 use camchain_codegen::model::{Body, Closure, Contact, JointKind, Model, ParameterMode, Profile};
 use camchain_codegen::schema::{Files, load_model, parse_model_from};
@@ -27,11 +28,8 @@ use camchain_runtime::{
     ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
     Energy, InitialGuess, LoopInfo, ModelInfo, ParameterInfo, ProfileKind, SimSettings,
 };
-use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+use nalgebra::{Rotation3, Unit};
 use std::path::Path;
-
-type Vec3 = Vector3<f64>;
-type Mat3 = Matrix3<f64>;
 
 /// Builds the static description of a model: coordinates (name, kind, driven flag),
 /// contact names, whether it is spatial, the initial guess and the default settings.
@@ -112,10 +110,6 @@ fn coordinate_info(body: &Body) -> CoordinateInfo {
         },
         driven: body.joint.prescribed.is_some(),
     }
-}
-
-pub(crate) fn vec3(a: &[f64; 3]) -> Vec3 {
-    Vec3::new(a[0], a[1], a[2])
 }
 
 fn mat3(a: &[[f64; 3]; 3]) -> Mat3 {
@@ -214,69 +208,6 @@ impl BodyConst {
         let v_com = motion.point_velocity(&pose.com_offset);
         let w = motion.omega;
         0.5 * (self.mass * v_com.norm_squared() + w.dot(&(pose.inertia * w)))
-    }
-}
-
-/// Position and orientation of a body, in ground coordinates.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Pose {
-    /// Rotation ground ← body.
-    pub(crate) rot: Mat3,
-    /// Origin of the body frame (on the joint axis of a revolute joint).
-    pub(crate) origin: Vec3,
-    /// Joint axis.
-    axis: Vec3,
-    /// Vector from the parent's origin to this body's origin.
-    lever: Vec3,
-    /// Vector from the body origin to its centre of mass.
-    com_offset: Vec3,
-    /// Inertia about the centre of mass, ground axes: R I Rᵀ.
-    inertia: Mat3,
-}
-
-impl Pose {
-    /// The ground frame: identity rotation at the origin.
-    fn ground() -> Self {
-        Self {
-            rot: Mat3::identity(),
-            origin: Vec3::zeros(),
-            axis: Vec3::zeros(),
-            lever: Vec3::zeros(),
-            com_offset: Vec3::zeros(),
-            inertia: Mat3::zeros(),
-        }
-    }
-}
-
-/// Velocity state of a body: angular velocity and acceleration, velocity and acceleration
-/// of the body origin, all in ground coordinates.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Motion {
-    pub(crate) omega: Vec3,
-    pub(crate) alpha: Vec3,
-    pub(crate) vel: Vec3,
-    pub(crate) acc: Vec3,
-}
-
-impl Motion {
-    /// The ground is at rest.
-    pub(crate) fn rest() -> Self {
-        Self {
-            omega: Vec3::zeros(),
-            alpha: Vec3::zeros(),
-            vel: Vec3::zeros(),
-            acc: Vec3::zeros(),
-        }
-    }
-
-    /// Velocity of the body point at offset `r` from the origin.
-    pub(crate) fn point_velocity(&self, r: &Vec3) -> Vec3 {
-        self.vel + self.omega.cross(r)
-    }
-
-    /// Acceleration of the body point at offset `r` from the origin.
-    pub(crate) fn point_acceleration(&self, r: &Vec3) -> Vec3 {
-        self.acc + self.alpha.cross(r) + self.omega.cross(&self.omega.cross(r))
     }
 }
 

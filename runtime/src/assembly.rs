@@ -91,6 +91,18 @@ pub(crate) fn assemble<D: Dynamics + ?Sized>(
     assemble_from(model, t0, (&initial.q, &initial.qd), &initial.hold)
 }
 
+/// A consistent state at `t` from (q, q̇) with nothing held (what
+/// [`Simulate::state_at`](crate::Simulate::state_at) returns, and what a one-sided run
+/// restarts from at every lift-off and landing): [`assemble_from`] without its report.
+pub(crate) fn state_at<D: Dynamics + ?Sized>(
+    model: &D,
+    t: f64,
+    (q, qd): (&[f64], &[f64]),
+) -> Result<State, SimError> {
+    let hold = vec![false; model.info().n()];
+    assemble_from(model, t, (q, qd), &hold).map(|(state, _)| state)
+}
+
 /// A consistent state at t0 from (q, q̇): held and driven coordinates keep their values, one
 /// coordinate per contact is solved from h = 0 (nearest root for one contact) and the
 /// velocities of the solved ones from J q̇ = 0 (16).

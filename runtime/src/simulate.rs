@@ -76,8 +76,7 @@ pub trait Simulate: Dynamics {
     /// ones are re-solved by Newton (15) from the given values (which should be on the cam)
     /// and their velocities from (16); the others are kept.
     fn state_at(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<State, SimError> {
-        let hold = vec![false; self.info().n()];
-        crate::assembly::assemble_from(self, t, (q, qd), &hold).map(|(state, _)| state)
+        crate::assembly::state_at(self, t, (q, qd))
     }
 
     /// Advances `state` by `dt` with the model's default settings.

@@ -23,13 +23,13 @@
 //! Outputs stay on the run's grid; in flight the samples report N = 0 and the gap as h.
 
 use crate::SimSettings;
+use crate::assembly::state_at;
 use crate::dynamics::VelocityTerms;
 use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, Energy, ModelInfo};
 use crate::error::SimError;
 use crate::events::{ContactEvent, EventKind};
 use crate::phase::{GapReading, Grid, Phase, Recorder, Stop, Watch, landing_tolerance};
 use crate::sample::{Sample, SampleLevel};
-use crate::simulate::Simulate;
 use crate::stepping::{State, add_phase_counters, phase_counters, validate_run};
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
@@ -359,11 +359,11 @@ pub(crate) fn run_phases<D: Dynamics + ?Sized>(
             });
             let quadratures = (dissipated + hit.loss, driven_work + hit.drive_work);
             if hit.stays {
-                let mut next = model.state_at(stop.t, &stop.q, &hit.qd)?;
+                let mut next = state_at(model, stop.t, (&stop.q, &hit.qd))?;
                 next.set_quadratures(quadratures);
                 Mode::Contact(next)
             } else {
-                let mut next = detached.state_at(stop.t, &stop.q, &hit.qd)?;
+                let mut next = state_at(&detached, stop.t, (&stop.q, &hit.qd))?;
                 next.set_quadratures(quadratures);
                 Mode::Flight(next, &detached)
             }
@@ -375,7 +375,7 @@ pub(crate) fn run_phases<D: Dynamics + ?Sized>(
                 q: stop.q.clone(),
                 qd: stop.qd.clone(),
             });
-            let mut next = detached.state_at(stop.t, &stop.q, &stop.qd)?;
+            let mut next = state_at(&detached, stop.t, (&stop.q, &stop.qd))?;
             next.set_quadratures((dissipated, driven_work));
             Mode::Flight(next, &detached)
         };

@@ -6,6 +6,7 @@
 mod assembly;
 mod bad_models;
 mod contacts;
+mod layers;
 mod random_models;
 mod settings_ranges;
 mod symbolic_vs_numeric;
