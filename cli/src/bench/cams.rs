@@ -393,7 +393,7 @@ fn render(rhs: &[RhsRow], revolutions: &[Revolution], calls: usize, batches: usi
          of the follower's lift from the closed form (`eccentric_flat`: s = R + e cos θ, \
          harmonic motion of amplitude e; `eccentric_roller`: s = e cos θ + √((R + ρ)² − e² \
          sin² θ) above the camshaft's axis; R = 40 mm, e = 10 mm, ρ = 12.5 mm, θ = ωt at \
-         ω = 20 rad/s, as in `models/tests/suite/cams.rs`), and where there is none of every \
+         ω = 20 rad/s, as in `tests/suite/cams.rs`), and where there is none of every \
          coordinate from the numeric reference at the same settings (`rocker_roller`) or from \
          the same model at rtol = atol = 1e-13 (`camshaft_flywheel`). These mechanisms have \
          no free coordinate (but `camshaft_flywheel`'s camshaft): the follower is solved by \

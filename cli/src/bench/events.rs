@@ -67,7 +67,7 @@ pub fn run(quick: bool) -> Result<String, CliError> {
     Ok(render(&bilateral, &one_sided, flat_jump))
 }
 
-/// The jump speed of eccentric_flat from its file's parameters (models/tests/suite/unilateral.rs
+/// The jump speed of eccentric_flat from its file's parameters (tests/suite/unilateral.rs
 /// derives it): e² ((m ω² − k)² + c² ω²) = (m g + k (R − s_free))².
 fn eccentric_flat_jump() -> Result<f64, CliError> {
     let name = "eccentric_flat";
@@ -191,7 +191,7 @@ fn render(bilateral: &[Bilateral], one_sided: &[OneSided], flat_jump: f64) -> St
     let _ = writeln!(
         out,
         "\nOne-sided runs (restitution 0.5) where the scans find every lift-off, landing and \
-         impact (models/tests/suite/unilateral.rs checks them against the closed forms; ω_j = \
+         impact (tests/suite/unilateral.rs checks them against the closed forms; ω_j = \
          {flat_jump:.9} rad/s for eccentric_flat). Gap evaluations are positions only (the \
          dense output, the constraint and its Jacobian, the contact point), far cheaper than a \
          right-hand side.\n"

@@ -287,7 +287,7 @@ fn render(
          passing the horizontal singular position 20 times in 20 s) reports the point B0; A04 \
          (`bricard`, one redundant equation left out) the point P3, the joint C. No \
          reference solution files of the library were available: A02 is checked against its \
-         equivalent pendulum and, for N = 2, Exudyn's published runs (`models/tests/suite/loops.rs`).\n"
+         equivalent pendulum and, for N = 2, Exudyn's published runs (`tests/suite/loops.rs`).\n"
     );
     let _ = writeln!(
         text,

@@ -258,7 +258,7 @@ fn the_predicted_jump_speed_is_where_bisection_finds_it() {
 
 // The closed form of the jump speed; its run-time helpers serve the models' tests only.
 #[allow(dead_code)]
-#[path = "../../../models/tests/support/cycloidal.rs"]
+#[path = "../../../tests/support/cycloidal.rs"]
 mod cycloidal;
 
 #[test]
@@ -347,7 +347,7 @@ fn fails(dir: &Path, args: &[&str]) -> (i32, String) {
 fn bad_input_gives_one_line_and_its_exit_code() {
     let dir = scratch("cam-bad");
     let designs = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../models/tests/contact_models/designs.ron")
+        .join("../tests/contact_models/designs.ron")
         .display()
         .to_string();
     let bad = dir.join("bad.ron");

@@ -528,7 +528,7 @@ impl ModelSpec {
         let _ = writeln!(
             s,
             "// A random model drawn by runtime/tests/random/mod.rs (the files of\n// \
-             models/tests/random_models/ are rewritten by `cargo test -p camchain-reference --test \
+             tests/random_models/ are rewritten by `cargo test -p camchain-reference --test \
              random_models -- --ignored write_compiled_models`)."
         );
         let _ = writeln!(s, "(\n    name: {name:?},");

@@ -12,8 +12,8 @@
 //! A failure prints the shrunk model's RON file, ready to save and load.
 //!
 //! `cargo test -p camchain-reference --test suite random_models -- --ignored write_compiled_models`
-//! rewrites the fixed models of `models/tests/random_models/` (compiled by `models/build.rs`, checked by
-//! `models/tests/suite/random_compiled.rs`) from a fixed seed.
+//! rewrites the fixed models of `tests/random_models/` (compiled by the root `build.rs`, checked by
+//! `tests/suite/random_compiled.rs`) from a fixed seed.
 
 #[path = "../random/mod.rs"]
 mod random;
@@ -391,7 +391,7 @@ fn random_models_interpreted_equal_numeric() {
     }
 }
 
-/// The fixed models compiled by `models/build.rs` from `models/tests/random_models/`: one planar model with
+/// The fixed models compiled by the root `build.rs` from `tests/random_models/`: one planar model with
 /// a contact, one spatial tree with a contact, one spatial model with two contacts, one
 /// spatial model without contact, each of 3..=8 bodies, every one of which assembles and
 /// simulates for 1 s on the numeric reference, and whose markers can slide along their cams
@@ -399,10 +399,10 @@ fn random_models_interpreted_equal_numeric() {
 /// `cargo test -p camchain-reference --test suite random_models -- --ignored write_compiled_models`
 /// (proptest's generator may draw other models in another proptest version).
 #[test]
-#[ignore = "writes models/tests/random_models/*.ron; run by hand to regenerate them"]
+#[ignore = "writes tests/random_models/*.ron; run by hand to regenerate them"]
 fn write_compiled_models() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/tests/random_models");
-    std::fs::create_dir_all(&dir).expect("create models/tests/random_models");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/random_models");
+    std::fs::create_dir_all(&dir).expect("create tests/random_models");
     let mut runner = TestRunner::new_with_rng(
         Config::default(),
         TestRng::from_seed(proptest::test_runner::RngAlgorithm::ChaCha, &[7; 32]),

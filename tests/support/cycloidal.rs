@@ -9,7 +9,7 @@
 //!     F(θ, ω) = m ω² S″(θ) + c ω S′(θ) + m g + k (R_b + ρ + S(θ) − s_free),
 //!
 //! and the jump speed is the least ω > 0 at which min_θ F reaches zero. Shared by the
-//! models' one-sided runs (models/tests/suite/unilateral.rs) and the `camchain cam`
+//! models' one-sided runs (tests/suite/unilateral.rs) and the `camchain cam`
 //! command's prediction (cli/tests/suite/cam.rs), included in both with `#[path]`.
 
 use std::f64::consts::PI;

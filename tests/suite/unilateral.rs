@@ -208,7 +208,7 @@ fn lift_offs_per_turn(run: &Trajectory, omega: f64, least: f64) -> Vec<(usize, f
 
 /// Within this of its closed-form angle (rad): the lift-off is located to 1e-9 s (ω × 1e-9
 /// ≈ 1.5e-7 rad at 145 rad/s) on a run at rtol 1e-10, where N is the closed form to ~1e-9
-/// of its scale (the generated code against the same closed form, models/tests/suite/cams.rs),
+/// of its scale (the generated code against the same closed form, tests/suite/cams.rs),
 /// and the force's slope at the crossing (~ρ sin, tens of newtons per radian here) turns
 /// that into ≤ 1e-8 rad; 1e-6 rad leaves a margin and still tells the crossing from the
 /// least force (0.03 rad away at δ = 1e-3).

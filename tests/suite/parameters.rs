@@ -32,7 +32,7 @@ const SAME_CODE: f64 = 1e-13;
 const REFERENCE: f64 = 1e-12;
 
 fn source(name: &str) -> String {
-    let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{}/models/{name}.ron", env!("CARGO_MANIFEST_DIR"));
     std::fs::read_to_string(path).expect("the model file")
 }
 
@@ -49,7 +49,7 @@ fn by_name<'a>(
 
 #[test]
 fn every_parameter_read_at_run_time_gives_the_folded_code() {
-    // Every built-in model but n_four_bar, forty copies of four_bar (models/build.rs).
+    // Every built-in model but n_four_bar, forty copies of four_bar (build.rs).
     assert_eq!(all_at_run_time::ALL.len(), models::ALL.len() - 1);
     assert!(by_name(&all_at_run_time::ALL, "four_bar").info().n() > 0);
     for (name, runtime) in all_at_run_time::ALL.iter() {
@@ -189,7 +189,7 @@ fn a_run_with_other_values_follows_the_reference() {
 }
 
 /// The model file of `checks::checked`, as its build shows it.
-const CHECKED: &str = "models/tests/parameter_models/checked.ron";
+const CHECKED: &str = "tests/parameter_models/checked.ron";
 
 /// The generated code's and the numeric reference's errors for one value.
 fn both_errors(name: &str, value: f64) -> (String, String) {
@@ -282,7 +282,7 @@ fn a_bad_value_at_run_time_gets_the_error_the_build_gives() {
 }
 
 /// The model file of `checks::undercut`, as its build shows it.
-const UNDERCUT: &str = "models/tests/parameter_models/undercut.ron";
+const UNDERCUT: &str = "tests/parameter_models/undercut.ron";
 
 #[test]
 fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {

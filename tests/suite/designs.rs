@@ -188,7 +188,7 @@ fn every_follower_kind_reproduces_its_law_over_a_turn() {
 #[test]
 fn a_simple_harmonic_cam_reproduces_its_law_and_warns_of_its_jumps() {
     use camchain::runtime::Simulate;
-    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cycloidal_roller.ron");
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/cycloidal_roller.ron");
     let source = std::fs::read_to_string(&file)
         .expect("cycloidal_roller.ron")
         .replace("law: Cycloidal", "law: SimpleHarmonic");

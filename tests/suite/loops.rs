@@ -15,7 +15,7 @@ use camchain_reference::NumericModel;
 use std::path::Path;
 
 fn numeric(name: &str) -> NumericModel {
-    let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{}/models/{name}.ron", env!("CARGO_MANIFEST_DIR"));
     NumericModel::load(Path::new(&path)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 

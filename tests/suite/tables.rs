@@ -11,7 +11,7 @@ use camchain_reference::NumericModel;
 use std::path::{Path, PathBuf};
 
 fn model_file(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("{name}.ron"))
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("models/{name}.ron"))
 }
 
 fn load(name: &str) -> Model {
@@ -30,7 +30,8 @@ fn the_table_cam_csv_is_the_cycloidal_cams_profile() {
         720,
         "cycloidal_roller's cam (camchain cam cycloidal_roller --table)",
     );
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tables/cycloidal_roller_profile.csv");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("models/tables/cycloidal_roller_profile.csv");
     if std::env::var("CAMCHAIN_BLESS").is_ok_and(|v| v == "1") {
         std::fs::write(&path, &text).expect("writes the table");
     }

@@ -144,7 +144,7 @@ fn the_angles_at_0_03_s_match_the_test_set_reference() {
 fn the_numeric_reference_reaches_the_same_angles() {
     // The numeric recursion integrated through the same runtime: 1e-8 of the test set at
     // rtol 1e-11 (slower, so a little looser than the generated run's tolerance).
-    let path = format!("{}/andrews_squeezer.ron", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{}/models/andrews_squeezer.ron", env!("CARGO_MANIFEST_DIR"));
     let numeric = NumericModel::load(Path::new(&path)).expect("loads");
     let (_, last) = run_to(&numeric, 1e-11);
     let q = in_test_set_order(&numeric, &last.q);

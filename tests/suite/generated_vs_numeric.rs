@@ -30,7 +30,7 @@ fn every_generated_model_agrees_with_the_numeric_recursion() {
         "the five paper models, the double pendulum, the spatial arm"
     );
     for (name, generated) in models::ALL.iter() {
-        let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
+        let path = format!("{}/models/{name}.ron", env!("CARGO_MANIFEST_DIR"));
         let numeric = NumericModel::load(std::path::Path::new(&path))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let tol = common::for_tables(&numeric, TOL);
@@ -50,7 +50,7 @@ fn generated_and_numeric_trajectories_coincide() {
         "eccentric_flat",
     ] {
         let generated = models::by_name(name).expect("built in");
-        let path = format!("{}/{name}.ron", env!("CARGO_MANIFEST_DIR"));
+        let path = format!("{}/models/{name}.ron", env!("CARGO_MANIFEST_DIR"));
         let numeric = NumericModel::load(std::path::Path::new(&path)).expect("loads");
         let mut settings = generated.info().defaults.clone();
         settings.t_end = settings.t_end.min(3.0);

@@ -1,5 +1,5 @@
-//! Compiles the built-in models (`*.ron` in this directory) through `camchain-build`, the same
-//! API a user's build script calls, and, with the `random-models` feature, the random models
+//! Compiles the built-in models (`models/*.ron`) through `camchain-build`, the same API a
+//! user's build script calls, and, with the `random-models` feature, the random models
 //! of the property tests (`tests/random_models/*.ron`) and the contact test models
 //! (`tests/contact_models/*.ron`), not user-facing.
 
@@ -8,7 +8,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // The command line draws the mechanism and runs `--numeric` from the model text.
         .embed_model_source(true)
         .include_file("models.rs")
-        .compile_models(&["."])?;
+        .compile_models(&["models"])?;
     // Set by cargo when the `random-models` feature is on (this package's own tests).
     if std::env::var_os("CARGO_FEATURE_RANDOM_MODELS").is_some() {
         let out = std::path::PathBuf::from(std::env::var("OUT_DIR")?).join("random_models");
@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // Every built-in model but n_four_bar: its 81 links are forty copies of four_bar's
         // (compared in both modes), one parameter (gravity) is all it reads at run time, and
         // its two extra copies were 1.4 MB of the 8.8 MB this crate's tests compile.
-        let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(".")?
+        let mut files: Vec<std::path::PathBuf> = std::fs::read_dir("models")?
             .filter_map(|entry| entry.ok().map(|e| e.path()))
             .filter(|path| path.extension().is_some_and(|e| e == "ron"))
             .filter(|path| path.file_stem().is_some_and(|s| s != "n_four_bar"))

@@ -175,7 +175,7 @@ fn a_failing_run_reports_its_error_and_what_it_computed() {
     // The stress suite's unreachable cam: a driven arm whose tip cannot follow the cam past
     // t = π/3 s (cli/scenarios/unreachable.ron), on the numeric reference.
     let path = format!(
-        "{}/../cli/scenarios/unreachable.ron",
+        "{}/cli/scenarios/unreachable.ron",
         env!("CARGO_MANIFEST_DIR")
     );
     let model = camchain_reference::NumericModel::load(std::path::Path::new(&path))
@@ -210,7 +210,7 @@ fn a_lift_off_window_shorter_than_a_step_is_the_first_lift_off() {
     // eccentric_flat at ω_j (1 + 1e-4): the bilateral force is negative for 0.3 ms per turn
     // against steps of 1.6 ms (issue 24); a sweep's metrics must still report the first
     // lift-off, at the closed form's angle (located to 1e-9 s: 1.5e-7 rad; 1e-6 rad as in
-    // models/tests/suite/unilateral.rs), and a force below zero.
+    // tests/suite/unilateral.rs), and a force below zero.
     let cam = eccentric::EccentricFlat::from_file();
     let omega = cam.jump_speed() * (1.0 + 1e-4);
     let (down, least) = cam.lift_off_and_least(omega);
