@@ -13,13 +13,10 @@
 //! [`contact_terms`]; the emitter, the runtime and the outputs take it from there.
 
 pub mod curve;
-mod expressions;
 pub mod flat;
 pub mod knife;
 pub mod nearest;
 pub mod relative;
-
-pub use expressions::{dot_list, scalar_to_expr, value_and_derivatives};
 
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3};
