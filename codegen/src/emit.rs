@@ -27,6 +27,7 @@ use crate::model::Model;
 use std::fmt::Write;
 
 mod contacts;
+mod docs;
 mod emitter;
 mod function;
 mod fused;
@@ -45,6 +46,7 @@ mod trigonometry;
 mod wrapper;
 
 use contacts::{contact_kinematics_dispatch, contact_kinematics_helpers, contact_kinematics_specs};
+use docs::ConstraintDocs;
 use function::emit_function_full;
 use fused::{FusedTerms, all_roots, function_count, fused_count};
 use header::{header, op_count_table};
@@ -184,7 +186,7 @@ pub fn generate_from(
             .map(|rp| rp.given(receiver))
             .unwrap_or_default()
     };
-    let fused_specs = fused.specs(&d);
+    let fused_specs = fused.specs(&ConstraintDocs::new(model, &d));
     let fused_ops: usize = fused_specs
         .iter()
         .map(|(spec, given)| fused_count(&d, spec, &[given.clone(), derived("self.")].concat()))

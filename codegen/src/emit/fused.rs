@@ -3,6 +3,7 @@
 //! operation counts that decide whether the other entry points call the pair.
 
 use super::contacts::contact_output_roots;
+use super::docs::ConstraintDocs;
 use super::names::id_at;
 use super::spec::{FunctionSpec, Param, param};
 use super::trigonometry::{TrigMemo, reuse_position_trigonometry, trig_pairs};
@@ -96,7 +97,7 @@ impl FusedTerms {
     }
 
     /// The two function specifications, each with the nodes it reads from the cache.
-    pub(super) fn specs(&self, d: &Derivation) -> Vec<(FunctionSpec, Vec<(Id, String)>)> {
+    pub(super) fn specs(&self, docs: &ConstraintDocs) -> Vec<(FunctionSpec, Vec<(Id, String)>)> {
         let uses_cache = self.cache_len() > 0;
         let cache_param = |ty| Param {
             name: "cache",
@@ -108,10 +109,7 @@ impl FusedTerms {
             position_outputs.push((format!("cache[{k}]"), id));
         }
         let position = FunctionSpec {
-            doc: "h (3) and J (5b) for Newton (15) and the velocities (16), in one pass; \
-                  leaves the sines, cosines and profile values `velocity_terms` reuses in \
-                  `cache`."
-                .into(),
+            doc: docs.position_terms(),
             name: "position_terms".into(),
             params: vec![
                 param("q", "&[f64]"),
@@ -124,9 +122,7 @@ impl FusedTerms {
             tail: String::new(),
         };
         let velocity = FunctionSpec {
-            doc: "M, F, Q (13) and c (8) in one pass, reading `cache` as `position_terms` \
-                  left it at the same q."
-                .into(),
+            doc: docs.velocity_terms(),
             name: "velocity_terms".into(),
             params: vec![
                 param("t", "f64"),
@@ -152,7 +148,6 @@ impl FusedTerms {
             given.push((m.sin, format!("cache[{}]", m.slot + 1)));
             given.push((m.cos, format!("cache[{}]", m.slot + 2)));
         }
-        let _ = d;
         vec![(position, Vec::new()), (velocity, given)]
     }
 }

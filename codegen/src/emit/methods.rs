@@ -2,6 +2,7 @@
 //! energies and powers, the loops' points), each with a doc in the model's own terms.
 
 use super::contacts::geometry_spec;
+use super::docs::ConstraintDocs;
 use super::spec::{FunctionSpec, RETURN, param};
 use crate::derive::Derivation;
 use crate::expr::Id;
@@ -9,6 +10,7 @@ use crate::model::Model;
 
 pub(super) fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionSpec> {
     let n = model.n();
+    let docs = ConstraintDocs::new(model, d);
     let dy = &d.dynamics;
     let mass_outputs: Vec<(String, Id)> = (0..n)
         .flat_map(|i| (0..n).map(move |j| (i, j)))
@@ -98,7 +100,7 @@ pub(super) fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionS
             tail: String::new(),
         },
         FunctionSpec {
-            doc: "h(q) = f2 − f3(f1), eq. (3).".into(),
+            doc: docs.constraint(),
             name: "constraint".into(),
             params: vec![param("q", "&[f64]"), param("h", "&mut [f64]")],
             ret: None,
@@ -106,7 +108,7 @@ pub(super) fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionS
             tail: String::new(),
         },
         FunctionSpec {
-            doc: "J = J2 − f3' J1, eq. (5b), row-major nc×n.".into(),
+            doc: docs.jacobian(),
             name: "constraint_jacobian".into(),
             params: vec![param("q", "&[f64]"), param("j", "&mut [f64]")],
             ret: None,
@@ -114,7 +116,7 @@ pub(super) fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionS
             tail: String::new(),
         },
         FunctionSpec {
-            doc: "c of J q̈ + c = 0, eqs. (7, 8).".into(),
+            doc: docs.bias(),
             name: "constraint_bias".into(),
             params: vec![
                 param("q", "&[f64]"),
@@ -126,7 +128,7 @@ pub(super) fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionS
             tail: String::new(),
         },
         FunctionSpec {
-            doc: "J and c sharing one evaluation of the contact kinematics.".into(),
+            doc: docs.terms(),
             name: "constraint_terms".into(),
             params: vec![
                 param("q", "&[f64]"),
