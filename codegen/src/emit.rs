@@ -42,6 +42,8 @@ mod parameters;
 mod render;
 mod spec;
 mod tables;
+#[cfg(test)]
+mod testing;
 mod trigonometry;
 mod wrapper;
 

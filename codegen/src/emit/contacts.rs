@@ -194,3 +194,56 @@ pub(super) fn contact_kinematics_helpers(
 pub(super) fn c_name(model: &Model, k: usize) -> &str {
     &model.contacts[k].name
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::{derived, model};
+
+    #[test]
+    fn without_contacts_the_dispatch_writes_nothing() {
+        let text = contact_kinematics_dispatch(&model("double_pendulum"), true);
+        assert!(text.starts_with("/// No contact: nothing to write.\n"));
+        assert!(text.contains("_k: usize"));
+    }
+
+    #[test]
+    fn one_contact_is_dispatched_by_an_if_many_by_a_match() {
+        let m = model("cycloidal_roller");
+        let text = contact_kinematics_dispatch(&m, true);
+        assert!(text.contains("if k == 0 { contact_kinematics_0(&self.derived, q, qd, out); }"));
+        let mut two = m.clone();
+        two.contacts.push(two.contacts[0].clone());
+        let text = contact_kinematics_dispatch(&two, false);
+        assert!(text.contains("match k {\n0 => contact_kinematics_0(q, qd, out),\n1 => contact_kinematics_1(q, qd, out),\n_ => {}\n}"));
+    }
+
+    #[test]
+    fn a_contacts_geometry_fills_every_field_of_its_output() {
+        let (m, mut d) = derived("cycloidal_roller");
+        let c = d.contacts[0].clone();
+        let outputs = geometry_outputs(&mut d.graph, &c, "out[0].");
+        let targets: Vec<&str> = outputs.iter().map(|o| o.0.as_str()).collect();
+        // Position, follower, normal, axis and direction (3 each), then six scalars.
+        assert_eq!(targets.len(), 5 * 3 + 6);
+        assert_eq!(targets[0], "out[0].position[0]");
+        assert_eq!(targets[12], "out[0].direction[0]");
+        assert_eq!(targets[20], "out[0].sliding_speed");
+        let specs = contact_kinematics_specs(&m, &mut d, true);
+        assert_eq!(specs.len(), 1);
+        assert_eq!(specs[0].name, "contact_kinematics_0");
+        assert_eq!(specs[0].params[0].name, "derived");
+        // The geometry, x and y, J1 and J2 (n each), the two convective terms.
+        assert_eq!(specs[0].outputs.len(), 21 + 2 + 2 * m.n() + 2);
+    }
+
+    #[test]
+    fn the_direction_of_motion_is_a_unit_vector() {
+        let mut g = crate::expr::Graph::new();
+        let v = [g.var("a"), g.var("b"), g.var("c")];
+        let u = unit_vector(&mut g, v);
+        let values = g.eval(&u, &[3.0, 0.0, -4.0]);
+        // (3, 0, −4)/5: exact in binary up to one rounding of each division.
+        assert_eq!(values, [0.6, 0.0, -0.8]);
+    }
+}

@@ -113,3 +113,74 @@ impl ConstraintDocs {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::derived;
+
+    #[test]
+    fn a_model_without_constraints_says_it_has_no_rows() {
+        let (m, d) = derived("double_pendulum");
+        let docs = ConstraintDocs::new(&m, &d);
+        assert_eq!(
+            docs.constraint(),
+            "h(q), one row per equation: none (the model has no contact and no loop, so there \
+             is no row)."
+        );
+        assert_eq!(
+            docs.terms(),
+            "J and c: none (the model has no contact and no loop, so there is no row)."
+        );
+        assert!(docs.velocity_terms().starts_with("M, F, Q (13) (no c:"));
+    }
+
+    #[test]
+    fn a_four_bar_constraint_doc_names_its_loop_not_the_knife_edge() {
+        let (m, d) = derived("four_bar");
+        let docs = ConstraintDocs::new(&m, &d);
+        let h = docs.constraint();
+        assert_eq!(
+            h,
+            "h(q), one row per equation: loop `pin` (x, y), the cut joint's equations h = X·Y, \
+             eq. (K1)."
+        );
+        assert!(!h.contains("f3"), "{h}");
+        assert_eq!(
+            docs.bias(),
+            "c of J q̈ + c = 0: loop `pin` (x, y), eq. (K3)."
+        );
+    }
+
+    #[test]
+    fn a_knife_edge_on_an_explicit_profile_keeps_the_papers_equations() {
+        let (m, d) = derived("driven_convex");
+        let docs = ConstraintDocs::new(&m, &d);
+        let name = &m.contacts[0].name;
+        assert_eq!(
+            docs.constraint(),
+            format!(
+                "h(q), one row per equation: contact `{name}` (a knife edge on y = f(x)), \
+                 h = f2 − f3(f1), eq. (3)."
+            )
+        );
+        assert_eq!(
+            docs.jacobian(),
+            format!(
+                "J = ∂h/∂q, row-major nc×n: contact `{name}` (a knife edge on y = f(x)), \
+                 J = J2 − f3′ J1, eq. (5b)."
+            )
+        );
+    }
+
+    #[test]
+    fn a_roller_names_the_nearest_point_equations() {
+        let (m, d) = derived("cycloidal_roller");
+        let docs = ConstraintDocs::new(&m, &d);
+        assert!(
+            docs.constraint()
+                .contains("(a roller on the profile's nearest point), h = D − ρ, eq. (C7)")
+        );
+        assert!(docs.bias().ends_with("eq. (C9)."));
+    }
+}

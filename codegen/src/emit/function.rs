@@ -203,3 +203,89 @@ pub(super) fn input_bindings(d: &Derivation, used: &HashSet<Id>) -> Vec<(&'stati
     }
     lines
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::spec::param;
+    use crate::emit::testing::derived;
+
+    #[test]
+    fn a_function_binds_the_coordinates_it_reads_and_marks_unused_parameters() {
+        let (_, mut d) = derived("double_pendulum");
+        let (q1, q2) = (d.symbols.q[0], d.symbols.q[1]);
+        let sum = d.graph.add(q1, q2);
+        let twice = d.graph.mul(sum, sum);
+        let spec = FunctionSpec {
+            doc: "A test.".into(),
+            name: "f".into(),
+            params: vec![
+                param("q", "&[f64]"),
+                param("qd", "&[f64]"),
+                param("out", "&mut [f64]"),
+            ],
+            ret: None,
+            outputs: vec![("out[0]".into(), twice), ("out[1]".into(), q2)],
+            tail: String::new(),
+        };
+        let (text, count) = emit_function_given(&d, &spec, "", false, &[]);
+        // q1 + q2 is used twice: bound once; qd is not read.
+        let lines: Vec<&str> = text
+            .lines()
+            .filter(|l| !l.starts_with("__section__"))
+            .collect();
+        assert_eq!(lines[0], "/// A test.");
+        assert_eq!(lines[1], "fn f(q: &[f64], _qd: &[f64], out: &mut [f64]) {");
+        assert_eq!(&lines[2..4], ["let q1 = q[0];", "let q2 = q[1];"]);
+        assert_eq!(
+            lines.iter().filter(|l| l.contains("q1 + q2")).count(),
+            1,
+            "{text}"
+        );
+        assert_eq!(lines.last(), Some(&"}"));
+        assert!(lines.contains(&"out[1] = q2;"), "{text}");
+        assert_eq!((count.add_sub, count.mul, count.total()), (1, 1, 2));
+    }
+
+    #[test]
+    fn a_given_node_is_read_not_computed() {
+        let (_, mut d) = derived("double_pendulum");
+        let q1 = d.symbols.q[0];
+        let s = d.graph.sin(q1);
+        let spec = FunctionSpec {
+            doc: "Reads the cache.".into(),
+            name: "g".into(),
+            params: vec![param("q", "&[f64]"), param("cache", "&[f64]")],
+            ret: Some("f64"),
+            outputs: vec![(RETURN.into(), s)],
+            tail: String::new(),
+        };
+        let (text, count) = emit_function_given(&d, &spec, "", true, &[(s, "cache[4]".into())]);
+        assert!(
+            text.starts_with(
+                "/// Reads the cache.\nfn g(&self, _q: &[f64], cache: &[f64]) -> f64 {\n"
+            ),
+            "{text}"
+        );
+        assert!(text.contains("cache[4]"), "{text}");
+        assert!(!text.contains("sin"), "{text}");
+        assert_eq!(count.total(), 0);
+    }
+
+    #[test]
+    fn arrays_with_many_zeros_are_cleared_with_one_fill() {
+        assert_eq!(array_of("m[3]"), Some("m"));
+        assert_eq!(array_of("out.mass[12]"), Some("out.mass"));
+        assert_eq!(array_of("out[0].direction[1]"), None);
+        assert_eq!(array_of("let kinetic"), None);
+        let mut g = Graph::new();
+        let (zero, x) = (g.constant(0.0), g.var("x"));
+        let mut outputs: Vec<(String, Id)> = (0..ZERO_FILL_THRESHOLD)
+            .map(|k| (format!("m[{k}]"), zero))
+            .collect();
+        outputs.push(("j[0]".into(), zero));
+        outputs.push(("m[99]".into(), x));
+        assert_eq!(zero_filled_arrays(&g, &outputs), ["m"]);
+        assert!(zero_filled_arrays(&g, &outputs[1..]).is_empty());
+    }
+}

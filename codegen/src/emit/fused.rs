@@ -188,3 +188,40 @@ pub(super) fn fused_count(d: &Derivation, spec: &FunctionSpec, given: &[(Id, Str
     let given: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
     d.graph.op_count_until(&roots, &given).total()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::derived;
+
+    #[test]
+    fn without_constraints_the_position_level_is_empty_and_caches_nothing() {
+        let (m, mut d) = derived("double_pendulum");
+        let fused = FusedTerms::new(&mut d);
+        assert!(fused.position.is_empty());
+        // M (2×2), F (2), Q (2); no c.
+        assert_eq!(fused.velocity.len(), 8);
+        assert_eq!(fused.cache_len(), 0);
+        let specs = fused.specs(&ConstraintDocs::new(&m, &d));
+        assert_eq!(specs[0].0.name, "position_terms");
+        assert_eq!(specs[1].0.name, "velocity_terms");
+        assert!(!specs[0].0.params.iter().any(|p| p.always_used));
+    }
+
+    #[test]
+    fn the_cache_holds_a_slot_triple_per_memoised_angle_then_the_plain_values() {
+        // A cam on a revolute joint: its angle's sine and cosine, and the contact parameter.
+        let (m, mut d) = derived("cycloidal_roller");
+        let fused = FusedTerms::new(&mut d);
+        assert_eq!(fused.position.len(), 1 + m.n());
+        assert!(!fused.memo.is_empty());
+        for (k, memo) in fused.memo.iter().enumerate() {
+            assert_eq!(memo.slot, 3 * k);
+        }
+        let plain = fused.plain_cached();
+        assert_eq!(plain.first().map(|p| p.0), Some(3 * fused.memo.len()));
+        assert_eq!(fused.cache_len(), 3 * fused.memo.len() + plain.len());
+        let (_, given) = &fused.specs(&ConstraintDocs::new(&m, &d))[1];
+        assert_eq!(given.len(), plain.len() + 2 * fused.memo.len());
+    }
+}

@@ -83,3 +83,33 @@ pub(super) fn implicit_helpers(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::derived;
+
+    #[test]
+    fn no_contact_parameter_means_no_helper() {
+        let (_, d) = derived("double_pendulum");
+        let mut counts = Vec::new();
+        assert_eq!(implicit_helpers(&d, &mut counts, &[]), "");
+        assert!(counts.is_empty());
+    }
+
+    #[test]
+    fn a_contact_parameter_gets_its_residual_and_objective() {
+        let (_, d) = derived("cycloidal_roller");
+        let mut counts = Vec::new();
+        // The profile's dimensions are constant: the residual reads nothing derived.
+        let text = implicit_helpers(&d, &mut counts, &[]);
+        let names: Vec<&str> = counts.iter().map(|c| c.0.as_str()).collect();
+        assert_eq!(
+            names,
+            ["roller_parameter_residual", "roller_parameter_objective"]
+        );
+        assert!(text.contains("fn roller_parameter_residual(_derived: &Derived, x: f64, y: f64, s: f64) -> [f64; 2]"), "{text}");
+        assert!(text.contains("[value, slope]"));
+        assert!(text.contains("whose root with ψ′ < 0 Newton finds"));
+    }
+}

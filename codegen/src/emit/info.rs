@@ -131,3 +131,27 @@ pub(super) fn parameter_infos(model: &Model) -> String {
         .collect();
     items.join(", ")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::model;
+
+    #[test]
+    fn the_static_description_lists_coordinates_contacts_and_loops() {
+        let text = info_static(&model("four_bar"));
+        assert!(text.contains("loops: Vec::from([rt::LoopInfo { name: \"pin\".to_string(), kind: rt::LoopKind::Revolute, equations: Vec::from([\"x\".to_string(), \"y\".to_string()]) }])"), "{text}");
+        assert!(text.contains("contacts: Vec::from([])"));
+        let text = info_static(&model("double_pendulum"));
+        assert!(text.contains("rt::CoordinateInfo { name: \"q1\".to_string(), kind: rt::CoordinateKind::Revolute, driven: false }"));
+        assert!(text.contains("defaults: rt::SimSettings { t_end: 10.0, dt_out: 0.01,"));
+        assert!(text.contains("spatial: false"));
+    }
+
+    #[test]
+    fn run_time_parameters_carry_their_bounds() {
+        let text = parameter_infos(&model("double_pendulum"));
+        assert_eq!(text.matches("rt::ParameterInfo {").count(), 7);
+        assert!(text.starts_with("rt::ParameterInfo { name: \"l1\".to_string(), unit: \"m\".to_string(), default: 1.0, min: Some(0.0), max: None, description: \"length of link 1\".to_string() }"));
+    }
+}

@@ -34,3 +34,24 @@ pub(super) fn lit(v: f64) -> String {
         format!("{s}.0")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn float_literals_read_back_as_floats() {
+        assert_eq!(lit(1.0), "1.0");
+        assert_eq!(lit(-2.5), "-2.5");
+        assert_eq!(lit(1e-20), "1e-20");
+        assert_eq!(lit(f64::INFINITY), "inf");
+        assert_eq!(float_list(&[0.0, 3.0]), "[0.0, 3.0]");
+        assert_eq!(float_list(&[]), "[]");
+    }
+
+    #[test]
+    fn raw_strings_take_more_hashes_than_the_text_holds() {
+        assert_eq!(raw_string("a"), "r#\"a\"#");
+        assert_eq!(raw_string("say \"#hi\""), "r##\"say \"#hi\"\"##");
+    }
+}

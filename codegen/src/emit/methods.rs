@@ -229,3 +229,53 @@ pub(super) fn energy_spec(d: &Derivation) -> FunctionSpec {
         tail: "rt::Energy { kinetic, gravity, spring }".into(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::derived;
+
+    fn names(specs: &[FunctionSpec]) -> Vec<&str> {
+        specs.iter().map(|s| s.name.as_str()).collect()
+    }
+
+    const ALWAYS: [&str; 11] = [
+        "mass_matrix",
+        "inertial_forces",
+        "applied_forces",
+        "equations",
+        "constraint",
+        "constraint_jacobian",
+        "constraint_bias",
+        "constraint_terms",
+        "contact_geometry",
+        "prescribed",
+        "energy",
+    ];
+
+    #[test]
+    fn one_spec_per_dynamics_method_the_model_needs() {
+        let (m, mut d) = derived("double_pendulum");
+        let specs = function_specs(&m, &mut d);
+        assert_eq!(names(&specs), [&ALWAYS[..], &["damper_power"]].concat());
+        // A loop adds its points.
+        let (m, mut d) = derived("four_bar");
+        let specs = function_specs(&m, &mut d);
+        assert!(names(&specs).contains(&"loop_points"));
+    }
+
+    #[test]
+    fn the_mass_matrix_is_row_major_and_h_has_a_row_per_equation() {
+        let (m, mut d) = derived("double_pendulum");
+        let specs = function_specs(&m, &mut d);
+        let targets: Vec<&str> = specs[0].outputs.iter().map(|o| o.0.as_str()).collect();
+        assert_eq!(targets, ["m[0]", "m[1]", "m[2]", "m[3]"]);
+        assert_eq!(specs[0].outputs[1].1, d.dynamics.mass[0][1]);
+        assert!(specs[4].outputs.is_empty());
+        let (m, mut d) = derived("four_bar");
+        let specs = function_specs(&m, &mut d);
+        let h: Vec<&str> = specs[4].outputs.iter().map(|o| o.0.as_str()).collect();
+        assert_eq!(h, ["h[0]", "h[1]"]);
+        assert!(specs[4].doc.contains("loop `pin`"), "{}", specs[4].doc);
+    }
+}

@@ -165,3 +165,35 @@ pub(super) fn embedded_source(model: &Model, source: &str, text: &str) -> String
     );
     file
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::model;
+
+    #[test]
+    fn a_model_without_run_time_parameters_is_a_unit_struct() {
+        let text = model_type(&model("double_pendulum"), "p.ron", false);
+        assert!(text.starts_with("/// The model `double_pendulum`, generated from `p.ron`"));
+        assert!(text.contains("pub struct Model;\n"));
+        assert!(text.contains("None => Ok(Model),"));
+        assert!(text.contains("let known: &[&str] = &[\"l1\", \"l2\", \"m1\", \"m2\", \"g\", \"q1_start\", \"q2_start\"];"));
+    }
+
+    #[test]
+    fn a_parametric_model_holds_its_values_and_what_derives_from_them() {
+        let text = model_type(&model("double_pendulum"), "p.ron", true);
+        assert!(text.contains(
+            "pub struct Model {\nparameters: Parameters,\nvalues: [f64; 7],\nderived: Derived,"
+        ));
+        assert!(text.contains("check(&parameters)?;"));
+        assert!(!text.contains("pub struct Model;"));
+    }
+
+    #[test]
+    fn the_embedded_source_reads_as_written() {
+        let text = embedded_source(&model("double_pendulum"), "p.ron", "say \"#hi\"");
+        assert!(text.contains("pub const MODEL_SOURCE: &str = r##\"say \"#hi\"\"##;\n"));
+        assert!(text.contains("pub const MODEL_FILES: &[(&str, &str)] = &[];\n"));
+    }
+}

@@ -170,3 +170,27 @@ pub(super) fn id_at(g: &Graph, i: usize) -> Id {
     // Ids are dense indices; rebuild one from its index through the graph's node list.
     g.id_from_index(i)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn variables_get_sanitised_unique_names_that_avoid_the_generated_ones() {
+        let mut g = Graph::new();
+        let ids = ["Link 1", "link_1", "m", "t", "s_q1", "2x"].map(|n| g.var(n));
+        let names = Names::of_vars(&g);
+        let got: Vec<String> = ids.iter().map(|&id| names.var(&g, id)).collect();
+        assert_eq!(got, ["link_1", "link_1_2", "v_m", "t", "v_s_q1", "v_2x"]);
+    }
+
+    #[test]
+    fn identifiers_and_sanitising() {
+        assert_eq!(sanitize("Cam-Angle"), "cam_angle");
+        assert_eq!(sanitize(""), "x");
+        assert!(is_identifier("cache"));
+        assert!(!is_identifier("cache[3]"));
+        assert!(!is_identifier("3x"));
+        assert!(!is_identifier(""));
+    }
+}

@@ -56,3 +56,27 @@ pub(super) fn format(file: &str) -> Result<String, String> {
         syn::parse_file(file).map_err(|e| format!("generated code does not parse: {e}"))?;
     Ok(restore_comments(&prettyplease::unparse(&syntax)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn section_markers_become_comments_even_when_wrapped() {
+        let code = "fn f() {\n    __section__!(\"body arm\");\n    let a = 1;\n    \
+                    __section__!(\n        \"a long one\"\n    );\n}\n";
+        assert_eq!(
+            restore_comments(code),
+            "fn f() {\n    // body arm\n    let a = 1;\n    // a long one\n}\n"
+        );
+    }
+
+    #[test]
+    fn formatting_prints_with_prettyplease_and_refuses_what_does_not_parse() {
+        assert_eq!(
+            format("fn f(){__section__!(\"x\");let a=1;}").as_deref(),
+            Ok("fn f() {\n    // x\n    let a = 1;\n}\n")
+        );
+        assert!(format("fn (").is_err_and(|e| e.starts_with("generated code does not parse")));
+    }
+}

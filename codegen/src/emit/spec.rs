@@ -46,3 +46,16 @@ pub(super) const FIELD: &str = "field:";
 
 /// Where the fields of [`FIELD`] targets go in a function's tail.
 pub(super) const FIELDS: &str = "__fields__";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plain_parameter_is_prefixed_when_unused() {
+        let p = param("qd", "&[f64]");
+        assert_eq!((p.name, p.ty, p.always_used), ("qd", "&[f64]", false));
+        assert_ne!(RETURN, FIELDS);
+        assert!(FIELD.ends_with(':'));
+    }
+}

@@ -82,3 +82,54 @@ pub(super) fn law_helper(
         segments.join(", "),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use camchain_runtime::motion_law::{Law, MotionProgram, Segment};
+    use camchain_runtime::spline::{Ends, Spline};
+    use std::f64::consts::PI;
+
+    #[test]
+    fn a_spline_is_its_knots_values_and_second_derivatives() {
+        // Natural ends through (0, 0), (1, 1), (2, 0): M0 = M2 = 0 and
+        // M0 + 4 M1 + M2 = 6 (y0 − 2 y1 + y2) / h² = −12, so M1 = −3.
+        let spline = Spline::new(&[0.0, 1.0, 2.0], &[0.0, 1.0, 0.0], Ends::Natural);
+        let text = spline_helper("cam", &spline.expect("a valid table"));
+        assert!(text.contains("const CAM_X: [f64; 3] = [0.0, 1.0, 2.0];"));
+        assert!(text.contains("const CAM_Y: [f64; 3] = [0.0, 1.0, 0.0];"));
+        assert!(
+            text.contains("const CAM_M: [f64; 3] = [0.0, -3.0, 0.0];"),
+            "{text}"
+        );
+        assert!(text.contains("fn eval_cam(s: f64) -> [f64; 4] {\nrt::spline::evaluate(&CAM_X, &CAM_Y, &CAM_M, false, s)\n}"));
+        assert!(text.contains("open: its end cubics continue"));
+    }
+
+    #[test]
+    fn a_motion_law_is_its_segments() {
+        let cycloidal = |lift| Segment {
+            law: Law::Cycloidal,
+            angle: PI,
+            lift,
+        };
+        let program =
+            MotionProgram::new(&[cycloidal(0.01), cycloidal(0.0)]).expect("a rise and a return");
+        let text = law_helper("lift", &program);
+        assert!(
+            text.contains(
+                "const LIFT: [rt::motion_law::Segment; 2] = [rt::motion_law::Segment { law: \
+             rt::motion_law::Law::Cycloidal, angle: 3.141592653589793, lift: 0.01 }, \
+             rt::motion_law::Segment { law: rt::motion_law::Law::Cycloidal, angle: \
+             3.141592653589793, lift: 0.0 }];"
+            ),
+            "{text}"
+        );
+        assert!(text.contains("rt::motion_law::evaluate(&LIFT, theta)"));
+    }
+
+    #[test]
+    fn a_graph_without_tables_has_no_helper() {
+        assert_eq!(table_helpers(&Graph::new()), "");
+    }
+}

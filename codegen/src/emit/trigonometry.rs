@@ -235,3 +235,67 @@ pub(super) struct TrigMemo {
     pub(super) cos: Id,
     pub(super) slot: usize,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trigonometric_names_follow_robotran() {
+        let mut g = Graph::new();
+        let (q1, q2) = (g.var("q1"), g.var("Q2"));
+        let sum = g.add(q1, q2);
+        assert_eq!(trig_name(&g, Func::Sin, q1).as_deref(), Some("s_q1"));
+        assert_eq!(trig_name(&g, Func::Cos, sum).as_deref(), Some("c_q1_q2"));
+        assert_eq!(trig_name_of(Func::Sqrt, "q1"), None);
+        let twice = g.mul(q1, q1);
+        assert_eq!(angle_name(&g, twice), None);
+    }
+
+    #[test]
+    fn multisets_of_coordinates() {
+        assert_eq!(multiset_difference(&[0, 1, 1], &[1]), Some(vec![0, 1]));
+        assert_eq!(multiset_difference(&[0], &[0]), None);
+        assert_eq!(multiset_difference(&[0], &[2]), None);
+        assert_eq!(multiset_sum(&[2], &[0, 1]), vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn a_difference_of_angles_is_rebuilt_from_the_known_sines_and_cosines() {
+        let mut g = Graph::new();
+        let (a, b) = (g.var("a"), g.var("b"));
+        let ab = g.add(a, b);
+        let mut known = HashMap::new();
+        let (sab, cab) = (g.sin(ab), g.cos(ab));
+        let (sb, cb) = (g.sin(b), g.cos(b));
+        known.insert(vec![0, 1], (sab, cab));
+        known.insert(vec![1], (sb, cb));
+        let sin_a = trig_from_known(&mut g, Func::Sin, &[0], &known).unwrap_or(sab);
+        let cos_a = trig_from_known(&mut g, Func::Cos, &[0], &known).unwrap_or(sab);
+        let (x, y) = (0.3, -1.1);
+        let v = g.eval(&[sin_a, cos_a], &[x, y]);
+        // sin((a + b) − b) and cos((a + b) − b): a few roundings of values below 1.
+        assert!((v[0] - f64::sin(x)).abs() < 1e-15, "{}", v[0]);
+        assert!((v[1] - f64::cos(x)).abs() < 1e-15, "{}", v[1]);
+        assert_eq!(trig_from_known(&mut g, Func::Sin, &[2], &known), None);
+    }
+
+    #[test]
+    fn pairs_of_sine_and_cosine_get_three_cache_slots_each() {
+        let mut g = Graph::new();
+        let (q1, q2) = (g.var("q1"), g.var("q2"));
+        let ids = [g.sin(q1), g.cos(q1), g.sin(q2)];
+        let reachable = g.reachable(&ids);
+        let pairs = trig_pairs(&g, &reachable, &[]);
+        assert_eq!(
+            pairs,
+            [TrigMemo {
+                sin: ids[0],
+                cos: ids[1],
+                slot: 0
+            }]
+        );
+        // A parameter's angle is computed once per parameter set, not memoised.
+        assert!(trig_pairs(&g, &reachable, &[q1]).is_empty());
+    }
+}

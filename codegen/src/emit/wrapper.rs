@@ -99,3 +99,75 @@ pub(super) fn wrapper(model: &Model, cache_len: usize, name: &str) -> Option<Str
     body.push_str("}\n");
     Some(body)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::model;
+
+    /// The doc line every wrapper starts with.
+    const DOC: &str = "/// Calls the fused pair `position_terms`/`velocity_terms` (large model: every \
+                       expression is compiled once).\n";
+
+    #[test]
+    fn constraint_calls_the_position_level_only_with_scratch_for_j() {
+        let m = model("four_bar");
+        assert_eq!((m.n(), m.n_constraints()), (3, 2));
+        assert_eq!(
+            wrapper(&m, 7, "constraint").as_deref(),
+            Some(
+                format!(
+                    "{DOC}fn constraint(&self, q: &[f64], h: &mut [f64]) {{\n\
+                     let mut cache = [0.0; 7];\n\
+                     let j = &mut [0.0; 6];\n\
+                     self.position_terms(q, h, j, &mut cache);\n}}\n"
+                )
+                .as_str()
+            )
+        );
+    }
+
+    #[test]
+    fn mass_matrix_evaluates_at_rest_at_time_zero_with_scratch_for_the_rest() {
+        let m = model("four_bar");
+        assert_eq!(
+            wrapper(&m, 0, "mass_matrix").as_deref(),
+            Some(
+                format!(
+                    "{DOC}fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {{\n\
+                     let mut cache = [0.0; 0];\n\
+                     let h = &mut [0.0; 2];\n\
+                     let j = &mut [0.0; 6];\n\
+                     self.position_terms(q, h, j, &mut cache);\n\
+                     let qd = &mut [0.0; 3];\n\
+                     let f = &mut [0.0; 3];\n\
+                     let applied = &mut [0.0; 3];\n\
+                     let c = &mut [0.0; 2];\n\
+                     self.velocity_terms(0.0, q, qd, &cache, rt::VelocityTerms {{ mass: m, \
+                     inertial: f, applied, bias: c }});\n}}\n"
+                )
+                .as_str()
+            )
+        );
+    }
+
+    #[test]
+    fn equations_pass_time_and_rates_and_return_three_arrays() {
+        let text = wrapper(&model("four_bar"), 1, "equations").unwrap_or_default();
+        assert!(text.contains(
+            "fn equations(&self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], f: &mut [f64], \
+             applied: &mut [f64])"
+        ));
+        assert!(text.contains("self.velocity_terms(t, q, qd,"));
+        assert!(!text.contains("let m ="), "{text}");
+        assert!(text.contains("let c = &mut [0.0; 2];"), "{text}");
+    }
+
+    #[test]
+    fn functions_with_their_own_expressions_have_no_wrapper() {
+        let m = model("four_bar");
+        assert_eq!(wrapper(&m, 0, "energy"), None);
+        assert_eq!(wrapper(&m, 0, "position_terms"), None);
+        assert_eq!(ENTRY_POINTS.len(), 8);
+    }
+}
