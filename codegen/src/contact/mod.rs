@@ -9,8 +9,9 @@
 //!   follower point, found by Newton) and [`flat`] (a flat face: the profile's extreme point
 //!   along the face's normal).
 //!
-//! A new kind is one more module here returning [`ContactTerms`], and one more arm in
-//! [`contact_terms`]; the emitter, the runtime and the outputs take it from there.
+//! A new kind is one more module here returning [`ContactTerms`] (with the [`Formulas`] the
+//! generated docs quote), and one more arm in [`contact_terms`]; the emitter, the runtime and
+//! the outputs take it from there.
 
 pub mod curve;
 pub mod flat;

@@ -104,3 +104,26 @@ pub(super) fn unique_names<'n>(
     }
     Ok(index)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_vectors_and_their_refusals() {
+        assert_eq!(unit([0.0, 3.0, 4.0]), Some([0.0, 0.6, 0.8]));
+        assert_eq!(unit([0.0; 3]), None);
+        assert_eq!(unit([f64::NAN, 1.0, 0.0]), None);
+    }
+
+    #[test]
+    fn an_unknown_name_lists_the_known_ones_sorted() {
+        let index: HashMap<&str, usize> = [("wheel", 0), ("arm", 1)].into_iter().collect();
+        assert_eq!(
+            unknown(&index, "cam", "body"),
+            "unknown body `cam`; known: arm, wheel"
+        );
+        assert!(is_identifier("link_2"));
+        assert!(!is_identifier("2link"));
+    }
+}
