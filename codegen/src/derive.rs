@@ -2,8 +2,9 @@
 //! and prescribed motions, all in one expression graph.
 
 use crate::closure::{ClosureTerms, closure_terms};
-use crate::contact::{ContactTerms, contact_terms, scalar_to_expr, value_and_derivatives};
+use crate::contact::{ContactTerms, contact_terms};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
+use crate::expr::scalar::{scalar_to_expr, value_and_derivatives};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{Symbols, forward};
 use crate::linear;

@@ -498,7 +498,7 @@ pub fn joint_load(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Option
     // Parameter indices past the model's parameters are the coordinates, then their rates
     // (`JointLoad::expr`).
     let variables: Vec<Id> = s.params.iter().chain(&s.q).chain(&s.qd).copied().collect();
-    let tau = crate::contact::scalar_to_expr(g, expr, s.t, &variables);
+    let tau = crate::expr::scalar::scalar_to_expr(g, expr, s.t, &variables);
     g.label(tau, format!("load_{}", model.bodies[i].joint.coordinate));
     Some(tau)
 }

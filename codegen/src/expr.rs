@@ -15,6 +15,7 @@ use crate::profile::Func;
 use std::collections::{HashMap, HashSet};
 
 mod calculus;
+pub mod scalar;
 
 /// Handle of a node in a [`Graph`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

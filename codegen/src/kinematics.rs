@@ -10,7 +10,7 @@
 //! carried separately, seen in each body's frame, so that F and the gravity part of Q are
 //! separate recursions and each only costs O(n).
 
-use crate::contact::scalar_to_expr;
+use crate::expr::scalar::scalar_to_expr;
 use crate::expr::{Graph, Id};
 use crate::model::{Field, JointKind, Model};
 use crate::profile::Scalar;

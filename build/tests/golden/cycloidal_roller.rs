@@ -506,7 +506,7 @@ impl rt::Dynamics for Model {
         applied[0] = 0.0;
         applied[1] = weight_lift + (k_2 * (lift + term1) + lift_dot * c_2);
     }
-    /// h(q) = f2 − f3(f1), eq. (3).
+    /// h(q), one row per equation: contact `roller` (a roller on the profile's nearest point), h = D − ρ, eq. (C7).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
         let cam_angle = q[0];
         let lift = q[1];
@@ -571,7 +571,7 @@ impl rt::Dynamics for Model {
         let roller_distance = roller_offset_x * roller_ty - roller_offset_y * roller_tx;
         h[0] = roller_distance - 0.0125;
     }
-    /// J = J2 − f3' J1, eq. (5b), row-major nc×n.
+    /// J = ∂h/∂q, row-major nc×n: contact `roller` (a roller on the profile's nearest point), J = n·∂P/∂q, eq. (C8).
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
         let cam_angle = q[0];
         let lift = q[1];
@@ -631,7 +631,7 @@ impl rt::Dynamics for Model {
         j[0] = roller_j1_cam_angle * roller_ty + neg_roller_j2_cam_angle * roller_tx;
         j[1] = s_cam_angle * roller_ty - c_cam_angle * roller_tx;
     }
-    /// c of J q̈ + c = 0, eqs. (7, 8).
+    /// c of J q̈ + c = 0: contact `roller` (a roller on the profile's nearest point), eq. (C9).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
         let cam_angle = q[0];
         let lift = q[1];
@@ -744,7 +744,7 @@ impl rt::Dynamics for Model {
             + neg_roller_kappa * roller_along.powi(2)
                 / (1.0 + neg_roller_kappa * roller_distance);
     }
-    /// J and c sharing one evaluation of the contact kinematics.
+    /// J and c sharing one evaluation of the kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
         let cam_angle = q[0];
         let lift = q[1];
@@ -1022,7 +1022,7 @@ impl rt::Dynamics for Model {
         let c_2 = self.derived.c;
         c_2 * lift_dot.powi(2)
     }
-    /// h (3) and J (5b) for Newton (15) and the velocities (16), in one pass; leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
+    /// h and J for Newton (15) and the velocities (16), in one pass (see `constraint` and `constraint_jacobian`); leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
     fn position_terms(
         &self,
         q: &[f64],
@@ -1108,7 +1108,7 @@ impl rt::Dynamics for Model {
         cache[15] = roller_tx;
         cache[16] = roller_ty;
     }
-    /// M, F, Q (13) and c (8) in one pass, reading `cache` as `position_terms` left it at the same q.
+    /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
         &self,
         _t: f64,

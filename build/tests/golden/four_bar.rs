@@ -942,7 +942,7 @@ impl rt::Dynamics for Model {
         applied[1] = weight_moment_coupler_z;
         applied[2] = weight_moment_rocker_z;
     }
-    /// h(q) = f2 − f3(f1), eq. (3).
+    /// h(q), one row per equation: loop `pin` (x, y), the cut joint's equations h = X·Y, eq. (K1).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
         let q_crank = q[0];
         let q_coupler = q[1];
@@ -977,7 +977,7 @@ impl rt::Dynamics for Model {
         h[0] = loop_pin_gap_x;
         h[1] = loop_pin_gap_y;
     }
-    /// J = J2 − f3' J1, eq. (5b), row-major nc×n.
+    /// J = ∂h/∂q, row-major nc×n: loop `pin` (x, y), J = X_q·Y + X·Y_q, eq. (K2).
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
         let q_crank = q[0];
         let q_coupler = q[1];
@@ -1012,7 +1012,7 @@ impl rt::Dynamics for Model {
         j[4] = loop_pin_a_segment_q_coupler_x;
         j[5] = -loop_pin_b_segment_q_rocker_x;
     }
-    /// c of J q̈ + c = 0, eqs. (7, 8).
+    /// c of J q̈ + c = 0: loop `pin` (x, y), eq. (K3).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
         let q_crank = q[0];
         let q_coupler = q[1];
@@ -1062,7 +1062,7 @@ impl rt::Dynamics for Model {
             - neg_loop_pin_a_centripetal_q_coupler_y
             - neg_loop_pin_a_centripetal_q_crank_y;
     }
-    /// J and c sharing one evaluation of the contact kinematics.
+    /// J and c sharing one evaluation of the kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
         let q_crank = q[0];
         let q_coupler = q[1];
@@ -1237,7 +1237,7 @@ impl rt::Dynamics for Model {
     fn damper_power(&self, _qd: &[f64]) -> f64 {
         0.0
     }
-    /// h (3) and J (5b) for Newton (15) and the velocities (16), in one pass; leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
+    /// h and J for Newton (15) and the velocities (16), in one pass (see `constraint` and `constraint_jacobian`); leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
     fn position_terms(
         &self,
         q: &[f64],
@@ -1284,7 +1284,7 @@ impl rt::Dynamics for Model {
         j[4] = loop_pin_a_segment_q_coupler_x;
         j[5] = -loop_pin_b_segment_q_rocker_x;
     }
-    /// M, F, Q (13) and c (8) in one pass, reading `cache` as `position_terms` left it at the same q.
+    /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
         &self,
         _t: f64,

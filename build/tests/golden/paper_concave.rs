@@ -855,7 +855,7 @@ impl rt::Dynamics for Model {
         applied[2] = weight_q3 + (q3 * k3 + q3_dot * c3);
         applied[3] = q4_dot * c4 + (weight_moment_body4_z + q4 * k4);
     }
-    /// h(q) = f2 − f3(f1), eq. (3).
+    /// h(q), one row per equation: contact `A` (a knife edge on y = f(x)), h = f2 − f3(f1), eq. (3).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
         let q1 = q[0];
         let q2 = q[1];
@@ -888,7 +888,7 @@ impl rt::Dynamics for Model {
         let a_y = 0.8 + a_arm_q1_y;
         h[0] = a_y - a_x * (a_x * (0.5 + 0.5 * a_x) - 0.595);
     }
-    /// J = J2 − f3' J1, eq. (5b), row-major nc×n.
+    /// J = ∂h/∂q, row-major nc×n: contact `A` (a knife edge on y = f(x)), J = J2 − f3′ J1, eq. (5b).
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
         let q1 = q[0];
         let q2 = q[1];
@@ -924,7 +924,7 @@ impl rt::Dynamics for Model {
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
         j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
     }
-    /// c of J q̈ + c = 0, eqs. (7, 8).
+    /// c of J q̈ + c = 0: contact `A` (a knife edge on y = f(x)), eqs. (7, 8).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
         let q1 = q[0];
         let q2 = q[1];
@@ -982,7 +982,7 @@ impl rt::Dynamics for Model {
             - q4_dot * a_segment_q4_y;
         c[0] = a_convective_y + neg_a_convective_x * a_slope - a_fxx * a_x_rate.powi(2);
     }
-    /// J and c sharing one evaluation of the contact kinematics.
+    /// J and c sharing one evaluation of the kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
         let q1 = q[0];
         let q2 = q[1];
@@ -1207,7 +1207,7 @@ impl rt::Dynamics for Model {
         let c4 = self.derived.c4;
         c4 * q4_dot.powi(2) + (c2 * q2_dot.powi(2) + c3 * q3_dot.powi(2))
     }
-    /// h (3) and J (5b) for Newton (15) and the velocities (16), in one pass; leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
+    /// h and J for Newton (15) and the velocities (16), in one pass (see `constraint` and `constraint_jacobian`); leaves the sines, cosines and profile values `velocity_terms` reuses in `cache`.
     fn position_terms(
         &self,
         q: &[f64],
@@ -1251,7 +1251,7 @@ impl rt::Dynamics for Model {
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
         j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
     }
-    /// M, F, Q (13) and c (8) in one pass, reading `cache` as `position_terms` left it at the same q.
+    /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
         &self,
         _t: f64,

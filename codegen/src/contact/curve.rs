@@ -7,7 +7,7 @@
 //! follower and the curvature signed so that it is positive where the profile is hollow seen
 //! from the follower.
 
-use super::expressions::value_and_derivatives;
+use crate::expr::scalar::value_and_derivatives;
 use crate::expr::{Graph, Id};
 use crate::kinematics::Symbols;
 use crate::model::{Field, Model, Profile};

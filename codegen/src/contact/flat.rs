@@ -13,11 +13,11 @@
 //!
 //! the last term from the support point's motion ṡ = −ω_r (m⊥·c′)/(m·c″).
 
-use super::ContactTerms;
 use super::curve::{
     add_scaled, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
 };
 use super::relative::Relative;
+use super::{ContactTerms, Formulas};
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{BodyKinematics, Symbols, vec3};
 use crate::model::{Model, Profile};
@@ -119,5 +119,11 @@ pub fn flat(
         curvature: f.curvature,
         sliding,
         relative: rel,
+        formulas: Formulas {
+            kind: "a flat face on the profile's support point".to_string(),
+            h: "h = m·(F − c(s*)), eq. (C11)",
+            jacobian: "J = m·∂F/∂q + (∂ω_r/∂q̇) m⊥·(F − c(s*)), eq. (C12)",
+            bias: "eq. (C13)",
+        },
     }
 }

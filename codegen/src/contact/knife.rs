@@ -9,9 +9,9 @@
 //!
 //! h is not a distance: |∇h| = √(1 + f′²), the factor between λ and the normal force.
 
-use super::ContactTerms;
 use super::curve::{CurvePoint, curve_at};
 use super::relative::Relative;
+use super::{ContactTerms, Formulas};
 use crate::expr::Graph;
 use crate::kinematics::Symbols;
 use crate::model::Model;
@@ -76,5 +76,11 @@ pub fn explicit(
         curvature,
         sliding,
         relative: rel,
+        formulas: Formulas {
+            kind: "a knife edge on y = f(x)".to_string(),
+            h: "h = f2 − f3(f1), eq. (3)",
+            jacobian: "J = J2 − f3′ J1, eq. (5b)",
+            bias: "eqs. (7, 8)",
+        },
     }
 }

@@ -9,17 +9,15 @@
 //!   follower point, found by Newton) and [`flat`] (a flat face: the profile's extreme point
 //!   along the face's normal).
 //!
-//! A new kind is one more module here returning [`ContactTerms`], and one more arm in
-//! [`contact_terms`]; the emitter, the runtime and the outputs take it from there.
+//! A new kind is one more module here returning [`ContactTerms`] (with the [`Formulas`] the
+//! generated docs quote), and one more arm in [`contact_terms`]; the emitter, the runtime and
+//! the outputs take it from there.
 
 pub mod curve;
-mod expressions;
 pub mod flat;
 pub mod knife;
 pub mod nearest;
 pub mod relative;
-
-pub use expressions::{dot_list, scalar_to_expr, value_and_derivatives};
 
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3};
@@ -53,6 +51,23 @@ pub struct ContactTerms {
     pub sliding: Id,
     /// The follower seen from the cam (its point's cam-frame kinematics, the cam frame).
     pub relative: Relative,
+    /// How this kind writes h, J and c: what the generated functions' docs say.
+    pub formulas: Formulas,
+}
+
+/// A contact kind's h, J and c in the notation of `docs/method.md`, with their equation
+/// numbers (the paper's, or that document's `C` equations): the docs of the generated
+/// `constraint`, `constraint_jacobian` and `constraint_bias` describe the model's own kinds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Formulas {
+    /// The kind, e.g. "a knife edge on y = f(x)".
+    pub kind: String,
+    /// h, e.g. "h = f2 − f3(f1), eq. (3)".
+    pub h: &'static str,
+    /// J, e.g. "J = J2 − f3′ J1, eq. (5b)".
+    pub jacobian: &'static str,
+    /// c of J q̈ + c = 0, e.g. "eqs. (7, 8)".
+    pub bias: &'static str,
 }
 
 /// Derives the terms of every contact of `model`.

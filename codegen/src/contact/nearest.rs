@@ -13,11 +13,11 @@
 //!
 //! (κ D < 1 wherever the roller does not undercut the profile.)
 
-use super::ContactTerms;
 use super::curve::{
     self, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
 };
 use super::relative::Relative;
+use super::{ContactTerms, Formulas};
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{Symbols, vec3};
 use crate::model::{Field, Model, Profile};
@@ -121,5 +121,23 @@ pub fn nearest(
         curvature: f.curvature,
         sliding,
         relative: rel,
+        formulas: if radius.is_some() {
+            Formulas {
+                kind: format!(
+                    "a {} on the profile's nearest point",
+                    contact.follower.kind().label()
+                ),
+                h: "h = D − ρ, eq. (C7)",
+                jacobian: "J = n·∂P/∂q, eq. (C8)",
+                bias: "eq. (C9)",
+            }
+        } else {
+            Formulas {
+                kind: "a knife edge on the profile's nearest point".to_string(),
+                h: "h = D, eq. (C7) with ρ = 0",
+                jacobian: "J = n·∂P/∂q, eq. (C8)",
+                bias: "eq. (C9)",
+            }
+        },
     }
 }

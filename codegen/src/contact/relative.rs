@@ -19,7 +19,7 @@
 //! where col_j(p) = u_j × (p − o_j) for a revolute joint and u_j for a prismatic one, s_j = +1
 //! on the follower's side, −1 on the cam's, and ° marks velocity-product parts.
 
-use super::expressions::dot_list;
+use crate::expr::scalar::dot_list;
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
 use crate::model::{Contact, Field, JointKind, Model};

@@ -4,10 +4,10 @@
 //! once when the parameters are set (SD/FAST's `sdinit`), so that the functions a
 //! right-hand side calls read a stored number wherever the folded code had a constant.
 
-use super::{
-    ALLOW_LITERALS, ALLOW_UNUSED, FIELD, FIELDS, FunctionSpec, Param, emit_function_given, lit,
-    sanitize,
-};
+use super::function::emit_function_given;
+use super::literals::{ALLOW_LITERALS, ALLOW_UNUSED, lit};
+use super::names::sanitize;
+use super::spec::{FIELD, FIELDS, FunctionSpec, Param};
 use crate::derive::Derivation;
 use crate::expr::{Graph, Id, OpCount};
 use crate::model::{Field, FieldLocation, Model, RuntimeCheck};

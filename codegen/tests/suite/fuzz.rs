@@ -15,8 +15,8 @@
 //! A failing case is shrunk and saved by proptest in `codegen/tests/fuzz.proptest-regressions`
 //! (committed when it exists, so the case is replayed first on every later run).
 
-use camchain_codegen::contact::value_and_derivatives;
 use camchain_codegen::expr::Graph;
+use camchain_codegen::expr::scalar::value_and_derivatives;
 use camchain_codegen::profile::{Scalar, parse_expression};
 use camchain_codegen::schema::parse_model;
 use camchain_codegen::{Derivation, assembly};

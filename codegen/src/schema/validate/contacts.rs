@@ -3,10 +3,11 @@
 //! profile's hollows, a flat face on a convex profile turning only about the cam's axis, a
 //! polar radius that stays positive), each located at the field it concerns.
 
-use super::{
-    BodyTree, Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile, cam_axes,
-    expression, finite, identifier, lookup, unit_vector,
-};
+use super::bodies::BodyTree;
+use super::fields::{finite, identifier, lookup, unit_vector};
+use super::markers::cam_axes;
+use super::parameters::expression;
+use super::{Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile};
 use crate::contact::curve::profile_samples;
 use crate::model::{Body, Contact, JointKind, RuntimeCheck};
 use crate::schema::raw;

@@ -3,7 +3,8 @@
 //! followed, each located at the field it concerns. The profile itself is synthesised by
 //! [`crate::design`].
 
-use super::{Checked, Context, Follower, Profile, finite};
+use super::fields::{finite, positive};
+use super::{Checked, Context, Follower, Profile};
 use crate::design::{self, CamDesign, DESIGN_SAMPLES, Geometry, Motion, Senses};
 use crate::model::Field;
 use crate::profile::{Scalar, Tabulated};
@@ -69,7 +70,7 @@ pub(super) fn law_profile(
         Some(n) => {
             let at = format!("{field}.speed");
             let (_, value) = cx.dimension(&at, n)?;
-            super::positive(cx.at, &at, "the cam's nominal speed", value)?;
+            positive(cx.at, &at, "the cam's nominal speed", value)?;
             let expression = match n {
                 raw::Number::Value(v) => Scalar::Const(*v),
                 raw::Number::Expr(source) => cx.table.parsed(&at, source)?,
@@ -433,6 +434,6 @@ impl Context<'_> {
     /// A positive number that must not depend on run-time parameters.
     fn positive_constant(&self, field: &str, n: &raw::Number, what: &str) -> Checked<f64> {
         let value = self.constant(field, n)?;
-        super::positive(self.at, field, what, value)
+        positive(self.at, field, what, value)
     }
 }

@@ -2,7 +2,9 @@
 //! that the mechanism can have them: known bodies, two different bodies, unit axes, no more
 //! equations than free coordinates, and a planar model's loops in its plane.
 
-use super::{BodyTree, Checked, Context, GROUND, identifier, unit_vector};
+use super::bodies::BodyTree;
+use super::fields::{identifier, unit_vector};
+use super::{Checked, Context, GROUND};
 use crate::model::{Body, Closure, ClosurePoint, Contact, Field, LoopKind, Model};
 use crate::schema::raw;
 use std::collections::HashMap;

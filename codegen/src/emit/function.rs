@@ -1,0 +1,291 @@
+//! One generated function's text from its specification: signature (unused parameters
+//! prefixed with `_`), input bindings, the emitter's bindings, then the outputs (arrays with
+//! many zeros cleared with one `fill`).
+
+use super::emitter::Emitter;
+use super::names::{Names, is_identifier};
+use super::spec::{FIELD, FIELDS, FunctionSpec, RETURN};
+use super::trigonometry::TrigMemo;
+use crate::derive::Derivation;
+use crate::expr::{Graph, Id, Node, OpCount};
+use std::collections::HashSet;
+use std::fmt::Write;
+
+/// Emits `spec`; the nodes of `given` are read from the expressions paired with them (e.g.
+/// `cache[3]`) instead of being computed.
+pub(super) fn emit_function_given(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    prelude: &str,
+    method: bool,
+    given: &[(Id, String)],
+) -> (String, OpCount) {
+    emit_function_full(d, spec, prelude, method, given, &[], &[])
+}
+
+/// [`emit_function_given`], the sine–cosine pairs of `memo` computed through the cache
+/// (`rt::sin_cos_memo`), and the Newton solves of the implicit variables of `warm` started
+/// from the solutions kept where it says.
+pub(super) fn emit_function_full(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    prelude: &str,
+    method: bool,
+    given: &[(Id, String)],
+    memo: &[TrigMemo],
+    warm: &[(Id, String)],
+) -> (String, OpCount) {
+    let g = &d.graph;
+    let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
+    let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
+    let count = g.op_count_until(&roots, &given_set);
+    let mut body = Emitter::new(g, &spec.outputs, given, &d.symbols.params);
+    for m in memo {
+        body.memo.insert(m.sin, *m);
+        body.memo.insert(m.cos, *m);
+    }
+    body.warm = warm.iter().cloned().collect();
+    if d.has_runtime_parameters() {
+        body.derived_arg = if method {
+            "&self.derived, "
+        } else {
+            "derived, "
+        }
+        .to_string();
+    }
+    let (bindings, used_vars) = body.bindings();
+    let inputs = input_bindings(d, &used_vars);
+    let mut used_params: HashSet<&str> = inputs.iter().map(|(p, _)| *p).collect();
+    if body.solves_read_derived && !method {
+        used_params.insert("derived");
+    }
+    // A scalar argument read under its own name.
+    for (id, source) in given {
+        if is_identifier(source) && body.names.contains_key(id) {
+            if let Some(p) = spec.params.iter().find(|p| p.name == source) {
+                used_params.insert(p.name);
+            }
+        }
+    }
+    // A parameter that a bound given expression reads (`derived.k1`, `cache[3]`).
+    for p in &spec.params {
+        let reads = |(id, source): &(Id, String)| {
+            body.names.contains_key(id)
+                && (source.starts_with(&format!("{}.", p.name))
+                    || source.starts_with(&format!("{}[", p.name)))
+        };
+        if given.iter().any(reads) {
+            used_params.insert(p.name);
+        }
+    }
+    let params: Vec<String> = spec
+        .params
+        .iter()
+        .map(|p| {
+            let written = spec
+                .outputs
+                .iter()
+                .any(|(t, _)| t.starts_with(&format!("{}[", p.name)));
+            let used = p.always_used || used_params.contains(p.name) || written;
+            let name = if used {
+                p.name.to_string()
+            } else {
+                format!("_{}", p.name)
+            };
+            format!("{name}: {}", p.ty)
+        })
+        .collect();
+    let receiver = if method { "&self, " } else { "" };
+    let ret = spec.ret.map(|r| format!(" -> {r}")).unwrap_or_default();
+    let mut text = format!(
+        "/// {}\nfn {}({receiver}{}){ret} {{\n",
+        spec.doc,
+        spec.name,
+        params.join(", ")
+    );
+    for (_, line) in &inputs {
+        text.push_str(line);
+    }
+    text.push_str(prelude);
+    text.push_str(&bindings);
+    let mut fields = String::new();
+    let filled = zero_filled_arrays(g, &spec.outputs);
+    for array in &filled {
+        let _ = writeln!(text, "{array}.fill(0.0);");
+    }
+    for (target, id) in &spec.outputs {
+        if g.is_zero(*id) && array_of(target).is_some_and(|a| filled.contains(&a)) {
+            continue;
+        }
+        if target == RETURN {
+            let _ = writeln!(text, "{}", body.print(*id, 0));
+        } else if let Some(field) = target.strip_prefix(FIELD) {
+            let value = body.print(*id, 0);
+            if value == field {
+                let _ = writeln!(fields, "{field},");
+            } else {
+                let _ = writeln!(fields, "{field}: {value},");
+            }
+        } else {
+            let _ = writeln!(text, "{target} = {};", body.print(*id, 0));
+        }
+    }
+    text.push_str(&spec.tail.replace(FIELDS, &fields));
+    text.push_str("\n}\n");
+    (text, count)
+}
+
+/// Outputs that are zero, per array, from which the array is cleared with one `fill(0.0)`
+/// instead of one assignment each: a sparse M or J of a long chain (an N-four-bar's 81×81 M
+/// is 98 % zeros) would otherwise be mostly `m[k] = 0.0;` lines. Below it, the assignments
+/// are kept (and the small models' code stays as it was).
+pub(super) const ZERO_FILL_THRESHOLD: usize = 64;
+
+/// The array of an output target `name[index]` (`m`, `out.mass`), if it is one.
+pub(super) fn array_of(target: &str) -> Option<&str> {
+    let (array, rest) = target.split_once('[')?;
+    (rest.ends_with(']') && !rest.contains('[')).then_some(array)
+}
+
+/// The arrays with at least [`ZERO_FILL_THRESHOLD`] zero outputs, in order of appearance.
+pub(super) fn zero_filled_arrays<'t>(g: &Graph, outputs: &'t [(String, Id)]) -> Vec<&'t str> {
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for (target, id) in outputs {
+        let Some(array) = array_of(target) else {
+            continue;
+        };
+        if !g.is_zero(*id) {
+            continue;
+        }
+        match counts.iter_mut().find(|(a, _)| *a == array) {
+            Some((_, count)) => *count += 1,
+            None => counts.push((array, 1)),
+        }
+    }
+    counts
+        .into_iter()
+        .filter(|(_, count)| *count >= ZERO_FILL_THRESHOLD)
+        .map(|(array, _)| array)
+        .collect()
+}
+
+/// `let q1 = q[0];` lines for the variables the function uses, with the parameter they read.
+pub(super) fn input_bindings(d: &Derivation, used: &HashSet<Id>) -> Vec<(&'static str, String)> {
+    let mut lines = Vec::new();
+    let names = Names::of_vars(&d.graph);
+    for (i, id) in d.symbols.q.iter().enumerate() {
+        if used.contains(id) {
+            lines.push(("q", format!("let {} = q[{i}];\n", names.var(&d.graph, *id))));
+        }
+    }
+    for (i, id) in d.symbols.qd.iter().enumerate() {
+        if used.contains(id) {
+            lines.push((
+                "qd",
+                format!("let {} = qd[{i}];\n", names.var(&d.graph, *id)),
+            ));
+        }
+    }
+    if used.contains(&d.symbols.t) {
+        lines.push(("t", String::new()));
+    }
+    for &id in &d.symbols.params {
+        if used.contains(&id) {
+            let Node::Var(k) = d.graph.node(id) else {
+                continue;
+            };
+            let field = &d.graph.var_names()[k as usize];
+            lines.push((
+                "p",
+                format!("let {} = p.{field};\n", names.var(&d.graph, id)),
+            ));
+        }
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::spec::param;
+    use crate::emit::testing::derived;
+
+    #[test]
+    fn a_function_binds_the_coordinates_it_reads_and_marks_unused_parameters() {
+        let (_, mut d) = derived("double_pendulum");
+        let (q1, q2) = (d.symbols.q[0], d.symbols.q[1]);
+        let sum = d.graph.add(q1, q2);
+        let twice = d.graph.mul(sum, sum);
+        let spec = FunctionSpec {
+            doc: "A test.".into(),
+            name: "f".into(),
+            params: vec![
+                param("q", "&[f64]"),
+                param("qd", "&[f64]"),
+                param("out", "&mut [f64]"),
+            ],
+            ret: None,
+            outputs: vec![("out[0]".into(), twice), ("out[1]".into(), q2)],
+            tail: String::new(),
+        };
+        let (text, count) = emit_function_given(&d, &spec, "", false, &[]);
+        // q1 + q2 is used twice: bound once; qd is not read.
+        let lines: Vec<&str> = text
+            .lines()
+            .filter(|l| !l.starts_with("__section__"))
+            .collect();
+        assert_eq!(lines[0], "/// A test.");
+        assert_eq!(lines[1], "fn f(q: &[f64], _qd: &[f64], out: &mut [f64]) {");
+        assert_eq!(&lines[2..4], ["let q1 = q[0];", "let q2 = q[1];"]);
+        assert_eq!(
+            lines.iter().filter(|l| l.contains("q1 + q2")).count(),
+            1,
+            "{text}"
+        );
+        assert_eq!(lines.last(), Some(&"}"));
+        assert!(lines.contains(&"out[1] = q2;"), "{text}");
+        assert_eq!((count.add_sub, count.mul, count.total()), (1, 1, 2));
+    }
+
+    #[test]
+    fn a_given_node_is_read_not_computed() {
+        let (_, mut d) = derived("double_pendulum");
+        let q1 = d.symbols.q[0];
+        let s = d.graph.sin(q1);
+        let spec = FunctionSpec {
+            doc: "Reads the cache.".into(),
+            name: "g".into(),
+            params: vec![param("q", "&[f64]"), param("cache", "&[f64]")],
+            ret: Some("f64"),
+            outputs: vec![(RETURN.into(), s)],
+            tail: String::new(),
+        };
+        let (text, count) = emit_function_given(&d, &spec, "", true, &[(s, "cache[4]".into())]);
+        assert!(
+            text.starts_with(
+                "/// Reads the cache.\nfn g(&self, _q: &[f64], cache: &[f64]) -> f64 {\n"
+            ),
+            "{text}"
+        );
+        assert!(text.contains("cache[4]"), "{text}");
+        assert!(!text.contains("sin"), "{text}");
+        assert_eq!(count.total(), 0);
+    }
+
+    #[test]
+    fn arrays_with_many_zeros_are_cleared_with_one_fill() {
+        assert_eq!(array_of("m[3]"), Some("m"));
+        assert_eq!(array_of("out.mass[12]"), Some("out.mass"));
+        assert_eq!(array_of("out[0].direction[1]"), None);
+        assert_eq!(array_of("let kinetic"), None);
+        let mut g = Graph::new();
+        let (zero, x) = (g.constant(0.0), g.var("x"));
+        let mut outputs: Vec<(String, Id)> = (0..ZERO_FILL_THRESHOLD)
+            .map(|k| (format!("m[{k}]"), zero))
+            .collect();
+        outputs.push(("j[0]".into(), zero));
+        outputs.push(("m[99]".into(), x));
+        assert_eq!(zero_filled_arrays(&g, &outputs), ["m"]);
+        assert!(zero_filled_arrays(&g, &outputs[1..]).is_empty());
+    }
+}

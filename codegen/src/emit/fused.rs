@@ -1,0 +1,227 @@
+//! The fused pair a right-hand side calls: `position_terms` (h, J) and `velocity_terms`
+//! (M, F, Q, c), the values the first hands to the second through the cache, and the
+//! operation counts that decide whether the other entry points call the pair.
+
+use super::contacts::contact_output_roots;
+use super::docs::ConstraintDocs;
+use super::names::id_at;
+use super::spec::{FunctionSpec, Param, param};
+use super::trigonometry::{TrigMemo, reuse_position_trigonometry, trig_pairs};
+use crate::derive::Derivation;
+use crate::expr::{Id, Node, OpCount};
+use std::collections::HashSet;
+
+/// The two functions a right-hand side calls, position level (h, J) then velocity level
+/// (M, F, Q, c), and the q-only values the first hands to the second through `cache`.
+pub(super) struct FusedTerms {
+    /// Nodes both levels need whose computation is worth a store and a load: elementary
+    /// functions (sines, cosines, profile terms), powers and divisions.
+    pub(super) cached: Vec<Id>,
+    /// The sine–cosine pairs of joint angles the position level computes, each with three
+    /// cache entries (angle, sine, cosine) at the start of the cache: the position level
+    /// reuses them when it is evaluated again at the same angles (Newton moving a sliding
+    /// coordinate, the step's end evaluated again), and the velocity level reads them.
+    pub(super) memo: Vec<TrigMemo>,
+    pub(super) position: Vec<(String, Id)>,
+    pub(super) velocity: Vec<(String, Id)>,
+}
+
+impl FusedTerms {
+    pub(super) fn new(d: &mut Derivation) -> Self {
+        let n = d.symbols.q.len();
+        let dy = &d.dynamics;
+        let mut position = Vec::new();
+        let rows = d.constraint_rows();
+        for (k, row) in rows.iter().enumerate() {
+            position.push((format!("h[{k}]"), row.0));
+        }
+        for (k, row) in rows.iter().enumerate() {
+            for (i, &e) in row.1.iter().enumerate() {
+                position.push((format!("j[{}]", k * n + i), e));
+            }
+        }
+        let mut velocity = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                velocity.push((format!("out.mass[{}]", i * n + j), dy.mass[i][j]));
+            }
+        }
+        for (i, &e) in dy.inertial.iter().enumerate() {
+            velocity.push((format!("out.inertial[{i}]"), e));
+        }
+        for (i, &e) in dy.applied.iter().enumerate() {
+            velocity.push((format!("out.applied[{i}]"), e));
+        }
+        for (k, row) in rows.iter().enumerate() {
+            velocity.push((format!("out.bias[{k}]"), row.2));
+        }
+        drop(rows);
+        let roots = |outputs: &[(String, Id)]| -> Vec<Id> { outputs.iter().map(|o| o.1).collect() };
+        reuse_position_trigonometry(&mut d.graph, &roots(&position), &mut velocity);
+        let g = &d.graph;
+        let in_position = g.reachable(&roots(&position));
+        let in_velocity = g.reachable(&roots(&velocity));
+        let cached = (0..g.len())
+            .filter(|&i| in_position[i] && in_velocity[i])
+            .map(|i| id_at(g, i))
+            .filter(|&id| {
+                matches!(
+                    g.node(id),
+                    Node::Call(..) | Node::Powf(..) | Node::Div(..) | Node::Table(..)
+                ) || g.implicit_of(id).is_some()
+            })
+            .collect();
+        let memo = trig_pairs(g, &in_position, &d.symbols.params);
+        FusedTerms {
+            cached,
+            memo,
+            position,
+            velocity,
+        }
+    }
+
+    /// The cached nodes that are not in a memo triple, with their cache index.
+    pub(super) fn plain_cached(&self) -> Vec<(usize, Id)> {
+        let in_memo = |id: Id| self.memo.iter().any(|m| m.sin == id || m.cos == id);
+        self.cached
+            .iter()
+            .filter(|&&id| !in_memo(id))
+            .enumerate()
+            .map(|(k, &id)| (3 * self.memo.len() + k, id))
+            .collect()
+    }
+
+    /// Entries of the cache.
+    pub(super) fn cache_len(&self) -> usize {
+        3 * self.memo.len() + self.plain_cached().len()
+    }
+
+    /// The two function specifications, each with the nodes it reads from the cache.
+    pub(super) fn specs(&self, docs: &ConstraintDocs) -> Vec<(FunctionSpec, Vec<(Id, String)>)> {
+        let uses_cache = self.cache_len() > 0;
+        let cache_param = |ty| Param {
+            name: "cache",
+            ty,
+            always_used: uses_cache,
+        };
+        let mut position_outputs = self.position.clone();
+        for (k, id) in self.plain_cached() {
+            position_outputs.push((format!("cache[{k}]"), id));
+        }
+        let position = FunctionSpec {
+            doc: docs.position_terms(),
+            name: "position_terms".into(),
+            params: vec![
+                param("q", "&[f64]"),
+                param("h", "&mut [f64]"),
+                param("j", "&mut [f64]"),
+                cache_param("&mut [f64]"),
+            ],
+            ret: None,
+            outputs: position_outputs,
+            tail: String::new(),
+        };
+        let velocity = FunctionSpec {
+            doc: docs.velocity_terms(),
+            name: "velocity_terms".into(),
+            params: vec![
+                param("t", "f64"),
+                param("q", "&[f64]"),
+                param("qd", "&[f64]"),
+                cache_param("&[f64]"),
+                Param {
+                    name: "out",
+                    ty: "rt::VelocityTerms<'_>",
+                    always_used: true,
+                },
+            ],
+            ret: None,
+            outputs: self.velocity.clone(),
+            tail: String::new(),
+        };
+        let mut given: Vec<(Id, String)> = self
+            .plain_cached()
+            .into_iter()
+            .map(|(k, id)| (id, format!("cache[{k}]")))
+            .collect();
+        for m in &self.memo {
+            given.push((m.sin, format!("cache[{}]", m.slot + 1)));
+            given.push((m.cos, format!("cache[{}]", m.slot + 2)));
+        }
+        vec![(position, Vec::new()), (velocity, given)]
+    }
+}
+
+/// Operation count of a function's outputs (what it computes when emitted on its own), the
+/// nodes of `given` read rather than computed.
+pub(super) fn function_count(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    given: &[(Id, String)],
+) -> OpCount {
+    let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
+    let given: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
+    d.graph.op_count_until(&roots, &given)
+}
+
+/// The outputs of every generated function (the standalone entry points, the fused pair and
+/// the contact kinematics).
+pub(super) fn all_roots(d: &Derivation, specs: &[FunctionSpec], fused: &FusedTerms) -> Vec<Id> {
+    let mut roots: Vec<Id> = specs
+        .iter()
+        .flat_map(|s| s.outputs.iter().map(|(_, id)| *id))
+        .chain(fused.position.iter().map(|(_, id)| *id))
+        .chain(fused.velocity.iter().map(|(_, id)| *id))
+        .collect();
+    for c in &d.contacts {
+        roots.extend(contact_output_roots(c));
+    }
+    for (_, def) in d.graph.implicits() {
+        roots.extend([def.residual, def.derivative, def.objective]);
+    }
+    roots
+}
+
+/// Operation count of a fused function, the cached nodes read rather than computed.
+pub(super) fn fused_count(d: &Derivation, spec: &FunctionSpec, given: &[(Id, String)]) -> usize {
+    let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
+    let given: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
+    d.graph.op_count_until(&roots, &given).total()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emit::testing::derived;
+
+    #[test]
+    fn without_constraints_the_position_level_is_empty_and_caches_nothing() {
+        let (m, mut d) = derived("double_pendulum");
+        let fused = FusedTerms::new(&mut d);
+        assert!(fused.position.is_empty());
+        // M (2×2), F (2), Q (2); no c.
+        assert_eq!(fused.velocity.len(), 8);
+        assert_eq!(fused.cache_len(), 0);
+        let specs = fused.specs(&ConstraintDocs::new(&m, &d));
+        assert_eq!(specs[0].0.name, "position_terms");
+        assert_eq!(specs[1].0.name, "velocity_terms");
+        assert!(!specs[0].0.params.iter().any(|p| p.always_used));
+    }
+
+    #[test]
+    fn the_cache_holds_a_slot_triple_per_memoised_angle_then_the_plain_values() {
+        // A cam on a revolute joint: its angle's sine and cosine, and the contact parameter.
+        let (m, mut d) = derived("cycloidal_roller");
+        let fused = FusedTerms::new(&mut d);
+        assert_eq!(fused.position.len(), 1 + m.n());
+        assert!(!fused.memo.is_empty());
+        for (k, memo) in fused.memo.iter().enumerate() {
+            assert_eq!(memo.slot, 3 * k);
+        }
+        let plain = fused.plain_cached();
+        assert_eq!(plain.first().map(|p| p.0), Some(3 * fused.memo.len()));
+        assert_eq!(fused.cache_len(), 3 * fused.memo.len() + plain.len());
+        let (_, given) = &fused.specs(&ConstraintDocs::new(&m, &d))[1];
+        assert_eq!(given.len(), plain.len() + 2 * fused.memo.len());
+    }
+}
