@@ -212,8 +212,8 @@ pub struct ContactGeometry {
     pub x: f64,
     /// The contact point's y in the cam frame.
     pub y: f64,
-    /// The follower point (the knife edge, the roller's centre, the marker on the flat
-    /// face), ground coordinates.
+    /// The follower point (the knife edge, the centre of a roller or of a curved face's arc,
+    /// the marker on the flat face), ground coordinates.
     pub follower: [f64; 3],
     /// Unit normal at the contact, ground coordinates, pointing from the cam into the
     /// follower: the direction of the force the cam exerts.

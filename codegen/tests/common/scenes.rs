@@ -30,8 +30,9 @@ pub struct Kind {
     pub follower: &'static str,
     /// The profile lines (`profile:`, `polar:`, `parametric:`, `range:`).
     pub profile: &'static str,
-    /// How far the follower point sits from the profile at the drawn states (m): the
-    /// roller's radius, 0 for a knife edge or a flat face (whose marker is on the face).
+    /// How far the marker sits from the profile at the drawn states (m): the roller's
+    /// radius, 0 for a knife edge, a flat face or a curved face (whose marker is on the
+    /// face).
     pub offset: f64,
     /// True when the kind needs the follower to turn only about the cam's axis.
     pub planar_only: bool,
@@ -41,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 9] = [
+pub const KINDS: [Kind; 12] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -109,6 +110,30 @@ pub const KINDS: [Kind; 9] = [
     Kind {
         name: "flat on parametric",
         follower: "follower: Flat(normal: (0.0, -1.0, 0.0)),",
+        profile: "parametric: (x: \"0.05*s.cos()\", y: \"0.042*s.sin()\"), range: (0.0, 6.283185307179586),",
+        offset: 0.0,
+        planar_only: true,
+        turn: 3.1,
+    },
+    Kind {
+        name: "mushroom on explicit",
+        follower: "follower: Mushroom(radius: 0.03, normal: (0.0, -1.0, 0.0)),",
+        profile: "profile: \"0.045 - 2.0*x*x + 0.3*x.powi(3)\", range: (-0.2, 0.2),",
+        offset: 0.0,
+        planar_only: true,
+        turn: 0.4,
+    },
+    Kind {
+        name: "mushroom on polar",
+        follower: "follower: Mushroom(radius: 0.03, normal: (0.0, -1.0, 0.0)),",
+        profile: "polar: \"0.01*theta.cos() + (0.0016 - 0.0001*theta.sin().powi(2)).sqrt()\",",
+        offset: 0.0,
+        planar_only: true,
+        turn: 3.1,
+    },
+    Kind {
+        name: "mushroom on parametric",
+        follower: "follower: Mushroom(radius: 0.03, normal: (0.0, -1.0, 0.0)),",
         profile: "parametric: (x: \"0.05*s.cos()\", y: \"0.042*s.sin()\"), range: (0.0, 6.283185307179586),",
         offset: 0.0,
         planar_only: true,
