@@ -5,7 +5,8 @@
 
 use camchain_runtime::parameters::UnknownParameter;
 use camchain_runtime::{
-    InvalidSetting, MetricsFailure, ParameterError, RunMetrics, SimError, Stats,
+    InvalidSetting, MetricsFailure, ParameterError, RunMetrics, SimError, SimFailure, Stats,
+    Trajectory,
 };
 use std::error::Error;
 
@@ -54,6 +55,21 @@ fn sim_error_debug_is_the_message() {
         printed_by_main(error),
         "at t = 1.5 s the step budget of one call was exhausted"
     );
+}
+
+#[test]
+fn sim_failure_debug_is_the_message_not_the_trajectory() {
+    let failure = SimFailure {
+        error: SimError::TooManySteps { t: 1.5 },
+        partial: Trajectory {
+            sample_count: 151,
+            ..Trajectory::default()
+        },
+    };
+    let expected = "simulation stopped after 151 samples: at t = 1.5 s the step budget of one call was exhausted";
+    assert_eq!(format!("{failure:?}"), expected);
+    // What the run methods return: a boxed failure.
+    assert_eq!(printed_by_main(Box::new(failure)), expected);
 }
 
 #[test]
