@@ -374,12 +374,3 @@ mod tests {
         assert!(!sane.to_string().contains("diverged"), "{sane}");
     }
 }
-
-impl fmt::Debug for crate::simulate::SimFailure {
-    /// The one-line message of `Display` (the samples reached and the error), not the
-    /// partial trajectory: what a `main` returning `Result<(), Box<dyn std::error::Error>>`
-    /// prints after `Error: `. The fields stay public for a program that needs them.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        fmt::Display::fmt(self, f)
-    }
-}
