@@ -61,10 +61,10 @@ pub(super) fn non_finite(_ctx: &Context) -> Result<Section, CliError> {
         let outcome = match numeric.simulate(bad, &settings) {
             Ok(_) => "ok (not detected)".to_string(),
             Err(failure) => format!(
-                "**{}**: {} ({} samples kept)",
+                "**{}**: {} ({} kept)",
                 kind(&failure.error),
                 cell(&failure.error.to_string()),
-                failure.partial.samples.len()
+                crate::counted(failure.partial.samples.len(), "sample")
             ),
         };
         let _ = writeln!(text, "| {label} | {outcome} |");
