@@ -45,12 +45,19 @@
 //! }
 //! ```
 //!
+//! The generated `Model` has the common runs as its own methods (`assemble`, `step`,
+//! `sample`, `simulate`, `simulate_metrics`, `default_settings`); the others
+//! (`simulate_unilateral`, `simulate_observed`, `simulate_monitored`, …) and `info()` are
+//! methods of the traits [`runtime::Simulate`] and [`runtime::Dynamics`], which must be in
+//! scope to be called. `use camchain::prelude::*;` brings them, with the settings and the
+//! error types a program's `main` needs (see [`prelude`]).
+//!
 //! The repository's `examples/downstream/` is such a crate, built and run by CI. The same
 //! steps, run here on the paper's model, which the crate `camchain-models` compiles with
 //! `camchain_build::compile_models` exactly as above:
 //!
 //! ```
-//! use camchain::runtime::{Dynamics, Simulate};
+//! use camchain::prelude::*;
 //! use camchain_models::paper_concave::Model;
 //!
 //! let model = Model::default();
@@ -76,12 +83,71 @@
 
 pub use camchain_runtime as runtime;
 
+/// What a program that runs generated models needs in scope: `use camchain::prelude::*;`.
+///
+/// The traits [`Dynamics`](runtime::Dynamics) (what every generated `Model` implements:
+/// `info`, the parameters, the equations) and [`Simulate`](runtime::Simulate) (every run:
+/// `simulate_unilateral`, `simulate_observed`, `simulate_monitored`, `step_with`, …, for any
+/// `Dynamics`), whose methods cannot be called without them in scope; the settings of a run
+/// and what it returns; and the errors, whose `Debug` is their one-line message, so that
+/// `?` in a `main` returning `Result<(), Box<dyn std::error::Error>>` prints it.
+///
+/// A function generic over any model, which compiles with the prelude alone:
+///
+/// ```
+/// use camchain::prelude::*;
+///
+/// /// Runs `model` with one-sided contact and returns when its follower first lifts off (s).
+/// fn first_lift_off<M: Dynamics>(
+///     model: &M,
+///     t_end: f64,
+/// ) -> Result<Option<f64>, Box<dyn std::error::Error>> {
+///     let state: State = model.assemble(0.0)?;
+///     let settings = SimSettings {
+///         t_end,
+///         dt_out: 0.01,
+///         integrator: IntegratorKind::Dopri5,
+///         dt: 1e-3,
+///         rtol: 1e-8,
+///         atol: 1e-10,
+///     };
+///     let run: Trajectory = model.simulate_unilateral(state.clone(), &settings, 0.5)?;
+///     let metrics: RunMetrics =
+///         model.simulate_metrics(state, &settings, MetricsOptions::default())?;
+///     let _ = (metrics.max_normal_force, model.info().n());
+///     Ok(run.events.first().map(|event| event.t))
+/// }
+///
+/// // The error types convert into the `Box<dyn Error>` of such a function.
+/// fn _errors(
+///     _: SimError,
+///     _: Box<SimFailure>,
+///     _: Box<MetricsFailure>,
+///     _: ParameterError,
+///     _: InvalidSetting,
+/// ) {
+/// }
+/// ```
+pub mod prelude {
+    pub use camchain_runtime::events::{ContactEvent, EventKind};
+    pub use camchain_runtime::{
+        ContactLaw, Dynamics, IntegratorKind, InvalidSetting, MetricsFailure, MetricsOptions,
+        ModelInfo, ParameterError, ParameterInfo, RunMetrics, Sample, SimError, SimFailure,
+        SimSettings, Simulate, State, Stats, Trajectory,
+    };
+}
+
 #[cfg(feature = "reference")]
 pub use camchain_reference as reference;
 
 /// Includes the module that `camchain_build::compile_models` generated for a model, by its
 /// module name (the model's `name:`, or its file stem): the `Model` type, which implements
 /// [`runtime::Dynamics`], its `INFO` and its `OP_COUNTS`.
+///
+/// `Model`'s own methods cover the common runs; the other runs are methods of the traits
+/// [`runtime::Simulate`] and [`runtime::Dynamics`], in scope with `use camchain::prelude::*;`
+/// (rustc may suggest `camchain::camchain_runtime::Simulate`, which does not resolve: the
+/// path is `camchain::runtime::Simulate`, or the prelude).
 ///
 /// The generated items go where the macro is invoked; give them a module of their own:
 ///

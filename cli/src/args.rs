@@ -16,13 +16,13 @@ pub const DEFAULT_MODELS: [&str; 2] = ["paper_concave", "paper_convex"];
 /// The output directory used when neither `--out` nor `--csv` is given.
 pub const DEFAULT_OUT: &str = "out";
 
-/// `camchain`: simulate multibody chains whose tip slides on a fixed cam.
+/// `camchain`: simulate cam mechanisms from model files; sweep, design and benchmark them.
 #[derive(Debug, Parser)]
 #[command(
     name = "camchain",
     version,
-    about = "Simulate multibody chains whose tip slides on a fixed cam (Lipiński's method).",
-    long_about = "Simulate multibody chains whose tip slides on a fixed cam (Lipiński's method).\n\n\
+    about = "Simulate cam mechanisms from model files: chains, trees and closed loops of rigid bodies whose knife-edge, roller or flat followers touch fixed or moving cams.",
+    long_about = "Simulate cam mechanisms from model files: chains, trees and closed loops of rigid bodies whose knife-edge, roller or flat followers touch fixed or moving cams.\n\n\
                   Without a command, runs `simulate` (same options): by default the paper's \
                   concave and convex cams, a summary on the terminal, CSV and figures in out/."
 )]

@@ -50,6 +50,16 @@ use clap::Parser;
 use std::io::Write;
 use std::process::ExitCode;
 
+/// `1 run`, `2 runs`: a count and its noun, in the plural unless the count is one (`noun`
+/// is the singular; every noun printed with a count here takes an `s`).
+pub(crate) fn counted(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 /// Why the command failed.
 #[derive(Debug)]
 pub enum CliError {
@@ -75,7 +85,7 @@ impl std::fmt::Display for CliError {
             CliError::Usage(message) | CliError::Failed(message) => f.write_str(message),
             CliError::Reported => f.write_str("failed (reported above)"),
             CliError::Interrupted { .. } => f.write_str("interrupted (reported above)"),
-            CliError::RunsFailed(n) => write!(f, "{n} runs failed"),
+            CliError::RunsFailed(n) => write!(f, "{} failed", counted(*n, "run")),
         }
     }
 }
@@ -128,7 +138,9 @@ pub fn main() -> ExitCode {
                     eprintln!("error: {message}");
                 }
                 CliError::Reported | CliError::Interrupted { .. } => {}
-                CliError::RunsFailed(n) => eprintln!("error: {n} runs failed (see their rows)"),
+                CliError::RunsFailed(n) => {
+                    eprintln!("error: {} failed (see their rows)", counted(*n, "run"));
+                }
             }
             error.exit_code()
         }

@@ -199,9 +199,13 @@ fn assemble_contacts(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> 
     let free_count = free.iter().filter(|f| **f).count();
     if free_count < nc {
         return Err(format!(
-            "initial state cannot be assembled onto the cams: {nc} contacts need one \
-             coordinate each that is neither held nor driven, and {free_count} {} free: leave \
-             more out of initial.hold",
+            "initial state cannot be assembled onto the cams: {} neither held nor driven, and \
+             {free_count} {} free: leave more out of initial.hold",
+            if nc == 1 {
+                "1 contact needs a coordinate that is".to_string()
+            } else {
+                format!("{nc} contacts need one coordinate each that is")
+            },
             if free_count == 1 { "is" } else { "are" }
         ));
     }

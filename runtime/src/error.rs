@@ -4,7 +4,7 @@
 use std::fmt;
 
 /// Why assembly, a step or a simulation could not continue.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// Newton's method on the dependent coordinates, eq. (15), did not converge: the
     /// contact point cannot reach the cam for the current independent (and driven)
@@ -163,6 +163,15 @@ pub enum SimError {
         /// What is wrong.
         message: String,
     },
+}
+
+impl fmt::Debug for SimError {
+    /// The one-line message of `Display`, so that a `main` returning
+    /// `Result<(), Box<dyn std::error::Error>>` prints it as it is after `Error: `. The
+    /// fields stay public for a program that needs them.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(self, f)
+    }
 }
 
 impl SimError {

@@ -61,3 +61,14 @@ pub use parameters::{ParameterError, ParameterInfo};
 pub use settings::InvalidSetting;
 pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};
 pub use unilateral::ContactLaw;
+
+// Beside the type's definition in `simulate.rs` when that file is next changed; here (the
+// crate's root) it adds no edge between the modules.
+impl std::fmt::Debug for SimFailure {
+    /// The one-line message of `Display` (the samples reached and the error), not the
+    /// partial trajectory: what a `main` returning `Result<(), Box<dyn std::error::Error>>`
+    /// prints after `Error: `. The fields stay public for a program that needs them.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(self, f)
+    }
+}

@@ -23,6 +23,7 @@ use crate::stepping::{
     State, Stats, adaptive_step, add_counters_since, all_counters, finish_step,
     interpolate_last_step, load_state, rk4_step, validate_run,
 };
+use std::fmt;
 
 /// What a run reports of itself when its trajectory is not kept.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,13 +71,22 @@ pub struct MetricsOptions {
 }
 
 /// A metrics run that stopped early: the error and the metrics until then.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Clone, PartialEq, thiserror::Error)]
 #[error("simulation stopped at t = {} s: {error}", partial.t)]
 pub struct MetricsFailure {
     /// Why the run stopped.
     pub error: SimError,
     /// The metrics of the part that was computed.
     pub partial: RunMetrics,
+}
+
+impl fmt::Debug for MetricsFailure {
+    /// The one-line message of `Display`, so that a `main` returning
+    /// `Result<(), Box<dyn std::error::Error>>` prints it as it is after `Error: `. The
+    /// fields stay public for a program that needs them.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(self, f)
+    }
 }
 
 /// Running extremes.

@@ -32,7 +32,7 @@ pub struct ParameterInfo {
 
 /// A parameter value refused at run time, located in the model file like a build error:
 /// displayed as `file:line:column: field: message`.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Clone, PartialEq, Eq, thiserror::Error)]
 pub struct ParameterError {
     /// The model file, as the build showed it.
     pub file: String,
@@ -44,6 +44,15 @@ pub struct ParameterError {
     pub field: String,
     /// What is wrong.
     pub message: String,
+}
+
+impl fmt::Debug for ParameterError {
+    /// The one-line message of `Display`, so that a `main` returning
+    /// `Result<(), Box<dyn std::error::Error>>` prints it as it is after `Error: `. The
+    /// fields stay public for a program that needs them.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(self, f)
+    }
 }
 
 impl fmt::Display for ParameterError {
@@ -286,13 +295,22 @@ pub fn resolve(
 }
 
 /// A name that is not one of the model's run-time parameters.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{message}")]
 pub struct UnknownParameter {
     /// The name given.
     pub name: String,
     /// The explanation, listing the known names.
     pub message: String,
+}
+
+impl fmt::Debug for UnknownParameter {
+    /// The one-line message of `Display`, so that a `main` returning
+    /// `Result<(), Box<dyn std::error::Error>>` prints it as it is after `Error: `. The
+    /// fields stay public for a program that needs them.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(self, f)
+    }
 }
 
 #[cfg(test)]

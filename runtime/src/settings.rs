@@ -41,13 +41,22 @@ pub const MAX_STREAMED_SAMPLES: f64 = 1e9;
 pub const MAX_STEPS_PER_CALL: usize = 10_000_000;
 
 /// A setting that cannot be used, and why.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct InvalidSetting {
     /// The field of [`SimSettings`] at fault (`t_end`, `dt_out`, `dt`, `rtol`, `atol`), or
     /// `t_end/dt_out` for a sample count out of range.
     pub field: &'static str,
     /// What is wrong, with the value.
     pub message: String,
+}
+
+impl fmt::Debug for InvalidSetting {
+    /// The one-line message of `Display`, so that a `main` returning
+    /// `Result<(), Box<dyn std::error::Error>>` prints it as it is after `Error: `. The
+    /// fields stay public for a program that needs them.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(self, f)
+    }
 }
 
 impl fmt::Display for InvalidSetting {

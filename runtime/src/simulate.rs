@@ -41,7 +41,7 @@ pub struct Trajectory {
 }
 
 /// A simulation that stopped early: the error and everything computed until then.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Clone, PartialEq, thiserror::Error)]
 #[error("simulation stopped after {} samples: {error}", partial.sample_count)]
 pub struct SimFailure {
     /// Why the simulation stopped.

@@ -334,7 +334,13 @@ fn report_failure(
     let samples = trajectory.sample_count;
     match saved {
         Ok(Saved::Partial(path)) => eprintln!(
-            "{label}: the {samples} samples computed until then are in {}",
+            "{label}: {} computed until then {} in {}",
+            if samples == 1 {
+                "the sample"
+            } else {
+                "the samples"
+            },
+            if samples == 1 { "is" } else { "are" },
             path.display()
         ),
         Ok(_) => {}

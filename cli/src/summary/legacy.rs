@@ -220,7 +220,12 @@ pub fn render(report: &SliceReport) -> String {
     } = report;
     let mut text = String::new();
     let span = match (samples.first(), samples.last()) {
-        (Some(a), Some(b)) => format!("t = {} to {} s, {} samples", a.t, b.t, samples.len()),
+        (Some(a), Some(b)) => format!(
+            "t = {} to {} s, {}",
+            a.t,
+            b.t,
+            crate::counted(samples.len(), "sample")
+        ),
         _ => "no samples".into(),
     };
     let _ = writeln!(

@@ -168,7 +168,10 @@ pub fn render(report: &RunReport) -> String {
     } = report;
     let mut text = String::new();
     let span = match digest.span() {
-        Some((first, last)) => format!("t = {first} to {last} s, {} samples", digest.count()),
+        Some((first, last)) => format!(
+            "t = {first} to {last} s, {}",
+            crate::counted(digest.count(), "sample")
+        ),
         None => "no samples".into(),
     };
     let _ = writeln!(

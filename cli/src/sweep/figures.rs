@@ -7,7 +7,7 @@
 //!   parameter as points (`scatter.png`), runs without a value as crosses on the axis.
 
 use super::PlotData;
-use super::spec::{Design, Runs};
+use super::spec::{Design, Runs, Swept};
 use super::table::METRICS;
 use crate::plots::{Figure, HeatPanel, LinePanel, Panel, PointsPanel, Row, Series};
 use std::path::{Path, PathBuf};
@@ -55,7 +55,25 @@ fn label(metric: &str) -> String {
     }
 }
 
-/// The range of `values`, widened a little (and around a single value).
+/// `k [N/m]`: a swept parameter's axis, with its unit when the model declares one.
+fn axis(swept: &Swept) -> String {
+    if swept.unit.is_empty() {
+        swept.name.clone()
+    } else {
+        format!("{} [{}]", swept.name, swept.unit)
+    }
+}
+
+/// What a panel without a single value says: the metric is missing from every run.
+fn no_value(metric: &str) -> String {
+    match metric {
+        "first_lift_off" => "no lift-off in any run".to_string(),
+        _ => format!("no {metric} in any run"),
+    }
+}
+
+/// The range of `values`, widened a little (and around a single value); values that are
+/// all non-negative get no range below zero.
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
@@ -70,11 +88,17 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     } else {
         0.5
     };
-    (lo - pad, hi + pad)
+    let low = if lo >= 0.0 {
+        (lo - pad).max(0.0)
+    } else {
+        lo - pad
+    };
+    (low, hi + pad)
 }
 
 fn lines(model: &str, runs: &Runs, plot: &PlotData, k: usize) -> Figure {
     let name = &runs.swept[k].name;
+    let x_label = axis(&runs.swept[k]);
     let mut order: Vec<usize> = (0..plot.rows.len()).collect();
     order.sort_by(|&a, &b| plot.rows[a].0[k].total_cmp(&plot.rows[b].0[k]));
     let x_range = range(plot.rows.iter().map(|(v, _)| v[k]));
@@ -98,11 +122,16 @@ fn lines(model: &str, runs: &Runs, plot: &PlotData, k: usize) -> Figure {
                 series.push(current);
             }
             let y_range = range(series.iter().flatten().map(|p| p.1));
+            let title = if series.is_empty() {
+                format!("{metric} against {name}: {}", no_value(metric))
+            } else {
+                format!("{metric} against {name}")
+            };
             Row {
                 height: 300,
                 panels: vec![Panel::Lines(LinePanel {
-                    title: format!("{metric} against {name}"),
-                    x_label: name.clone(),
+                    title,
+                    x_label: x_label.clone(),
                     y_label: label(metric),
                     x_range,
                     y_range,
@@ -121,7 +150,10 @@ fn lines(model: &str, runs: &Runs, plot: &PlotData, k: usize) -> Figure {
         })
         .collect();
     Figure {
-        title: format!("{model}: sweep of {name} ({} runs)", plot.rows.len()),
+        title: format!(
+            "{model}: sweep of {name} ({})",
+            crate::counted(plot.rows.len(), "run")
+        ),
         width: 1100,
         rows,
     }
@@ -152,12 +184,13 @@ fn heat_maps(model: &str, runs: &Runs, plot: &PlotData, a: usize, b: usize) -> F
             }
             Panel::Heat(HeatPanel {
                 title: metric.clone(),
-                x_label: xa.clone(),
-                y_label: xb.clone(),
+                x_label: axis(&runs.swept[a]),
+                y_label: axis(&runs.swept[b]),
                 z_label: label(metric),
                 x: xs.clone(),
                 y: ys.clone(),
                 z,
+                empty: no_value(metric),
             })
         })
         .collect();
@@ -171,8 +204,8 @@ fn heat_maps(model: &str, runs: &Runs, plot: &PlotData, a: usize, b: usize) -> F
     }
     Figure {
         title: format!(
-            "{model}: sweep of {xa} and {xb} ({} runs; grey: no value)",
-            plot.rows.len()
+            "{model}: sweep of {xa} and {xb} ({}; grey: no value)",
+            crate::counted(plot.rows.len(), "run")
         ),
         width: 1400,
         rows,
@@ -205,9 +238,14 @@ fn scatter(model: &str, runs: &Runs, plot: &PlotData, varying: &[usize]) -> Figu
                         .filter(|(_, ms)| ms[m].is_none())
                         .map(|(v, _)| v[k])
                         .collect();
+                    let title = if points.is_empty() {
+                        format!("{metric} against {name}: {}", no_value(metric))
+                    } else {
+                        format!("{metric} against {name}")
+                    };
                     Panel::Points(PointsPanel {
-                        title: format!("{metric} against {name}"),
-                        x_label: name.clone(),
+                        title,
+                        x_label: axis(&runs.swept[k]),
                         y_label: label(metric),
                         x_range: range(plot.rows.iter().map(|(v, _)| v[k])),
                         y_range: range(points.iter().map(|p| p.1)),
@@ -223,7 +261,10 @@ fn scatter(model: &str, runs: &Runs, plot: &PlotData, varying: &[usize]) -> Figu
         })
         .collect();
     Figure {
-        title: format!("{model}: sweep ({} runs)", plot.rows.len()),
+        title: format!(
+            "{model}: sweep ({})",
+            crate::counted(plot.rows.len(), "run")
+        ),
         width: 550 * params.len().max(1) as u32,
         rows,
     }

@@ -340,7 +340,16 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
         })
         .collect();
     let bytes = sizes.as_ref().map(|s| s.iter().sum());
-    let (sweep, mut shards) = open_all(&args.files, bytes).map_err(failed)?;
+    let (mut sweep, mut shards) = open_all(&args.files, bytes).map_err(failed)?;
+    // The shards do not record units: a built-in model's declarations give them (a model
+    // file's figures have plain parameter names on their axes).
+    if let Some(model) = camchain_models::by_name(&sweep.model) {
+        for s in &mut sweep.runs.swept {
+            if let Some(p) = model.info().parameters.iter().find(|p| p.name == s.name) {
+                s.unit.clone_from(&p.unit);
+            }
+        }
+    }
     if bytes.is_some() {
         read_rows(&sweep, &mut shards, &mut io::sink(), None).map_err(failed)?;
         shards = reopen(&sweep, &shards).map_err(failed)?;
@@ -374,9 +383,9 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
     };
     if !args.quiet {
         let mut text = format!(
-            "merged {} shards of the sweep of {model}: {} runs, {} failed\n",
-            sweep.count,
-            sweep.total(),
+            "merged {} of the sweep of {model}: {}, {} failed\n",
+            crate::counted(sweep.count, "shard"),
+            crate::counted(sweep.total(), "run"),
             read.failed
         );
         if let Some(path) = &csv {

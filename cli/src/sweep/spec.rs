@@ -33,6 +33,9 @@ pub struct Swept {
     pub spec: String,
     /// Its values.
     pub values: Values,
+    /// Its unit as the model declares it (`N/m`; empty when it declares none or the model
+    /// is not known, as for `merge` of a model file), for the figures' axes.
+    pub unit: String,
 }
 
 impl Swept {
@@ -64,6 +67,7 @@ pub fn parse_param(text: &str) -> Result<Swept, String> {
         name: name.to_string(),
         spec: spec.split_whitespace().collect(),
         values,
+        unit: String::new(),
     })
 }
 

@@ -600,3 +600,24 @@ fn bad_options_and_files_name_the_flag_and_the_problem() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     assert!(!dir.join("out").exists(), "nothing ran");
 }
+
+/// `--help`'s first line says what the tool does now: cam mechanisms from model files with
+/// their kinds of follower and cam, not only a tip sliding on a fixed cam.
+#[test]
+fn help_first_line_describes_the_tool_of_today() {
+    let dir = scratch("help-first-line");
+    let out = camchain(&dir, &["--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    let help = text(&out.stdout);
+    let first = help.lines().next().unwrap_or_default();
+    assert!(!first.contains("fixed cam"), "{first}");
+    for kind in [
+        "model files",
+        "closed loops",
+        "roller",
+        "flat",
+        "moving cams",
+    ] {
+        assert!(first.contains(kind), "{kind} missing from: {first}");
+    }
+}

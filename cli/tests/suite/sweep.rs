@@ -189,6 +189,9 @@ fn shards_merge_into_the_unsharded_sweep() {
     );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(dir.join("figs/heatmaps.png").exists());
+    // merge knows a built-in model's units too.
+    let svg = std::fs::read_to_string(dir.join("figs/heatmaps.svg")).expect("the SVG");
+    assert!(svg.contains("swing [rad]") && svg.contains("c3 [N s/m]"));
     let (h1, whole) = rows(&dir.join("whole.csv"));
     let (h2, merged) = rows(&dir.join("merged.csv"));
     assert_eq!(h1, h2);
@@ -492,7 +495,13 @@ fn simulate_takes_parameter_values_checked_as_the_file() {
             2,
             "parameter `l1` is constant (folded into the generated code)",
         ),
-        ("foo=1", 2, "unknown parameter `foo`; known: J1, J2"),
+        // Only the parameters `--param` can set are listed, not those folded into the code.
+        (
+            "foo=1",
+            2,
+            "unknown parameter `foo`; the parameters that can be set: c2, c3, c4, k2, k3, k4, \
+             swing",
+        ),
         ("k3", 2, "is not NAME=VALUE"),
     ] {
         let out = camchain(
@@ -588,4 +597,76 @@ fn ctrl_c_keeps_the_rows_so_far_and_an_older_result_as_it_was() {
     for (k, row) in rows.iter().enumerate() {
         assert_eq!(row[0], k.to_string(), "rows in run order, none missing");
     }
+}
+
+/// The heat maps' axes name the swept parameters with their units (docs/model-format.md
+/// promises them), and a metric no run has (no lift-off on the concave cam, whose contact
+/// stays compressive) says so in its panel instead of an all-grey map with a 0–1 colour bar.
+#[test]
+fn heat_map_axes_have_units_and_an_empty_metric_says_so() {
+    let dir = scratch("sweep-heat-units");
+    let out = camchain(
+        &dir,
+        &[
+            "sweep",
+            "paper_concave",
+            "--param",
+            "swing=0.05,0.1",
+            "--param",
+            "c3=0,1",
+            "--metric",
+            "max_normal_force",
+            "--metric",
+            "first_lift_off",
+            "--t-end",
+            "0.3",
+            "--out",
+            "figs",
+            "-q",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let svg = std::fs::read_to_string(dir.join("figs/paper_concave_sweep/heatmaps.svg"))
+        .expect("the SVG");
+    assert!(svg.contains("swing [rad]"), "no unit on the swing axis");
+    assert!(svg.contains("c3 [N s/m]"), "no unit on the c3 axis");
+    assert!(svg.contains("no lift-off in any run"));
+    // c3 swept over 0 and 1 (a damping, never negative): no tick below zero on its axis.
+    assert!(
+        !svg.contains(">-0.2<") && !svg.contains(">-0.4<"),
+        "an axis below zero"
+    );
+}
+
+/// A count of one is singular wherever the sweep prints counts: `1 run`, `1 worker`.
+#[test]
+fn a_sweep_of_one_run_says_1_run() {
+    let dir = scratch("sweep-one-run");
+    let out = camchain(
+        &dir,
+        &[
+            "sweep",
+            "paper_concave",
+            "--param",
+            "swing=0.1",
+            "--t-end",
+            "0.2",
+            "--jobs",
+            "1",
+            "--csv",
+            "one.csv",
+        ],
+    );
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(stdout.contains("1 run "), "{stdout}");
+    assert!(stdout.contains("1 worker"), "{stdout}");
+    // No count of one followed by a plural (`1851 runs/s` is a rate, not a count of one).
+    let words: Vec<&str> = stdout.split_whitespace().collect();
+    assert!(
+        !words
+            .windows(2)
+            .any(|w| w[0] == "1" && (w[1].starts_with("runs") || w[1].starts_with("workers"))),
+        "{stdout}"
+    );
 }

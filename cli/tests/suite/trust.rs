@@ -355,7 +355,7 @@ fn a_model_file_gets_the_same_located_diagnoses_as_the_build() {
                 "hold: [\"q1\", \"q2\", \"q4\"]",
                 "hold: [\"q1\", \"q2\", \"q3\", \"q4\"]",
             ),
-            "1 contacts need one coordinate each that is neither held nor driven, and 0 are free",
+            "1 contact needs a coordinate that is neither held nor driven, and 0 are free",
         ),
         (
             "slider_out_of_plane",

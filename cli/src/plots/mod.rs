@@ -6,6 +6,14 @@
 //! bitmap backend and encoded with `png`). Text is laid out and rasterised by ab_glyph from
 //! DejaVu Sans embedded in the binary, so no system font or font library is needed.
 
+mod heat;
+mod legend;
+mod mechanism;
+
+use heat::draw_heat;
+use mechanism::draw_mechanism;
+pub use mechanism::time_color;
+
 use super::kinematics::CamPicture;
 use camchain_codegen::profile::Scalar;
 use plotters::coord::Shift;
@@ -102,6 +110,9 @@ pub struct HeatPanel {
     pub y: Vec<f64>,
     /// `z[i][j]` at (x[i], y[j]); `None` where the run failed or has no value (drawn grey).
     pub z: Vec<Vec<Option<f64>>>,
+    /// What the panel says, in place of a colour bar, when no cell has a value (`no lift-off
+    /// in any run`).
+    pub empty: String,
 }
 
 /// Points on one pair of axes.
@@ -377,9 +388,10 @@ fn draw_lines<DB: DrawingBackend>(
         }
     }
     if legend {
+        let corner = legend::corner(p, chart.plotting_area().dim_in_pixel());
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(NEUTRAL)
             .label_font((FONT, LEGEND_SIZE))
@@ -457,113 +469,6 @@ fn plain_chart<'a, DB: DrawingBackend>(
     }
     mesh.draw()?;
     Ok(chart)
-}
-
-/// The cell edges around increasing grid values: midway between neighbours, half a gap
-/// beyond the ends (a single value gets ±5 % of itself, or ±0.5).
-fn cell_edges(values: &[f64]) -> Vec<f64> {
-    match values {
-        [] => vec![0.0, 1.0],
-        [v] => {
-            let half = if *v == 0.0 { 0.5 } else { 0.05 * v.abs() };
-            vec![v - half, v + half]
-        }
-        _ => {
-            let n = values.len();
-            let mut edges = Vec::with_capacity(n + 1);
-            edges.push(values[0] - 0.5 * (values[1] - values[0]));
-            edges.extend(values.windows(2).map(|w| 0.5 * (w[0] + w[1])));
-            edges.push(values[n - 1] + 0.5 * (values[n - 1] - values[n - 2]));
-            edges
-        }
-    }
-}
-
-/// The viridis colour map over [0, 1].
-pub fn viridis(f: f64) -> RGBColor {
-    const STOPS: [[f64; 3]; 5] = [
-        [68.0, 1.0, 84.0],
-        [59.0, 82.0, 139.0],
-        [33.0, 145.0, 140.0],
-        [94.0, 201.0, 98.0],
-        [253.0, 231.0, 37.0],
-    ];
-    let x = 4.0
-        * if f.is_finite() {
-            f.clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-    let i = (x.floor() as usize).min(3);
-    let u = x - i as f64;
-    let mix = |k: usize| (STOPS[i][k] + u * (STOPS[i + 1][k] - STOPS[i][k])).round() as u8;
-    RGBColor(mix(0), mix(1), mix(2))
-}
-
-fn draw_heat<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    p: &HeatPanel,
-) -> Result<(), PlotError> {
-    let area = caption(area, &p.title)?;
-    let (w, _) = area.dim_in_pixel();
-    let (map, bar) = area.split_horizontally(w.saturating_sub(130));
-    let (xe, ye) = (cell_edges(&p.x), cell_edges(&p.y));
-    let (x0, x1) = (xe[0], xe[xe.len() - 1]);
-    let (y0, y1) = (ye[0], ye[ye.len() - 1]);
-    let values: Vec<f64> = p.z.iter().flatten().flatten().copied().collect();
-    let (lo, hi) = values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    let (lo, hi) = if lo.is_finite() && hi > lo {
-        (lo, hi)
-    } else if lo.is_finite() {
-        (lo - 0.5, lo + 0.5)
-    } else {
-        (0.0, 1.0)
-    };
-    let labels = (p.x_label.as_str(), p.y_label.as_str());
-    let mut chart = plain_chart(&map, labels, (x0, x1), (y0, y1), false)?;
-    let mut cells = Vec::new();
-    for (i, column) in p.z.iter().enumerate() {
-        for (j, z) in column.iter().enumerate() {
-            let color = match z {
-                Some(v) => viridis((v - lo) / (hi - lo)).filled(),
-                None => GRID_BOLD.filled(),
-            };
-            cells.push(Rectangle::new(
-                [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
-                color,
-            ));
-        }
-    }
-    chart.draw_series(cells)?;
-    let (power, z_label) = scaled_axis((lo, hi), &p.z_label);
-    let scale = 10f64.powi(-power);
-    let mut legend = ChartBuilder::on(&bar)
-        .margin(MARGIN)
-        .margin_left(4)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(0)
-        .right_y_label_area_size(90)
-        .build_cartesian_2d(0.0..1.0, (lo * scale)..(hi * scale))?
-        .set_secondary_coord(0.0..1.0, (lo * scale)..(hi * scale));
-    let z_format = tick_format((lo * scale, hi * scale));
-    legend
-        .configure_secondary_axes()
-        .y_desc(z_label.as_str())
-        .y_label_formatter(&z_format)
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_SIZE))
-        .draw()?;
-    let steps = 64;
-    legend.draw_series((0..steps).map(|k| {
-        let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
-        let (za, zb) = ((lo + a * (hi - lo)) * scale, (lo + b * (hi - lo)) * scale);
-        Rectangle::new([(0.0, za), (1.0, zb)], viridis(a).filled())
-    }))?;
-    Ok(())
 }
 
 fn draw_points<DB: DrawingBackend>(
@@ -649,182 +554,6 @@ fn decimate(points: &[(f64, f64)], (x0, x1): (f64, f64), buckets: usize) -> Vec<
     kept
 }
 
-/// Widens `bounds` (with a small border) so that one metre has the same length in pixels
-/// on both axes of a `width` × `height` plotting area.
-fn equal_scales(
-    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
-    (width, height): (u32, u32),
-) -> ((f64, f64), (f64, f64)) {
-    let border = 0.05 * (x1 - x0).max(y1 - y0).max(1e-3);
-    let (x0, x1, y0, y1) = (x0 - border, x1 + border, y0 - border, y1 + border);
-    let (w, h) = (f64::from(width.max(1)), f64::from(height.max(1)));
-    let scale = ((x1 - x0) / w).max((y1 - y0) / h);
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let (half_w, half_h) = (0.5 * scale * w, 0.5 * scale * h);
-    ((cx - half_w, cx + half_w), (cy - half_h, cy + half_h))
-}
-
-fn draw_mechanism<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    p: &MechanismPanel,
-) -> Result<(), PlotError> {
-    let area = caption(area, &p.title)?;
-    let (w, h) = area.dim_in_pixel();
-    let legend_width = if p.legend { LEGEND_COLUMN } else { 0 };
-    let (area, legend_area) = area.split_horizontally(w.saturating_sub(legend_width));
-    let plot = (
-        w.saturating_sub(legend_width + Y_LABEL_AREA + 2 * MARGIN),
-        h.saturating_sub(X_LABEL_AREA + 2 * MARGIN),
-    );
-    let ((x0, x1), (y0, y1)) = equal_scales(p.bounds, plot);
-    let labels = (p.x_label.as_str(), p.y_label.as_str());
-    let mut chart = plain_chart(&area, labels, (x0, x1), (y0, y1), true)?;
-    if let Some(profile) = &p.cam {
-        let curve: Vec<(f64, f64)> = (0..=PROFILE_POINTS)
-            .map(|i| x0 + (x1 - x0) * i as f64 / PROFILE_POINTS as f64)
-            .map(|x| (x, profile.eval(x)))
-            .filter(|(_, y)| y.is_finite())
-            .map(|(x, y)| (x, y.clamp(y0, y1)))
-            .collect();
-        let mut outline = curve.clone();
-        outline.extend([(x1, y0), (x0, y0)]);
-        chart.draw_series(std::iter::once(Polygon::new(outline, CAM_FILL.filled())))?;
-        chart.draw_series(LineSeries::new(curve, CAM_EDGE.stroke_width(2)))?;
-    }
-    for frame in &p.frames {
-        for cam in &frame.cams {
-            draw_cam(&mut chart, cam, frame.color)?;
-        }
-    }
-    for frame in &p.frames {
-        draw_frame(&mut chart, frame)?;
-    }
-    if p.legend {
-        draw_time_legend(&legend_area, p)?;
-    }
-    Ok(())
-}
-
-/// A cam where its body carries it (material filled, profile edge, base circle thin, centre
-/// as a small cross) and its follower's roller or flat face in the snapshot's colour.
-fn draw_cam<DB: DrawingBackend>(
-    chart: &mut Chart<'_, DB>,
-    cam: &CamPicture,
-    color: RGBColor,
-) -> Result<(), PlotError> {
-    if !cam.material.is_empty() {
-        chart.draw_series(std::iter::once(Polygon::new(
-            cam.material.clone(),
-            CAM_FILL.filled(),
-        )))?;
-    }
-    if cam.closed {
-        chart.draw_series(std::iter::once(Polygon::new(
-            cam.outline.clone(),
-            CAM_FILL.filled(),
-        )))?;
-    }
-    if !cam.outline.is_empty() {
-        let mut edge = cam.outline.clone();
-        if cam.closed {
-            edge.push(cam.outline[0]);
-        }
-        chart.draw_series(LineSeries::new(edge, CAM_EDGE.stroke_width(2)))?;
-    }
-    if !cam.base_circle.is_empty() {
-        chart.draw_series(LineSeries::new(
-            cam.base_circle.clone(),
-            NEUTRAL.stroke_width(1),
-        ))?;
-    }
-    if cam.centre.0.is_finite() && cam.centre.1.is_finite() {
-        chart.draw_series(std::iter::once(Cross::new(
-            cam.centre,
-            4,
-            CAM_EDGE.stroke_width(1),
-        )))?;
-    }
-    if !cam.roller.is_empty() {
-        chart.draw_series(LineSeries::new(cam.roller.clone(), color.stroke_width(2)))?;
-    }
-    if !cam.face.is_empty() {
-        chart.draw_series(LineSeries::new(cam.face.clone(), color.stroke_width(3)))?;
-    }
-    Ok(())
-}
-
-/// The legend of a snapshot panel, beside the chart: the cam, then one line per snapshot.
-fn draw_time_legend<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    p: &MechanismPanel,
-) -> Result<(), PlotError> {
-    let font = (FONT, LEGEND_SIZE).into_font();
-    let row = |i: usize| (MARGIN + 10 + 24 * i as u32) as i32;
-    let mut entries = 0;
-    let moving_cam = p
-        .frames
-        .iter()
-        .any(|f| f.cams.iter().any(|c| !c.outline.is_empty()));
-    if p.cam.is_some() || moving_cam {
-        let y = row(0);
-        area.draw(&Rectangle::new(
-            [(4, y - 7), (28, y + 7)],
-            CAM_FILL.filled(),
-        ))?;
-        area.draw(&PathElement::new(
-            [(4, y - 7), (28, y - 7)],
-            CAM_EDGE.stroke_width(2),
-        ))?;
-        area.draw(&Text::new("cam", (36, y - 8), font.clone()))?;
-        entries = 1;
-    }
-    for (i, frame) in p.frames.iter().enumerate() {
-        let y = row(entries + i);
-        area.draw(&PathElement::new(
-            [(4, y), (28, y)],
-            frame.color.stroke_width(3),
-        ))?;
-        area.draw(&Text::new(frame.label.as_str(), (36, y - 8), font.clone()))?;
-    }
-    if p.frames.iter().any(|f| !f.coms.is_empty()) {
-        let y = row(entries + p.frames.len());
-        area.draw(&Cross::new((16, y), 6, BLACK.stroke_width(2)))?;
-        area.draw(&Text::new("centre of mass", (36, y - 8), font))?;
-    }
-    Ok(())
-}
-
-fn draw_frame<DB: DrawingBackend>(
-    chart: &mut Chart<'_, DB>,
-    frame: &Frame,
-) -> Result<(), PlotError> {
-    let link = frame.color.stroke_width(3);
-    chart.draw_series(frame.links.iter().map(|l| PathElement::new(*l, link)))?;
-    let ring = frame.color.stroke_width(2);
-    chart.draw_series(
-        frame
-            .joints
-            .iter()
-            .map(|j| Circle::new(*j, 4, WHITE.filled())),
-    )?;
-    chart.draw_series(frame.joints.iter().map(|j| Circle::new(*j, 4, ring)))?;
-    chart.draw_series(
-        frame
-            .bases
-            .iter()
-            .map(|b| TriangleMarker::new(*b, 9, BLACK.filled())),
-    )?;
-    chart.draw_series(
-        frame
-            .tips
-            .iter()
-            .map(|t| Circle::new(*t, 5, frame.color.filled())),
-    )?;
-    let cross = frame.color.stroke_width(2);
-    chart.draw_series(frame.coms.iter().map(|c| Cross::new(*c, 6, cross)))?;
-    Ok(())
-}
-
 fn draw_message<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     text: &str,
@@ -838,24 +567,6 @@ fn draw_message<DB: DrawingBackend>(
         ));
     area.draw_text(text, &style, ((w / 2) as i32, (h / 2) as i32))?;
     Ok(())
-}
-
-/// A colour for fraction `f` ∈ [0, 1] of a run (viridis from dark purple to green, its
-/// pale yellow end left out so that every snapshot shows on white).
-pub fn time_color(f: f64) -> RGBColor {
-    const STOPS: [(f64, [f64; 3]); 5] = [
-        (0.0, [68.0, 1.0, 84.0]),
-        (0.25, [59.0, 82.0, 139.0]),
-        (0.5, [33.0, 145.0, 140.0]),
-        (0.75, [94.0, 201.0, 98.0]),
-        (1.0, [253.0, 231.0, 37.0]),
-    ];
-    let x = 0.8 * f.clamp(0.0, 1.0);
-    let i = STOPS.iter().rposition(|(s, _)| *s <= x).unwrap_or(0).min(3);
-    let ((s0, c0), (s1, c1)) = (STOPS[i], STOPS[i + 1]);
-    let u = (x - s0) / (s1 - s0);
-    let mix = |k: usize| (c0[k] + u * (c1[k] - c0[k])).round() as u8;
-    RGBColor(mix(0), mix(1), mix(2))
 }
 
 #[cfg(test)]
@@ -894,18 +605,5 @@ mod tests {
         assert_eq!(kept.first(), points.first());
         assert_eq!(kept.last(), points.last());
         assert!(kept.windows(2).all(|w| w[0].0 < w[1].0));
-    }
-
-    #[test]
-    fn equal_scales_keep_the_bounds_visible() {
-        let ((x0, x1), (y0, y1)) = equal_scales(((0.0, 1.0), (0.0, 0.2)), (800, 400));
-        assert!(x0 < 0.0 && x1 > 1.0 && y0 < 0.0 && y1 > 0.2);
-        assert!(((x1 - x0) / 800.0 - (y1 - y0) / 400.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn time_colours_run_from_purple_to_green() {
-        assert_eq!(time_color(0.0), RGBColor(68, 1, 84));
-        assert_eq!(time_color(2.0), time_color(1.0));
     }
 }
