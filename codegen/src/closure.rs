@@ -19,7 +19,7 @@
 use crate::contact::relative::{Labels, PointMotion, point_motion};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
-use crate::model::{ClosurePoint, Field, JointKind, LoopKind, Model};
+use crate::model::{ClosurePoint, Field, JointKind, LoopKind, Model, normal_pair};
 
 /// One scalar equation of a loop: h, J, c.
 #[derive(Debug, Clone)]
@@ -173,27 +173,6 @@ impl Carried {
         let bias = g.add(bias, last);
         Row { h, jacobian, bias }
     }
-}
-
-/// Two unit vectors spanning the plane normal to the unit vector `a`.
-pub fn normal_pair(a: [f64; 3]) -> [[f64; 3]; 2] {
-    // Start from the ground axis least aligned with a.
-    let k = (0..3)
-        .min_by(|&i, &j| a[i].abs().total_cmp(&a[j].abs()))
-        .unwrap_or(0);
-    let mut e = [0.0; 3];
-    e[k] = 1.0;
-    let cross = |x: [f64; 3], y: [f64; 3]| {
-        [
-            x[1] * y[2] - x[2] * y[1],
-            x[2] * y[0] - x[0] * y[2],
-            x[0] * y[1] - x[1] * y[0],
-        ]
-    };
-    let first = cross(a, e);
-    let norm = first.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let first = first.map(|x| x / norm);
-    [first, cross(a, first)]
 }
 
 /// Derives every loop of `model`.

@@ -21,17 +21,16 @@ pub mod assembly;
 pub mod closure;
 pub mod contact;
 pub mod derive;
-pub mod design;
 pub mod dynamics;
 pub mod emit;
-pub mod error;
 pub mod expr;
 pub mod kinematics;
 pub mod linear;
 pub mod lint;
-pub mod model;
-pub mod profile;
-pub mod schema;
+
+// The model file and the validated model live in `camchain-model` (shared with the numeric
+// reference); their paths stay available here.
+pub use camchain_model::{design, error, model, profile, read_model_file, schema};
 
 pub use derive::Derivation;
 pub use error::ModelError;
@@ -50,19 +49,6 @@ use std::path::Path;
 pub fn generate_file(path: &Path, display: &Path) -> Result<Generated, ModelError> {
     let source = read_model_file(path, display)?;
     generate_source(&source, display, &EmitOptions::default())
-}
-
-/// Reads a model file of at most [`schema::MAX_FILE_BYTES`] ([`schema::read_text`]: a longer
-/// regular file is refused unread, a device without end once it has given that much); a
-/// failure is a [`ModelError`] on `display` (line 0: not located).
-pub fn read_model_file(path: &Path, display: &Path) -> Result<String, ModelError> {
-    schema::read_text(path).map_err(|e| ModelError {
-        file: display.to_path_buf(),
-        line: 0,
-        column: 0,
-        field: String::new(),
-        message: format!("cannot read the file: {e}"),
-    })
 }
 
 /// Everything the build checks of a model file before it generates code: parsing and

@@ -6,8 +6,8 @@
 //! rule: J_j = Ẋ(e_j)·Y + X·Ẏ(e_j), c = Ẍ°·Y + 2 Ẋ·Ẏ + X·Ÿ°.
 
 use crate::motion::{Motion, Pose, Vec3, vec3};
-use camchain_codegen::closure::normal_pair;
-use camchain_codegen::model::{Closure, LoopKind};
+use camchain_model::model::normal_pair;
+use camchain_model::model::{Closure, LoopKind};
 
 /// A vector of a loop: a point or a direction carried by a body (`None`: the ground), or
 /// the gap between the loop's two points.

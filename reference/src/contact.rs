@@ -16,7 +16,7 @@
 use crate::jet::Jet2;
 use crate::motion::{Motion, Pose, Vec3, vec3};
 use crate::tape::Tape;
-use camchain_codegen::model::{Contact, Follower, JointKind, Model, Profile};
+use camchain_model::model::{Contact, Follower, JointKind, Model, Profile};
 use camchain_runtime::kinds::Outline;
 use camchain_runtime::{ContactGeometry, ContactKinematics};
 

@@ -21,9 +21,9 @@ use crate::closure::{ClosureConst, ClosureEval};
 use crate::contact::{ContactConst, Evaluated};
 use crate::jet::{eval_jet, eval_with};
 use crate::motion::{Mat3, Motion, Pose, Vec3, vec3};
-use camchain_codegen::ModelError;
-use camchain_codegen::model::{Body, Closure, Contact, JointKind, Model, ParameterMode, Profile};
-use camchain_codegen::schema::{Files, load_model, parse_model_from};
+use camchain_model::ModelError;
+use camchain_model::model::{Body, Closure, Contact, JointKind, Model, ParameterMode, Profile};
+use camchain_model::schema::{Files, load_model, parse_model_from};
 use camchain_runtime::{
     ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
     Energy, InitialGuess, LoopInfo, ModelInfo, ParameterInfo, ProfileKind, SimSettings,
@@ -235,7 +235,7 @@ pub struct NumericModel {
 }
 
 impl NumericModel {
-    /// Wraps a validated model (as produced by [`camchain_codegen::schema`]: parents listed
+    /// Wraps a validated model (as produced by [`camchain_model::schema`]: parents listed
     /// before children, unit axes, marker and body indices in range).
     ///
     /// # Panics
@@ -275,7 +275,7 @@ impl NumericModel {
         overrides: &[(String, f64)],
         mode: ParameterMode,
     ) -> Result<Self, ModelError> {
-        let source = camchain_codegen::read_model_file(path, path)?;
+        let source = camchain_model::read_model_file(path, path)?;
         Self::from_source_with(&source, path, overrides, mode)
     }
 
@@ -583,10 +583,10 @@ impl Dynamics for NumericModel {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use camchain_codegen::model::{
+    use camchain_model::model::{
         Follower, Initial, Joint, Marker, Prescribed, Simulation, SpringDamper,
     };
-    use camchain_codegen::profile::{Func, Scalar};
+    use camchain_model::profile::{Func, Scalar};
     use camchain_runtime::IntegratorKind;
     use nalgebra::DMatrix;
     use std::f64::consts::PI;

@@ -21,7 +21,7 @@
 //! Built splines are kept per function (by identity) on each thread, so a profile's table is
 //! solved once, not at every evaluation.
 
-use camchain_codegen::profile::{Tabulated, TabulatedFunction};
+use camchain_model::profile::{Tabulated, TabulatedFunction};
 use camchain_runtime::spline::{Ends, Spline};
 use std::cell::RefCell;
 use std::sync::Arc;

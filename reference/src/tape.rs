@@ -13,7 +13,7 @@
 //! those of the trees.
 
 use crate::jet::Jet2;
-use camchain_codegen::profile::{Func, Scalar, Tabulated};
+use camchain_model::profile::{Func, Scalar, Tabulated};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -187,7 +187,7 @@ impl Builder {
 mod tests {
     use super::*;
     use crate::jet::{eval_on, eval_with};
-    use camchain_codegen::profile::parse_expression;
+    use camchain_model::profile::parse_expression;
 
     /// The tape gives the trees' values bit for bit (the same operations on the same
     /// operands), and merges what repeats.

@@ -46,8 +46,18 @@ const FORBIDDEN: &[&str] = &[
 
 /// Package names in `cargo tree -p <package> -e <edges>` (offline: the lock file decides).
 fn tree(package: &str, edges: &str) -> BTreeSet<String> {
-    let output = Command::new(env!("CARGO"))
-        .args(["tree", "--offline", "-p", package, "-e", edges])
+    tree_with(package, edges, &[])
+}
+
+/// [`tree`] with `features` of the package on.
+fn tree_with(package: &str, edges: &str, features: &[&str]) -> BTreeSet<String> {
+    let features = features.join(",");
+    let mut command = Command::new(env!("CARGO"));
+    command.args(["tree", "--offline", "-p", package, "-e", edges]);
+    if !features.is_empty() {
+        command.args(["--features", &features]);
+    }
+    let output = command
         .args(["--prefix", "none", "--format", "{p}"])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
@@ -95,4 +105,30 @@ fn no_code_generator_parser_or_command_line_dependency_reaches_a_program() {
             .collect();
         assert!(found.is_empty(), "{package} depends on {found:?}");
     }
+}
+
+/// What the reference adds to a program (the facade's `reference` feature): itself and the
+/// model crate with the model file's parser (ron, serde, and syn for profile expressions),
+/// never the emitter (camchain-codegen, prettyplease): 27 crates where the emitter's 28
+/// stood (`camchain-codegen` and `prettyplease` out, `camchain-model` in).
+#[test]
+fn the_reference_feature_adds_the_model_file_but_no_emitter() {
+    let linked = tree_with("camchain", "normal,no-proc-macro", &["reference"]);
+    let model_file = [
+        "camchain",
+        "camchain-runtime",
+        "camchain-reference",
+        "camchain-model",
+        "ron",
+        "serde",
+        "serde_core",
+        "bitflags",
+        "typeid",
+        "unicode-ident",
+        "syn",
+        "quote",
+        "proc-macro2",
+    ];
+    assert_eq!(linked, expected(&model_file));
+    assert_eq!(linked.len(), 27);
 }

@@ -200,3 +200,39 @@ fn functions_called_per_step_do_not_allocate() {
         }
     }
 }
+
+/// A model name that is no Rust identifier runs on the numeric path (the schema's tests) but
+/// names no module: the build refuses it, at the `name` field when the file gives one (its
+/// line) and unlocated when the name comes from the file's stem.
+#[test]
+fn the_build_refuses_a_model_name_that_names_no_module() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let text = std::fs::read_to_string(dir.join("double_pendulum.ron")).expect("the model");
+    let options = camchain_codegen::EmitOptions::default();
+    let keyword = text.replace("name: \"double_pendulum\"", "name: \"fn\"");
+    assert_ne!(keyword, text, "the edit applies");
+    let line = 1 + keyword
+        .lines()
+        .position(|l| l.contains("name: \"fn\""))
+        .expect("the name's line");
+    let path = std::path::Path::new("models/double_pendulum.ron");
+    let e = match camchain_codegen::generate_source(&keyword, path, &options) {
+        Ok(_) => panic!("`fn` names no module"),
+        Err(e) => e,
+    };
+    assert_eq!((e.field.as_str(), e.line), ("name", line), "{e}");
+    assert!(e.message.contains("not a valid Rust identifier"), "{e}");
+
+    let unnamed: String = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("name: \"double_pendulum\""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let stem = std::path::Path::new("dir/some chain-v2.ron");
+    let e = match camchain_codegen::generate_source(&unnamed, stem, &options) {
+        Ok(_) => panic!("`some chain-v2` names no module"),
+        Err(e) => e,
+    };
+    assert_eq!((e.field.as_str(), e.line), ("name", 0));
+    assert!(e.message.contains("some chain-v2"), "{e}");
+}

@@ -521,8 +521,7 @@ impl CamDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::curve::{Frame, curve, frame};
-    use crate::expr::Graph;
+    use crate::samples::curvature;
     use crate::model::Profile;
     use camchain_runtime::motion_law::{Law, Segment};
 
@@ -624,8 +623,9 @@ mod tests {
     }
 
     /// The closed-form radius of curvature (the module's formulas) against the curvature of
-    /// the profile's expressions, differentiated symbolically by the graph and evaluated by
-    /// its interpreter (an independent route: nothing of the radii's derivation is used),
+    /// the profile's expressions, differentiated in forward mode (`crate::jet`, through
+    /// `crate::samples::curvature`: an independent route, nothing of the radii's derivation
+    /// is used),
     /// at 90 cam angles for every follower kind. Both are exact; they differ by the rounding
     /// of second derivatives of the envelope (relative 1e-9 leaves a wide margin over the
     /// measured 1e-12 while any wrong term would be off at O(1)).
@@ -658,10 +658,6 @@ mod tests {
                 x: x.clone(),
                 y: y.clone(),
             };
-            let mut graph = Graph::new();
-            let u = graph.var("u");
-            let c = curve(&mut graph, &profile, &x, Some(&y), "t", u, &[]);
-            let Frame { curvature, .. } = frame(&mut graph, &c, -1.0);
             let mut worst = 0.0f64;
             for k in 0..90 {
                 let theta = std::f64::consts::TAU * (k as f64 + 0.3) / 90.0;
@@ -676,18 +672,18 @@ mod tests {
                 );
                 // Curvature positive where hollow seen from the follower: a convex radius
                 // R is a curvature −1/R.
-                let kappa = graph.eval(&[curvature], &[u0])[0];
+                let kappa = curvature(&profile, u0);
                 let radius = -1.0 / kappa;
                 let error = (radius - at.radius_of_curvature).abs() / at.radius_of_curvature.abs();
                 worst = worst.max(error);
                 assert!(
                     error < 1e-9,
-                    "{what}: θ = {:.2}°: closed form {} vs the graph's {radius}",
+                    "{what}: θ = {:.2}°: closed form {} vs the profile's {radius}",
                     theta.to_degrees(),
                     at.radius_of_curvature
                 );
             }
-            eprintln!("{what}: radius of curvature, closed form against the graph: {worst:.1e}");
+            eprintln!("{what}: radius of curvature, closed form against the profile's: {worst:.1e}");
         }
     }
 }

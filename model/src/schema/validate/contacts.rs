@@ -8,7 +8,7 @@ use super::fields::{finite, identifier, lookup, unit_vector};
 use super::markers::cam_axes;
 use super::parameters::expression;
 use super::{Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile};
-use crate::contact::curve::profile_samples;
+use crate::samples::profile_samples;
 use crate::model::{Body, Contact, JointKind, RuntimeCheck};
 use crate::schema::raw;
 use camchain_runtime::contact::{

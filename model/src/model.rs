@@ -638,3 +638,26 @@ impl Model {
             .filter(|(_, p)| !p.constant)
     }
 }
+
+/// Two unit vectors spanning the plane normal to the unit vector `a`: the directions of a
+/// spatial loop's `normal_1` and `normal_2` equations, one convention for the derivation and
+/// the reference.
+pub fn normal_pair(a: [f64; 3]) -> [[f64; 3]; 2] {
+    // Start from the ground axis least aligned with a.
+    let k = (0..3)
+        .min_by(|&i, &j| a[i].abs().total_cmp(&a[j].abs()))
+        .unwrap_or(0);
+    let mut e = [0.0; 3];
+    e[k] = 1.0;
+    let cross = |x: [f64; 3], y: [f64; 3]| {
+        [
+            x[1] * y[2] - x[2] * y[1],
+            x[2] * y[0] - x[0] * y[2],
+            x[0] * y[1] - x[1] * y[0],
+        ]
+    };
+    let first = cross(a, e);
+    let norm = first.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let first = first.map(|x| x / norm);
+    [first, cross(a, first)]
+}

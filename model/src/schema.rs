@@ -416,29 +416,18 @@ mod tests {
         let display = Path::new("dir/some chain-v2.ron");
         let m = parse_model(&source, display).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(m.name, "some chain-v2");
-        let options = crate::EmitOptions::default();
-        let e = match crate::generate_source(&source, display, &options) {
-            Ok(_) => panic!("`some chain-v2` names no module"),
-            Err(e) => e,
-        };
-        assert_eq!((e.field.as_str(), e.line), ("name", 0));
-        assert!(e.message.contains("some chain-v2"), "{e}");
+        // The build refuses it as a module name: codegen/tests/suite/emit.rs.
     }
 
+    /// A keyword as the model's name runs on the numeric path; the build refuses it
+    /// (codegen/tests/suite/emit.rs).
     #[test]
-    fn the_build_rejects_a_keyword_as_model_name() {
+    fn a_keyword_as_model_name_parses() {
         let source = edited("\"test_chain\"", "\"fn\"");
         assert!(
             parse_model(&source, &file()).is_ok(),
             "the numeric path runs it"
         );
-        let options = crate::EmitOptions::default();
-        let e = match crate::generate_source(&source, &file(), &options) {
-            Ok(_) => panic!("`fn` names no module"),
-            Err(e) => e,
-        };
-        assert_eq!((e.field.as_str(), e.line), ("name", 3), "{e}");
-        assert!(e.message.contains("not a valid Rust identifier"), "{e}");
     }
 
     #[test]
