@@ -521,8 +521,8 @@ impl CamDesign {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::samples::curvature;
     use crate::model::Profile;
+    use crate::samples::curvature;
     use camchain_runtime::motion_law::{Law, Segment};
 
     /// A program with every kind of segment, lifts `h`.
@@ -683,7 +683,9 @@ mod tests {
                     at.radius_of_curvature
                 );
             }
-            eprintln!("{what}: radius of curvature, closed form against the profile's: {worst:.1e}");
+            eprintln!(
+                "{what}: radius of curvature, closed form against the profile's: {worst:.1e}"
+            );
         }
     }
 }

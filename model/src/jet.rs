@@ -9,8 +9,8 @@
 //! motion law) or the caller's (the numeric reference brings its own spline).
 
 use crate::profile::{Func, Scalar, Tabulated};
-use std::sync::Arc;
 use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::sync::Arc;
 
 /// A value with its first and second derivatives with respect to the one variable.
 ///

@@ -99,41 +99,6 @@ pub fn curve(
     }
 }
 
-/// `samples` + 1 evenly spaced samples of `profile` (its expressions with every parameter
-/// resolved) over `range`, with its symbolic derivatives evaluated by the interpreter.
-pub fn profile_samples(
-    profile: &Profile,
-    range: (f64, f64),
-    samples: usize,
-) -> Vec<camchain_runtime::contact::ProfileSample> {
-    let mut g = Graph::new();
-    let at = g.var("s");
-    let (first, second) = match profile {
-        Profile::Explicit { f, .. } => (f, None),
-        Profile::Polar { r, .. } => (r, None),
-        Profile::Parametric { x, y, .. } => (x, Some(y)),
-    };
-    let c = curve(&mut g, profile, first, second, "check", at, &[]);
-    let f = frame(&mut g, &c, follower_side(profile));
-    (0..=samples)
-        .map(|k| {
-            let s = range.0 + (range.1 - range.0) * k as f64 / samples.max(1) as f64;
-            let mut vars = vec![f64::NAN; g.var_names().len()];
-            vars[0] = s;
-            let curvature = g.eval(&[f.curvature], &vars)[0];
-            let radius = match profile {
-                Profile::Polar { r, .. } => r.eval(s),
-                _ => f64::NAN,
-            };
-            camchain_runtime::contact::ProfileSample {
-                at: s,
-                radius,
-                curvature,
-            }
-        })
-        .collect()
-}
-
 /// a·u + b·v for scalars a, b and 2-vectors u, v.
 fn combine(g: &mut Graph, a: Id, u: [Id; 2], b: Id, v: [Id; 2]) -> [Id; 2] {
     [0, 1].map(|k| {
@@ -269,4 +234,64 @@ pub fn add_scaled(g: &mut Graph, a: [Id; 2], k: Id, b: [Id; 2]) -> [Id; 2] {
         let t = g.mul(k, b[i]);
         g.add(a[i], t)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::parse_expression;
+
+    /// The schema's followability checks read a profile's curvature from the model crate
+    /// (`camchain_model::samples`, forward-mode differentiation); the derivation's frame
+    /// differentiates the same expressions symbolically here. Both are exact: they agree to
+    /// rounding (relative 1e-12 of curvatures ~10–1000 1/m) on every form, with the side
+    /// conventions of both.
+    #[test]
+    fn the_checks_curvature_is_the_derivations() {
+        let parse = |text: &str, var: &str| parse_expression(text, var).expect("parses");
+        let profiles = [
+            Profile::Explicit {
+                source: String::new(),
+                f: parse("0.045 - 2.0*x*x + 0.3*x.powi(3)", "x"),
+            },
+            Profile::Polar {
+                source: String::new(),
+                r: parse(
+                    "0.01*theta.cos() + (0.0016 - 0.0001*theta.sin().powi(2)).sqrt()",
+                    "theta",
+                ),
+            },
+            Profile::Parametric {
+                x_source: String::new(),
+                y_source: String::new(),
+                x: parse("0.05*s.cos() + 0.004*(3.0*s).sin()", "s"),
+                y: parse("0.042*s.sin()", "s"),
+            },
+        ];
+        for profile in &profiles {
+            let mut g = Graph::new();
+            let at = g.var("s");
+            let (first, second) = match profile {
+                Profile::Explicit { f, .. } => (f, None),
+                Profile::Polar { r, .. } => (r, None),
+                Profile::Parametric { x, y, .. } => (x, Some(y)),
+            };
+            let c = curve(&mut g, profile, first, second, "check", at, &[]);
+            let f = frame(&mut g, &c, follower_side(profile));
+            let samples = camchain_model::samples::profile_samples(profile, (-0.2, 6.0), 97);
+            for sample in samples {
+                let mut vars = vec![f64::NAN; g.var_names().len()];
+                vars[0] = sample.at;
+                let symbolic = g.eval(&[f.curvature], &vars)[0];
+                let scale = symbolic.abs().max(1.0);
+                assert!(
+                    (sample.curvature - symbolic).abs() < 1e-12 * scale,
+                    "{} at {}: {} vs {symbolic}",
+                    profile.kind_name(),
+                    sample.at,
+                    sample.curvature
+                );
+            }
+        }
+    }
 }

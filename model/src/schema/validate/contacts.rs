@@ -8,8 +8,8 @@ use super::fields::{finite, identifier, lookup, unit_vector};
 use super::markers::cam_axes;
 use super::parameters::expression;
 use super::{Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile};
-use crate::samples::profile_samples;
 use crate::model::{Body, Contact, JointKind, RuntimeCheck};
+use crate::samples::profile_samples;
 use crate::schema::raw;
 use camchain_runtime::contact::{
     PROFILE_CHECK_SAMPLES, Place, Shape, followable as followable_checked,
