@@ -565,11 +565,6 @@ fn integrator_parser() -> impl TypedValueParser<Value = IntegratorKind> {
     })
 }
 
-/// Name of an integrator as the command line spells it.
-pub fn integrator_name(kind: IntegratorKind) -> &'static str {
-    kind.name()
-}
-
 /// A coefficient of restitution: a number in [0, 1].
 fn restitution(text: &str) -> Result<f64, String> {
     let value: f64 = text

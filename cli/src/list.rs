@@ -1,6 +1,5 @@
 //! `camchain list`: the built-in models with their coordinates, contacts and defaults.
 
-use super::args::integrator_name;
 use super::source::builtin_file;
 use super::summary::unit;
 use camchain_models as models;
@@ -99,7 +98,7 @@ fn defaults(s: &SimSettings) -> String {
         "--t-end {} --dt-out {} --integrator {} --dt {} --rtol {:e} --atol {:e}",
         s.t_end,
         s.dt_out,
-        integrator_name(s.integrator),
+        s.integrator.name(),
         s.dt,
         s.rtol,
         s.atol

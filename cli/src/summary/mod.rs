@@ -19,7 +19,6 @@ mod tests;
 
 pub use digest::Digest;
 
-use super::args::integrator_name;
 use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::{
@@ -88,7 +87,7 @@ pub fn number(x: f64) -> String {
 }
 
 fn settings_text(settings: &SimSettings) -> String {
-    let name = integrator_name(settings.integrator);
+    let name = settings.integrator.name();
     match settings.integrator {
         IntegratorKind::Rk4 => match settings.rk4_landing_step() {
             None => format!("{name} (dt {} s)", settings.dt),

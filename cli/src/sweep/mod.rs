@@ -20,7 +20,7 @@ pub mod table;
 pub use merge::run as merge;
 
 use super::CliError;
-use super::args::{SweepArgs, integrator_name};
+use super::args::SweepArgs;
 use super::interrupt::Interrupt;
 use super::output;
 use camchain_codegen::ParameterMode;
@@ -273,7 +273,7 @@ pub fn preamble(plan: &Plan) -> Preamble {
         parameters: plan.runs.describe(),
         settings: format!(
             "{} {tolerances} t_end {} s, {sampling}",
-            integrator_name(s.integrator),
+            s.integrator.name(),
             s.t_end
         ),
     }
