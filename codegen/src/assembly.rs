@@ -114,15 +114,15 @@ fn assemble_with_loops(model: &Model, d: &Derivation) -> Result<Vec<f64>, (Strin
     } else {
         let mut first = nc;
         let mut located = ("loops".to_string(), String::from("a loop"));
-        for (l, closure) in model.loops.iter().enumerate() {
-            let count = closure.equations().len();
+        for (l, cut) in model.loops.iter().enumerate() {
+            let count = cut.equations().len();
             if row < first + count {
                 located = (
                     format!("loops[{l}]"),
                     format!(
                         "loop `{}` (equation {})",
-                        closure.name,
-                        closure.equations()[row - first]
+                        cut.name,
+                        cut.equations()[row - first]
                     ),
                 );
                 break;

@@ -1,13 +1,13 @@
 //! The whole symbolic derivation of a model: kinematics, cam constraints, dynamics, energy
 //! and prescribed motions, all in one expression graph.
 
-use crate::closure::{ClosureTerms, closure_terms};
 use crate::contact::{ContactTerms, contact_terms};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::scalar::{scalar_to_expr, value_and_derivatives};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{Symbols, forward};
 use crate::linear;
+use crate::loops::{LoopTerms, loop_terms};
 use crate::model::{Field, Model};
 
 /// q(t), q̇(t), q̈(t) of a driven coordinate.
@@ -44,8 +44,8 @@ pub struct Derivation {
     pub dynamics: DynamicsTerms,
     /// One entry per contact (1)–(8).
     pub contacts: Vec<ContactTerms>,
-    /// One entry per loop closure (docs/method.md §11).
-    pub loops: Vec<ClosureTerms>,
+    /// One entry per loop (docs/method.md §11).
+    pub loops: Vec<LoopTerms>,
     /// Energy expressions.
     pub energy: EnergyTerms,
     /// Prescribed motions of driven joints.
@@ -152,7 +152,7 @@ impl Derivation {
         let symbols = Symbols::new(&mut g, model);
         let kin = forward(&mut g, model, &symbols);
         let contacts = contact_terms(&mut g, model, &kin, &symbols);
-        let loops = closure_terms(&mut g, model, &kin, &symbols);
+        let loops = loop_terms(&mut g, model, &kin, &symbols);
         let dynamics = backward(&mut g, model, &symbols, &kin);
         let energy = energy(&mut g, model, &symbols, &kin);
         let drives = model

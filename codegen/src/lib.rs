@@ -18,7 +18,6 @@
 //! - [`emit`]: the generated Rust module.
 
 pub mod assembly;
-pub mod closure;
 pub mod contact;
 pub mod derive;
 pub mod dynamics;
@@ -27,6 +26,7 @@ pub mod expr;
 pub mod kinematics;
 pub mod linear;
 pub mod lint;
+pub mod loops;
 
 // The model file and the validated model live in `camchain-model` (shared with the numeric
 // reference); their paths stay available here.

@@ -320,23 +320,23 @@ impl Contact {
 
 /// A point fixed on a body, or on the ground, where a loop is cut.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ClosurePoint {
+pub struct LoopPoint {
     /// The body (sorted index), `None` for the ground.
     pub body: Option<usize>,
     /// The point in that body's frame (m).
     pub point: [f64; 3],
 }
 
-/// One loop-closure constraint: a cut joint between a point A of one body and a point B of
+/// One loop, closed by a cut joint between a point A of one body and a point B of
 /// another.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Closure {
+pub struct Loop {
     /// Unique name among contacts and loops (CSV columns `loop_<name>_<equation>`).
     pub name: String,
     /// The cut joint's kind.
     pub kind: LoopKind,
     /// A and B.
-    pub sides: [ClosurePoint; 2],
+    pub sides: [LoopPoint; 2],
     /// Unit vector in B's body frame: the pin's axis (spatial revolute), the line of a
     /// slider or of a slot.
     pub axis: [f64; 3],
@@ -347,7 +347,7 @@ pub struct Closure {
     pub planar: bool,
 }
 
-impl Closure {
+impl Loop {
     /// The names of its equations, in the order of its rows of h (CSV column suffixes):
     /// `x`, `y`, `z` for the components of A − B in ground axes, `normal` (`normal_1`,
     /// `normal_2`) for A − B across the line, `turn` for A's direction across B's line,
@@ -553,8 +553,8 @@ pub struct Model {
     pub markers: Vec<Marker>,
     /// Cam contacts: the first rows of h.
     pub contacts: Vec<Contact>,
-    /// Loop closures: the rows of h after the contacts'.
-    pub loops: Vec<Closure>,
+    /// The loops: the rows of h after the contacts'.
+    pub loops: Vec<Loop>,
     /// Initial guess.
     pub initial: Initial,
     /// Default simulation settings.

@@ -23,9 +23,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod closure;
 mod contact;
 pub mod jet;
+mod loops;
 mod motion;
 mod numeric;
 pub mod spline;

@@ -1,6 +1,6 @@
 //! The kinematics the recursions share: a body's pose and motion in ground coordinates,
 //! and the vector types they are written in. The Newton–Euler recursion (`numeric`)
-//! computes them body by body; the cam contacts and the loop closures read them.
+//! computes them body by body; the cam contacts and the loops read them.
 
 use nalgebra::{Matrix3, Vector3};
 

@@ -17,12 +17,12 @@
 //!   the joint axes, convective acceleration from the acceleration recursion with q̈ = 0,
 //!   profile derivatives from [`crate::jet`].
 
-use crate::closure::{ClosureConst, ClosureEval};
 use crate::contact::{ContactConst, Evaluated};
 use crate::jet::{eval_jet, eval_with};
+use crate::loops::{LoopConst, LoopEval};
 use crate::motion::{Mat3, Motion, Pose, Vec3, vec3};
 use camchain_model::ModelError;
-use camchain_model::model::{Body, Closure, Contact, JointKind, Model, ParameterMode, Profile};
+use camchain_model::model::{Body, Contact, JointKind, Loop, Model, ParameterMode, Profile};
 use camchain_model::schema::{Files, load_model, parse_model_from};
 use camchain_runtime::{
     ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
@@ -92,12 +92,12 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
     }
 }
 
-/// The runtime's description of a loop closure.
-pub fn loop_info(closure: &Closure) -> LoopInfo {
+/// The runtime's description of a loop cut.
+pub fn loop_info(cut: &Loop) -> LoopInfo {
     LoopInfo {
-        name: closure.name.clone(),
-        kind: closure.kind,
-        equations: closure.equations().iter().map(|e| e.to_string()).collect(),
+        name: cut.name.clone(),
+        kind: cut.kind,
+        equations: cut.equations().iter().map(|e| e.to_string()).collect(),
     }
 }
 
@@ -231,7 +231,7 @@ pub struct NumericModel {
     values: Vec<f64>,
     bodies: Vec<BodyConst>,
     contacts: Vec<ContactConst>,
-    loops: Vec<ClosureConst>,
+    loops: Vec<LoopConst>,
 }
 
 impl NumericModel {
@@ -247,7 +247,7 @@ impl NumericModel {
             .iter()
             .map(|c| ContactConst::new(&model, c))
             .collect();
-        let loops = model.loops.iter().map(ClosureConst::new).collect();
+        let loops = model.loops.iter().map(LoopConst::new).collect();
         Self {
             info: model_info(&model),
             values: model.runtime_parameters().map(|(_, p)| p.value).collect(),
@@ -407,8 +407,8 @@ impl NumericModel {
             .collect()
     }
 
-    /// Every loop evaluated at (q, q̇): h, J, c and its points ([`crate::closure`]).
-    fn loops_at(&self, q: &[f64], qd: &[f64]) -> Vec<ClosureEval> {
+    /// Every loop evaluated at (q, q̇): h, J, c and its points ([`crate::loops`]).
+    fn loops_at(&self, q: &[f64], qd: &[f64]) -> Vec<LoopEval> {
         if self.loops.is_empty() {
             return Vec::new();
         }

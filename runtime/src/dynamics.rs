@@ -106,7 +106,7 @@ impl ContactInfo {
     }
 }
 
-/// Static description of one loop closure: its rows of h follow the contacts' and the
+/// Static description of one loop: its rows of h follow the contacts' and the
 /// loops listed before it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopInfo {
@@ -130,7 +130,7 @@ pub struct ModelInfo {
     pub coordinates: Vec<CoordinateInfo>,
     /// The contacts (one constraint each, the first rows of h), in order.
     pub contacts: Vec<ContactInfo>,
-    /// The loop closures (their equations are the rows of h after the contacts'), in order.
+    /// The loops (their equations are the rows of h after the contacts'), in order.
     pub loops: Vec<LoopInfo>,
     /// False for a planar model (contact z coordinates are always 0 and not reported).
     pub spatial: bool,
@@ -360,7 +360,7 @@ pub trait Dynamics {
     /// `M q̈ + F + Q = joint drive loads` (so a spring contributes `+k (q − rest)`).
     fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
 
-    /// The two points of every loop closure (A then B, ground coordinates) at q, into `out`
+    /// The two points of every loop's cut joint (A then B, ground coordinates) at q, into `out`
     /// (length 2 × the number of loops): what figures draw. Does nothing without loops.
     fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
         let _ = (q, out);

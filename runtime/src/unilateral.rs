@@ -255,7 +255,7 @@ fn validate_unilateral<D: Dynamics + ?Sized>(
     let invalid = |message: String| Err(SimError::InvalidSettings { message });
     if !model.info().loops.is_empty() {
         return invalid(format!(
-            "unilateral contact is not available in a model with loop closures yet; {} has {}",
+            "unilateral contact is not available in a model with loops yet; {} has {}",
             model.info().name,
             model.info().loops.len()
         ));

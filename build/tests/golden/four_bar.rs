@@ -1197,7 +1197,7 @@ impl rt::Dynamics for Model {
         let torque = self.derived.torque;
         q_crank_dot * torque
     }
-    /// The points A and B of every loop closure, ground coordinates.
+    /// The points A and B of every loop's cut joint, ground coordinates.
     fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
         let q_crank = q[0];
         let q_coupler = q[1];

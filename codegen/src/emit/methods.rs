@@ -172,7 +172,7 @@ pub(super) fn function_specs(model: &Model, d: &mut Derivation) -> Vec<FunctionS
             })
             .collect();
         specs.push(FunctionSpec {
-            doc: "The points A and B of every loop closure, ground coordinates.".into(),
+            doc: "The points A and B of every loop's cut joint, ground coordinates.".into(),
             name: "loop_points".into(),
             params: vec![param("q", "&[f64]"), param("out", "&mut [[f64; 3]]")],
             ret: None,

@@ -197,7 +197,7 @@ pub(super) struct Marker {
     pub position: Vec3,
 }
 
-/// A loop closure: the joint a loop is cut at, between two markers.
+/// A loop: the joint it is cut at, between two markers.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Loop {

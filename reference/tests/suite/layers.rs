@@ -1,8 +1,8 @@
 //! The reference's modules import each other without a circle: the kinematics the
-//! recursion, the cam contacts and the loop closures share (poses, motions, vectors) live in
-//! `motion`, which imports none of them, and `contact` and `closure` do not reach back into
+//! recursion, the cam contacts and the loops share (poses, motions, vectors) live in
+//! `motion`, which imports none of them, and `contact` and `loops` do not reach back into
 //! `numeric`, which uses both. Asserted on the sources' `crate::` paths (comments apart):
-//! `contact` and `closure` used to take `Pose`, `Motion` and `vec3` from `numeric`.
+//! `contact` and `loops` (then `closure`) used to take `Pose`, `Motion` and `vec3` from `numeric`.
 
 use std::path::Path;
 
@@ -36,11 +36,11 @@ fn the_shared_kinematics_import_none_of_their_users() {
 }
 
 #[test]
-fn contacts_and_closures_do_not_import_the_recursion() {
+fn contacts_and_loops_do_not_import_the_recursion() {
     // The recursion does import both (so the check below is on real import lines).
     let numeric = imports("numeric.rs");
-    assert!(numeric.contains(&"contact".to_string()) && numeric.contains(&"closure".to_string()));
-    for file in ["contact.rs", "closure.rs"] {
+    assert!(numeric.contains(&"contact".to_string()) && numeric.contains(&"loops".to_string()));
+    for file in ["contact.rs", "loops.rs"] {
         let found = imports(file);
         assert!(found.contains(&"motion".to_string()), "{file}: {found:?}");
         assert!(!found.contains(&"numeric".to_string()), "{file}: {found:?}");

@@ -1,11 +1,11 @@
-//! Loop closures (`loops:`): the cut joint's two points, its kind and axes, and the checks
+//! Loops (`loops:`): the cut joint's two points, its kind and axes, and the checks
 //! that the mechanism can have them: known bodies, two different bodies, unit axes, no more
 //! equations than free coordinates, and a planar model's loops in its plane.
 
 use super::bodies::BodyTree;
 use super::fields::{identifier, unit_vector};
 use super::{Checked, Context, GROUND};
-use crate::model::{Body, Closure, ClosurePoint, Contact, Field, LoopKind, Model};
+use crate::model::{Body, Contact, Field, Loop, LoopKind, LoopPoint, Model};
 use crate::schema::raw;
 use std::collections::HashMap;
 
@@ -16,7 +16,7 @@ pub(super) fn loops(
     tree: &BodyTree,
     model: &Model,
     cx: &Context,
-) -> Checked<Vec<Closure>> {
+) -> Checked<Vec<Loop>> {
     let at = cx.at;
     let mut names: HashMap<&str, String> = model
         .contacts
@@ -25,7 +25,7 @@ pub(super) fn loops(
         .map(|(k, c): (usize, &Contact)| (c.name.as_str(), format!("contacts[{k}]")))
         .collect();
     let planar = model.is_planar();
-    let mut closures = Vec::with_capacity(list.len());
+    let mut cuts = Vec::with_capacity(list.len());
     let mut rows = model.contacts.len();
     let free = model
         .bodies
@@ -45,8 +45,8 @@ pub(super) fn loops(
                 ),
             ));
         }
-        let closure = closure(cx, tree, l, raw_loop, planar)?;
-        rows += closure.equations().len();
+        let cut = cut_joint(cx, tree, l, raw_loop, planar)?;
+        rows += cut.equations().len();
         if rows > free {
             return Err(at.error(
                 &path,
@@ -56,23 +56,23 @@ pub(super) fn loops(
                      not driven; a mechanism needs at least as many coordinates as equations \
                      (is a body missing, or a joint driven that should not be?)",
                     raw_loop.name,
-                    closure.equations().len()
+                    cut.equations().len()
                 ),
             ));
         }
-        closures.push(closure);
+        cuts.push(cut);
     }
-    Ok(closures)
+    Ok(cuts)
 }
 
 /// One loop, validated.
-fn closure(
+fn cut_joint(
     cx: &Context,
     tree: &BodyTree,
     l: usize,
     raw_loop: &raw::Loop,
     planar: bool,
-) -> Checked<Closure> {
+) -> Checked<Loop> {
     let at = cx.at;
     let path = format!("loops[{l}]");
     let sides = [(0, "a", &raw_loop.a), (1, "b", &raw_loop.b)].map(|(s, key, side)| {
@@ -85,7 +85,7 @@ fn closure(
         let point = cx.vector_of(&format!("{path}.{key}.point"), &side.point, |k| {
             Field::LoopPoint(l, s, k)
         })?;
-        Ok(ClosurePoint { body, point })
+        Ok(LoopPoint { body, point })
     });
     let [a, b] = sides;
     let sides = [a?, b?];
@@ -126,7 +126,7 @@ fn closure(
              one of its revolute joints instead",
         ));
     }
-    Ok(Closure {
+    Ok(Loop {
         name: raw_loop.name.clone(),
         kind,
         sides,
@@ -142,7 +142,7 @@ fn in_plane(
     l: usize,
     raw_loop: &raw::Loop,
     kind: LoopKind,
-    sides: &[ClosurePoint; 2],
+    sides: &[LoopPoint; 2],
     [axis, axis_a]: [[f64; 3]; 2],
 ) -> Checked<()> {
     let at = cx.at;

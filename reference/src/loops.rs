@@ -1,4 +1,4 @@
-//! Loop closures evaluated numerically (docs/method.md §11), by a route of their own: the
+//! Loops evaluated numerically (docs/method.md §11), by a route of their own: the
 //! points and directions of a loop are placed by the nalgebra pose recursion, their rates
 //! are the body velocities of the motion recursion (9) at q̇ (a Jacobian column is the rate
 //! at q̇ = e_j), and their velocity-product accelerations come from the same recursion at
@@ -7,7 +7,7 @@
 
 use crate::motion::{Motion, Pose, Vec3, vec3};
 use camchain_model::model::normal_pair;
-use camchain_model::model::{Closure, LoopKind};
+use camchain_model::model::{Loop, LoopKind};
 
 /// A vector of a loop: a point or a direction carried by a body (`None`: the ground), or
 /// the gap between the loop's two points.
@@ -64,35 +64,35 @@ impl Item {
 
 /// One loop's constant data: the vector pairs whose products are its equations.
 #[derive(Debug, Clone)]
-pub(crate) struct ClosureConst {
+pub(crate) struct LoopConst {
     equations: Vec<(Item, Item)>,
     points: [(Option<usize>, Vec3); 2],
 }
 
 /// h, J, c of one loop at (q, q̇), and its points.
 #[derive(Debug, Clone)]
-pub(crate) struct ClosureEval {
+pub(crate) struct LoopEval {
     pub(crate) h: Vec<f64>,
     pub(crate) jacobian: Vec<Vec<f64>>,
     pub(crate) bias: Vec<f64>,
     pub(crate) points: [[f64; 3]; 2],
 }
 
-impl ClosureConst {
-    pub(crate) fn new(closure: &Closure) -> Self {
-        let [a, b] = closure.sides.map(|s| (s.body, vec3(&s.point)));
+impl LoopConst {
+    pub(crate) fn new(cut: &Loop) -> Self {
+        let [a, b] = cut.sides.map(|s| (s.body, vec3(&s.point)));
         let gap = Item::Gap([a, b]);
         let along_b = |v: [f64; 3]| Item::Direction(b.0, vec3(&v));
         let along_a = |v: [f64; 3]| Item::Direction(a.0, vec3(&v));
         let components = |k: usize| (0..k).map(|i| (gap, Item::Axis(i))).collect::<Vec<_>>();
-        let d = closure.axis;
-        let equations = match (closure.kind, closure.planar) {
+        let d = cut.axis;
+        let equations = match (cut.kind, cut.planar) {
             (LoopKind::Revolute, true) => components(2),
             (LoopKind::Spherical, _) => components(3),
             (LoopKind::Revolute, false) => {
                 let mut e = components(3);
                 for perpendicular in normal_pair(d) {
-                    e.push((along_a(closure.axis_a), along_b(perpendicular)));
+                    e.push((along_a(cut.axis_a), along_b(perpendicular)));
                 }
                 e
             }
@@ -100,7 +100,7 @@ impl ClosureConst {
                 let normal = [-d[1], d[0], 0.0];
                 vec![
                     (gap, along_b(normal)),
-                    (along_a(closure.axis_a), along_b(normal)),
+                    (along_a(cut.axis_a), along_b(normal)),
                 ]
             }
             (LoopKind::PointOnLine, true) => vec![(gap, along_b([-d[1], d[0], 0.0]))],
@@ -109,7 +109,7 @@ impl ClosureConst {
                 .map(|e| (gap, along_b(e)))
                 .collect(),
         };
-        ClosureConst {
+        LoopConst {
             equations,
             points: [a, b],
         }
@@ -121,8 +121,8 @@ impl ClosureConst {
         poses: &[Pose],
         motions: &[Motion],
         units: &[Vec<Motion>],
-    ) -> ClosureEval {
-        let mut out = ClosureEval {
+    ) -> LoopEval {
+        let mut out = LoopEval {
             h: Vec::new(),
             jacobian: Vec::new(),
             bias: Vec::new(),

@@ -1,4 +1,4 @@
-//! Loop closures (docs/method.md §11): a joint cut to make the tree comes back as equations
+//! Loops (docs/method.md §11): a joint cut to make the tree comes back as equations
 //! h(q) = 0 between a point A of one body and a point B of another, with J = ∂h/∂q and the
 //! convective term c of J q̈ + c = 0, derived on the graph like a contact's and emitted as
 //! the rows of h after the contacts'.
@@ -19,7 +19,7 @@
 use crate::contact::relative::{Labels, PointMotion, point_motion};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
-use crate::model::{ClosurePoint, Field, JointKind, LoopKind, Model, normal_pair};
+use crate::model::{Field, JointKind, LoopKind, LoopPoint, Model, normal_pair};
 
 /// One scalar equation of a loop: h, J, c.
 #[derive(Debug, Clone)]
@@ -32,10 +32,10 @@ pub struct Row {
     pub bias: Id,
 }
 
-/// The terms of one loop closure.
+/// The terms of one loop cut.
 #[derive(Debug, Clone)]
-pub struct ClosureTerms {
-    /// Its equations, in the order of [`crate::model::Closure::equations`].
+pub struct LoopTerms {
+    /// Its equations, in the order of [`crate::model::Loop::equations`].
     pub rows: Vec<Row>,
     /// A and B, ground coordinates (what the outputs draw).
     pub points: [V3; 2],
@@ -176,57 +176,55 @@ impl Carried {
 }
 
 /// Derives every loop of `model`.
-pub fn closure_terms(
+pub fn loop_terms(
     g: &mut Graph,
     model: &Model,
     kin: &[BodyKinematics],
     s: &Symbols,
-) -> Vec<ClosureTerms> {
+) -> Vec<LoopTerms> {
     (0..model.loops.len())
         .map(|l| {
-            let closure = &model.loops[l];
+            let cut = &model.loops[l];
             g.set_section(format!(
                 "loop {}: the cut {} joint, h, J, c",
-                closure.name,
-                closure.kind.name()
+                cut.name,
+                cut.kind.name()
             ));
             let motions = [0, 1].map(|side| side_motion(g, model, kin, s, l, side));
             let [a, b] = [0, 1].map(|side| Carried::point(g, s, &motions[side]));
             let gap = a.minus(g, &b);
-            vec3::label(g, gap.value, &format!("loop_{}_gap", closure.name));
-            let [body_a, body_b] = closure.sides.map(|p: ClosurePoint| p.body);
-            let rows = match (closure.kind, closure.planar) {
+            vec3::label(g, gap.value, &format!("loop_{}_gap", cut.name));
+            let [body_a, body_b] = cut.sides.map(|p: LoopPoint| p.body);
+            let rows = match (cut.kind, cut.planar) {
                 (LoopKind::Revolute, true) => (0..2).map(|k| gap.component(g, k)).collect(),
                 (LoopKind::Spherical, _) => (0..3).map(|k| gap.component(g, k)).collect(),
                 (LoopKind::Revolute, false) => {
                     let mut rows: Vec<Row> = (0..3).map(|k| gap.component(g, k)).collect();
-                    let axis =
-                        Carried::direction(g, model, kin, body_a, closure.axis_a, &motions[0]);
-                    for e in normal_pair(closure.axis) {
+                    let axis = Carried::direction(g, model, kin, body_a, cut.axis_a, &motions[0]);
+                    for e in normal_pair(cut.axis) {
                         let e = Carried::direction(g, model, kin, body_b, e, &motions[1]);
                         rows.push(axis.dot(g, &e));
                     }
                     rows
                 }
                 (LoopKind::Prismatic, _) => {
-                    let [d, z] = [closure.axis, [0.0, 0.0, 1.0]];
+                    let [d, z] = [cut.axis, [0.0, 0.0, 1.0]];
                     let normal = [
                         z[1] * d[2] - z[2] * d[1],
                         z[2] * d[0] - z[0] * d[2],
                         z[0] * d[1] - z[1] * d[0],
                     ];
                     let n = Carried::direction(g, model, kin, body_b, normal, &motions[1]);
-                    let along =
-                        Carried::direction(g, model, kin, body_a, closure.axis_a, &motions[0]);
+                    let along = Carried::direction(g, model, kin, body_a, cut.axis_a, &motions[0]);
                     vec![gap.dot(g, &n), along.dot(g, &n)]
                 }
                 (LoopKind::PointOnLine, true) => {
-                    let d = closure.axis;
+                    let d = cut.axis;
                     let normal = [-d[1], d[0], 0.0];
                     let n = Carried::direction(g, model, kin, body_b, normal, &motions[1]);
                     vec![gap.dot(g, &n)]
                 }
-                (LoopKind::PointOnLine, false) => normal_pair(closure.axis)
+                (LoopKind::PointOnLine, false) => normal_pair(cut.axis)
                     .into_iter()
                     .map(|e| {
                         let n = Carried::direction(g, model, kin, body_b, e, &motions[1]);
@@ -234,10 +232,10 @@ pub fn closure_terms(
                     })
                     .collect(),
             };
-            for (row, equation) in rows.iter().zip(closure.equations()) {
-                g.label(row.h, format!("loop_{}_{equation}", closure.name));
+            for (row, equation) in rows.iter().zip(cut.equations()) {
+                g.label(row.h, format!("loop_{}_{equation}", cut.name));
             }
-            ClosureTerms {
+            LoopTerms {
                 rows,
                 points: [a.value, b.value],
             }
@@ -254,11 +252,11 @@ fn side_motion(
     l: usize,
     side: usize,
 ) -> PointMotion {
-    let closure = &model.loops[l];
-    let point = closure.sides[side];
+    let cut = &model.loops[l];
+    let point = cut.sides[side];
     let local = s.field3(g, model, |k| Field::LoopPoint(l, side, k), point.point);
     let moving = vec![true; model.n()];
-    let name = format!("loop_{}_{}", closure.name, ["a", "b"][side]);
+    let name = format!("loop_{}_{}", cut.name, ["a", "b"][side]);
     point_motion(
         g,
         model,
