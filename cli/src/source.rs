@@ -127,18 +127,13 @@ pub fn load_with(
             .map(|(_, c)| *c)
             .ok_or_else(|| CliError::Failed(format!("{arg} has no constructor")))?;
         let pairs: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
-        let settable: Vec<&str> = loaded
-            .engine
-            .dynamics()
-            .info()
-            .parameters
-            .iter()
-            .map(|p| p.name.as_str())
-            .collect();
-        let model = constructor(&pairs).map_err(|mut e| {
-            e.message = settable_only(std::mem::take(&mut e.message), &settable);
+        let model = constructor(&pairs).map_err(|e| {
+            // The generated code names the folded parameters itself ("is constant", or the
+            // list of constants after those it knows); the numeric path can set them all.
             let hint = if e.message.contains("is constant") {
                 ", or set it on the numeric reference (--numeric)"
+            } else if e.message.contains("folded into") {
+                "; the numeric reference (--numeric) sets the constant ones too"
             } else {
                 ""
             };
@@ -166,27 +161,6 @@ pub fn load_with(
     loaded.geometry = Geometry::new(&model);
     loaded.engine = Engine::Numeric(Box::new(NumericModel::new(model)));
     Ok(loaded)
-}
-
-/// An unknown-parameter message of generated code (`unknown parameter `x`; known: …`, whose
-/// list has every declared parameter, those folded into the code too) with the list of the
-/// parameters `--param` can set instead: the run-time ones, `settable`. Any other message
-/// is returned as it is.
-pub(crate) fn settable_only(message: String, settable: &[&str]) -> String {
-    let Some(at) = message.find("; known: ") else {
-        return message;
-    };
-    if !message[..at].contains("unknown parameter `") {
-        return message;
-    }
-    let mut names = settable.to_vec();
-    names.sort_unstable();
-    let list = if names.is_empty() {
-        "none (every parameter is folded into the generated code; --numeric sets them)".into()
-    } else {
-        names.join(", ")
-    };
-    format!("{}; the parameters that can be set: {list}", &message[..at])
 }
 
 /// A built-in model's description with other parameter values (for drawing it).

@@ -255,12 +255,33 @@ pub mod checks {
     /// "unknown parameter `name`; known: a, b" (the names sorted), or a note that the model
     /// has none.
     pub fn unknown_parameter(name: &str, known: &[&str]) -> String {
-        if known.is_empty() {
-            return format!("unknown parameter `{name}`: this model declares no parameter");
+        unknown_parameter_among(name, known, &[])
+    }
+
+    /// [`unknown_parameter`] for generated code, which tells the parameters that can be set
+    /// (`settable`) from those folded into it at build time (`constant`): only the first are
+    /// offered as "known", the second are named as constant so that nobody is told to set a
+    /// value the build has folded away.
+    pub fn unknown_parameter_among(name: &str, settable: &[&str], constant: &[&str]) -> String {
+        let sorted = |names: &[&str]| {
+            let mut names = names.to_vec();
+            names.sort_unstable();
+            names.join(", ")
+        };
+        match (settable.is_empty(), constant.is_empty()) {
+            (true, true) => format!("unknown parameter `{name}`: this model declares no parameter"),
+            (true, false) => format!(
+                "unknown parameter `{name}`: this build of the model has no parameter that can \
+                 be set (constant, folded into the code: {})",
+                sorted(constant)
+            ),
+            (false, true) => format!("unknown parameter `{name}`; known: {}", sorted(settable)),
+            (false, false) => format!(
+                "unknown parameter `{name}`; known: {} (constant, folded into the code: {})",
+                sorted(settable),
+                sorted(constant)
+            ),
         }
-        let mut sorted = known.to_vec();
-        sorted.sort_unstable();
-        format!("unknown parameter `{name}`; known: {}", sorted.join(", "))
     }
 
     /// The message for a value given to a parameter folded at build time.
@@ -384,5 +405,23 @@ mod tests {
         assert_eq!(resolve(&declared, &[("omega", 7.0)]), Ok(vec![40.0, 7.0]));
         let e = resolve(&declared, &[("omegaa", 7.0)]).unwrap_err();
         assert_eq!(e.message, "unknown parameter `omegaa`; known: k, omega");
+    }
+    #[test]
+    fn unknown_names_are_offered_only_the_parameters_that_can_be_set() {
+        assert_eq!(
+            unknown_parameter_among("x", &["omega", "k"], &["m"]),
+            "unknown parameter `x`; known: k, omega (constant, folded into the code: m)"
+        );
+        let none_settable = unknown_parameter_among("x", &[], &["m", "l"]);
+        assert!(
+            none_settable.contains("no parameter that can be set")
+                && none_settable.ends_with("(constant, folded into the code: l, m)"),
+            "{none_settable}"
+        );
+        assert!(!none_settable.contains("; known:"), "{none_settable}");
+        assert_eq!(
+            unknown_parameter_among("x", &[], &[]),
+            unknown_parameter("x", &[])
+        );
     }
 }

@@ -267,7 +267,7 @@ fn a_bad_value_at_run_time_gets_the_error_the_build_gives() {
         (
             "mass",
             1.0,
-            "checked.ron:8:17: parameters: unknown parameter `mass`; known: c, g, jx, jz, k, len, lift, m",
+            "checked.ron:8:17: parameters: unknown parameter `mass`; known: c, jx, jz, k, len, lift, m (constant, folded into the code: g)",
         ),
     ];
     for (name, value, expected) in cases {

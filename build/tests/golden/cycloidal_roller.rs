@@ -211,9 +211,10 @@ impl Parameters {
                         );
                     }
                     None => {
-                        rt::parameters::checks::unknown_parameter(
+                        rt::parameters::checks::unknown_parameter_among(
                             name,
-                            &["R_b", "h", "rho", "omega", "m", "k", "free", "c", "g"],
+                            &Self::NAMES,
+                            &["R_b", "h", "rho", "g"],
                         )
                     }
                 };

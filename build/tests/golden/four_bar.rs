@@ -262,20 +262,10 @@ impl Parameters {
                         );
                     }
                     None => {
-                        rt::parameters::checks::unknown_parameter(
+                        rt::parameters::checks::unknown_parameter_among(
                             name,
-                            &[
-                                "a",
-                                "b",
-                                "c",
-                                "d",
-                                "m_crank",
-                                "m_coupler",
-                                "m_rocker",
-                                "flywheel",
-                                "torque",
-                                "g",
-                            ],
+                            &Self::NAMES,
+                            &[],
                         )
                     }
                 };

@@ -221,8 +221,9 @@ impl Parameters {
                         );
                     }
                     None => {
-                        rt::parameters::checks::unknown_parameter(
+                        rt::parameters::checks::unknown_parameter_among(
                             name,
+                            &Self::NAMES,
                             &[
                                 "l1",
                                 "l2",
@@ -242,13 +243,6 @@ impl Parameters {
                                 "bx",
                                 "by",
                                 "g",
-                                "k2",
-                                "k3",
-                                "k4",
-                                "c2",
-                                "c3",
-                                "c4",
-                                "swing",
                             ],
                         )
                     }

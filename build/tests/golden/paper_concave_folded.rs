@@ -69,7 +69,7 @@ impl Model {
                 let message = if known.contains(&name) {
                     rt::parameters::checks::constant_parameter(name)
                 } else {
-                    rt::parameters::checks::unknown_parameter(name, known)
+                    rt::parameters::checks::unknown_parameter_among(name, &[], known)
                 };
                 Err(rt::ParameterError {
                     file: "models/paper_concave.ron".to_string(),

@@ -495,12 +495,14 @@ fn simulate_takes_parameter_values_checked_as_the_file() {
             2,
             "parameter `l1` is constant (folded into the generated code)",
         ),
-        // Only the parameters `--param` can set are listed, not those folded into the code.
+        // Only the parameters `--param` can set are offered as known; those folded into the
+        // code are named as constant, and the numeric path that can set them is pointed at.
         (
             "foo=1",
             2,
-            "unknown parameter `foo`; the parameters that can be set: c2, c3, c4, k2, k3, k4, \
-             swing",
+            "unknown parameter `foo`; known: c2, c3, c4, k2, k3, k4, swing (constant, folded \
+             into the code: J1, J2, J3, J4, a1, a2, a3, bx, by, g, l1, l2, l3, l4, m1, m2, m3, \
+             m4); the numeric reference (--numeric) sets the constant ones too",
         ),
         ("k3", 2, "is not NAME=VALUE"),
     ] {

@@ -129,7 +129,7 @@ pub(super) fn plain_constructors(model: &Model, source: &str) -> String {
          Some(&(name, _)) => {{\n\
          let known: &[&str] = &[{names}];\n\
          let message = if known.contains(&name) {{ rt::parameters::checks::constant_parameter(name) }} \
-         else {{ rt::parameters::checks::unknown_parameter(name, known) }};\n\
+         else {{ rt::parameters::checks::unknown_parameter_among(name, &[], known) }};\n\
          Err(rt::ParameterError {{ file: {source:?}.to_string(), line: {}, column: {}, field: {:?}.to_string(), message }})\n\
          }}\n}}\n}}\n",
         at.line,

@@ -236,9 +236,10 @@ fn parameters_struct(model: &Model, file: &str) -> String {
         .filter(|p| p.constant)
         .map(|p| format!("({:?}, {})", p.name, location_from(&p.constant_at, file)))
         .collect();
-    let all_names: Vec<String> = model
+    let constant_names: Vec<String> = model
         .parameters
         .iter()
+        .filter(|p| p.constant)
         .map(|p| format!("{:?}", p.name))
         .collect();
     let list_at = location_from(&model.parameters_at, file);
@@ -269,7 +270,7 @@ fn parameters_struct(model: &Model, file: &str) -> String {
          _ => {{\n\
          let message = match FOLDED.iter().find(|(folded, _)| *folded == name) {{\n\
          Some(&(_, at)) => return rt::parameters::located(at, Err(rt::parameters::checks::constant_parameter(name))),\n\
-         None => rt::parameters::checks::unknown_parameter(name, &[{all_names}]),\n\
+         None => rt::parameters::checks::unknown_parameter_among(name, &Self::NAMES, &[{constant_names}]),\n\
          }};\n\
          return rt::parameters::located({list_at}, Err(message));\n\
          }}\n\
@@ -280,7 +281,7 @@ fn parameters_struct(model: &Model, file: &str) -> String {
         name = model.name,
         names = names.join(", "),
         to_values = to_values.join(", "),
-        all_names = all_names.join(", "),
+        constant_names = constant_names.join(", "),
         folded = folded.join(", "),
     )
 }

@@ -89,8 +89,14 @@ pub(super) fn parameters(
     }
     for (name, value) in options.overrides {
         let Some(&i) = index.get(name.as_str()) else {
-            let known: Vec<&str> = list.iter().map(|p| p.name.as_str()).collect();
-            return Err(at.error("parameters", checks::unknown_parameter(name, &known)));
+            let names = |constant: bool| -> Vec<&str> {
+                out.iter()
+                    .filter(|p| p.constant == constant)
+                    .map(|p| p.name.as_str())
+                    .collect()
+            };
+            let message = checks::unknown_parameter_among(name, &names(false), &names(true));
+            return Err(at.error("parameters", message));
         };
         let path = format!("parameters[{i}]");
         if out[i].constant {
