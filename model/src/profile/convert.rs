@@ -7,7 +7,7 @@ use super::literal::number;
 use super::parse::{BinOp, Node, NodeKind};
 use super::{
     ALLOWED_FUNCTIONS, ALLOWED_SUMMARY, ExprError, MAX_POWI, MAX_TREE_DEPTH, Scalar, apply,
-    function_by_name,
+    function_by_name, shown,
 };
 
 /// The [`Scalar`] that `tree`, parsed from `source`, denotes.
@@ -145,7 +145,7 @@ impl<'a> Converter<'a> {
                 format!(
                     "field access `.{}` is not allowed; math functions need parentheses, e.g. \
                      `x.sin()`",
-                    self.text(*member)
+                    shown(self.text(*member))
                 ),
             )),
             NodeKind::Call { function, args } => self.call(function, args, at),
@@ -165,7 +165,7 @@ impl<'a> Converter<'a> {
         if let Some(value) = named_constant(&names) {
             return Ok(Value::constant(value));
         }
-        let written = names.join("::");
+        let written = shown(&names.join("::"));
         let message = if names.len() == 1 && function_by_name(&written).is_some() {
             format!("`{written}` is a function: call it, e.g. `{written}(x)` or `x.{written}()`")
         } else {
@@ -300,7 +300,10 @@ impl<'a> Converter<'a> {
 fn unknown_function(at: usize, name: &str) -> ExprError {
     ExprError::new(
         at,
-        format!("`{name}` is not a known math function; allowed: {ALLOWED_FUNCTIONS}"),
+        format!(
+            "`{}` is not a known math function; allowed: {ALLOWED_FUNCTIONS}",
+            shown(name)
+        ),
     )
 }
 
@@ -326,9 +329,6 @@ fn function_call_name<'a>(names: &[&'a str]) -> Option<&'a str> {
     (prefix_ok && known).then_some(*last)
 }
 
-/// Longest literal text quoted in full in a message; longer ones are elided.
-const SHOWN: usize = 40;
-
 /// A numeric literal, plain or suffixed `f64`, that must be finite.
 fn literal(text: &str, at: usize) -> Result<Value, ExprError> {
     let Some(n) = number(text) else {
@@ -353,14 +353,6 @@ fn literal(text: &str, at: usize) -> Result<Value, ExprError> {
             at,
             format!("the constant `{}` is not a finite f64", shown(text)),
         ))
-    }
-}
-
-/// `text`, or its start and its length when it is long.
-fn shown(text: &str) -> String {
-    match text.char_indices().nth(SHOWN) {
-        Some((cut, _)) => format!("{}… ({} bytes)", &text[..cut], text.len()),
-        None => text.to_string(),
     }
 }
 

@@ -308,6 +308,18 @@ const ALLOWED_FUNCTIONS: &str =
 const ALLOWED_SUMMARY: &str = "use numbers, the variable, PI, E, + - * /, parentheses and \
      math functions";
 
+/// Longest text (a name, a literal, a token) an error message quotes in full.
+const SHOWN: usize = 40;
+
+/// `text` for an error message: itself, or its start and its length when it is long (a
+/// model file may hold a megabyte-long name or number).
+fn shown(text: &str) -> String {
+    match text.char_indices().nth(SHOWN) {
+        Some((cut, _)) => format!("{}… ({} bytes)", &text[..cut], text.len()),
+        None => text.to_string(),
+    }
+}
+
 fn function_by_name(name: &str) -> Option<Func> {
     FUNCTIONS.iter().find(|(n, _)| *n == name).map(|(_, f)| *f)
 }

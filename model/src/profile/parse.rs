@@ -16,9 +16,9 @@
 //! expression is long (a sum of 1000 terms), which the conversion bounds by
 //! [`super::MAX_TREE_DEPTH`].
 
-use super::ExprError;
 use super::lex::{Kind, Token};
 use super::literal::number;
+use super::{ExprError, shown};
 
 /// Words that are neither a member name nor a path segment after `::`: the literals `true`
 /// and `false`, `_`, and the path keywords (the screen has rejected the other keywords).
@@ -156,7 +156,7 @@ impl Parser<'_> {
             token.start,
             format!(
                 "not a valid expression: {expected}, found `{}`",
-                token.text(self.source)
+                shown(token.text(self.source))
             ),
         )
     }

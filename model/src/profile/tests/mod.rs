@@ -243,3 +243,61 @@ fn integer_literals_of_every_base_have_their_values() {
         assert_eq!(parse_x(&source), Scalar::Const(want), "{source}");
     }
 }
+
+/// Hostile inputs are refused with their limit's message at the offending byte, within a
+/// small stack: the screen refuses deep nesting before the parser recurses, the lexer keeps
+/// no more tokens than the limit, and the conversion stops at the tree depth limit. Run on a
+/// thread of 512 KiB, a quarter of a default thread's stack.
+#[test]
+fn hostile_inputs_are_refused_in_a_small_stack() {
+    let n = 100_000;
+    let cases: Vec<(String, usize, String)> = vec![
+        // The 33rd `(` (offset 32) is one level too deep.
+        (
+            format!("{}x{}", "(".repeat(n), ")".repeat(n)),
+            32,
+            format!("more than {MAX_NESTING} levels"),
+        ),
+        (
+            "-".repeat(n) + "x",
+            32,
+            format!("more than {MAX_NESTING} levels"),
+        ),
+        // `sin(` is 4 bytes: the 33rd `(` is at 32·4 + 3.
+        (
+            format!("{}x{}", "sin(".repeat(n), ")".repeat(n)),
+            131,
+            format!("more than {MAX_NESTING} levels"),
+        ),
+        // A megabyte of `x+`: the 2001st token, at byte 2000, is one too many.
+        (
+            "x+".repeat(1 << 19) + "x",
+            2000,
+            format!("more than {MAX_TOKENS} tokens"),
+        ),
+        // 600 additions written without parentheses: a left-deep tree whose 257th level is
+        // the sum starting at byte 0.
+        (
+            "x".to_string() + &" + x".repeat(600),
+            0,
+            format!("more than {MAX_TREE_DEPTH} operations"),
+        ),
+        // A chain of 600 method calls, as deep.
+        (
+            "x".to_string() + &".sin()".repeat(600),
+            0,
+            format!("more than {MAX_TREE_DEPTH} operations"),
+        ),
+    ];
+    let outcome = std::thread::Builder::new()
+        .stack_size(512 * 1024)
+        .spawn(move || {
+            for (source, offset, text) in cases {
+                let e = error_x(&source);
+                assert_eq!(e.offset, offset, "{}…: {e}", &source[..20]);
+                assert!(e.message.contains(&text), "{}…: {e}", &source[..20]);
+            }
+        })
+        .map(std::thread::JoinHandle::join);
+    assert!(matches!(outcome, Ok(Ok(()))), "{outcome:?}");
+}
