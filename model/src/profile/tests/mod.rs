@@ -121,6 +121,30 @@ fn tree_shape_follows_rust_precedence() {
     );
 }
 
+/// Rust's grammar where it is easy to get wrong: a method on a float literal binds tighter
+/// than the sign before it (`-2.0.powi(2)` is −4, not 4), `-` and `/` associate to the left,
+/// and a sign applies to a product's first factor only. Trees written by hand.
+#[test]
+fn signs_methods_and_associativity_follow_rust() {
+    let b = Box::new;
+    let (x, two) = (|| b(Scalar::Var), || b(Scalar::Const(2.0)));
+    assert_eq!(
+        parse_x("-2.0.powi(2)"),
+        Scalar::Neg(b(Scalar::Powi(two(), 2)))
+    );
+    assert_eq!(parse_x("-2.0.powi(2)").eval(0.0), -4.0);
+    assert_eq!(
+        parse_x("x - x - 2"),
+        Scalar::Sub(b(Scalar::Sub(x(), x())), two())
+    );
+    assert_eq!(
+        parse_x("x / x / 2"),
+        Scalar::Div(b(Scalar::Div(x(), x())), two())
+    );
+    assert_eq!(parse_x("-x * 2"), Scalar::Mul(b(Scalar::Neg(x())), two()));
+    assert_eq!(parse_x("2.sqrt()"), Scalar::Call(Func::Sqrt, two()));
+}
+
 /// (source, expected byte offset, text the message must contain).
 const BAD: &[(&str, usize, &str)] = &[
     ("0.5*y + x", 4, "only variable allowed here is `x`"),
