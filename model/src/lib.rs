@@ -6,8 +6,9 @@
 //! - [`schema`]: the RON file format, parsing and validation with file/line/field errors.
 //! - [`model`]: the validated model (bodies, joints, markers, contacts, loops, initial state,
 //!   settings, run-time parameters).
-//! - [`profile`]: one-variable expressions (cam profiles, drives, joint loads) parsed with
-//!   `syn`, and functions given by data ([`profile::Tabulated`]).
+//! - [`profile`]: one-variable expressions (cam profiles, drives, joint loads) in Rust
+//!   syntax, parsed by the crate's own parser, and functions given by data
+//!   ([`profile::Tabulated`]).
 //! - [`design`]: cams designed from a follower's motion law (the envelope construction).
 //! - [`jet`]: second-order forward-mode differentiation of those expressions.
 //! - [`samples`]: a profile's polar radius and curvature along its range, for the checks that

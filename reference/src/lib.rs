@@ -8,7 +8,7 @@
 //! the generated code against; and it lets a model file be simulated without rebuilding (the
 //! command line's `camchain simulate path.ron`).
 //!
-//! It depends on the model parser (`camchain-codegen`: syn, ron, serde), which is why it is a
+//! It depends on the model parser (`camchain-model`: ron, serde), which is why it is a
 //! crate of its own and not part of the runtime a simulating program links. A program reaches
 //! it as `camchain::reference` with the `camchain` facade's `reference` feature.
 //!
