@@ -222,10 +222,13 @@ pub(super) fn line_column(source: &str, offset: usize) -> (usize, usize) {
 }
 
 /// The byte range `start..end` of a token.
+#[cfg(test)]
 pub(super) type Span = (usize, usize);
 
 /// Byte ranges of the token ending last at or before `offset` and of the token starting at
-/// `offset` (comments and whitespace are not tokens).
+/// `offset` (comments and whitespace are not tokens). Test-only: the reader's errors carry
+/// these ranges; the comparison with ron locates ron's errors with it.
+#[cfg(test)]
 pub(super) fn tokens_around(source: &str, offset: usize) -> (Option<Span>, Option<Span>) {
     let tokens = tokenize(source);
     let before = tokens
@@ -240,7 +243,9 @@ pub(super) fn tokens_around(source: &str, offset: usize) -> (Option<Span>, Optio
     (before, at)
 }
 
-/// Byte offset of the 1-based (line, column) position; clamped to the text.
+/// Byte offset of the 1-based (line, column) position; clamped to the text (test-only, as
+/// [`tokens_around`]).
+#[cfg(test)]
 pub(super) fn byte_offset(source: &str, line: usize, column: usize) -> usize {
     let line_start = if line <= 1 {
         0
