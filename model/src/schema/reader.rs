@@ -28,7 +28,11 @@
 //! sequence can make it panic, and each token costs time linear in its length.
 
 mod de;
+#[cfg(test)]
+mod differential;
 mod error;
+#[cfg(test)]
+mod generate;
 mod lexer;
 mod number;
 #[cfg(test)]
@@ -45,4 +49,16 @@ pub(super) const MAX_DEPTH: usize = 128;
 /// Reads one value of type `T` from the whole of `source` (after its `#![…]` attributes).
 pub(super) fn from_str<'s, T: Deserialize<'s>>(source: &'s str) -> Result<T, Error> {
     de::Reader::new(source).read()
+}
+
+/// First character of an identifier. ron uses Unicode's XID_Start; the standard library's
+/// Alphabetic property is the same for every ASCII character and close elsewhere (the
+/// schema's names are ASCII, so any other identifier is refused either way).
+fn is_ident_start(c: char) -> bool {
+    c == '_' || c.is_alphabetic()
+}
+
+/// Further characters of an identifier (XID_Continue in ron; see [`is_ident_start`]).
+fn is_ident_continue(c: char) -> bool {
+    c == '_' || c.is_alphanumeric()
 }

@@ -298,8 +298,8 @@ struct Name<'a>(&'a str);
 impl fmt::Display for Name<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut chars = self.0.chars();
-        let plain = chars.next().is_some_and(super::lexer::is_ident_start)
-            && chars.all(super::lexer::is_ident_continue);
+        let plain =
+            chars.next().is_some_and(super::is_ident_start) && chars.all(super::is_ident_continue);
         if plain || self.0.is_empty() {
             write!(f, "`{}`", self.0)
         } else {

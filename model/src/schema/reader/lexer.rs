@@ -8,6 +8,7 @@
 //! in its length.
 
 use super::error::{Code, Error, Place};
+use super::{is_ident_continue, is_ident_start};
 use std::borrow::Cow;
 
 /// One token.
@@ -59,18 +60,6 @@ fn is_whitespace(c: char) -> bool {
             | '\u{2028}'
             | '\u{2029}'
     )
-}
-
-/// First character of an identifier. ron uses Unicode's XID_Start; the standard library's
-/// Alphabetic property is the same for every ASCII character and close elsewhere (the
-/// schema's names are ASCII, so any other identifier is refused either way).
-pub(super) fn is_ident_start(c: char) -> bool {
-    c == '_' || c.is_alphabetic()
-}
-
-/// Further characters of an identifier (XID_Continue in ron; see [`is_ident_start`]).
-pub(super) fn is_ident_continue(c: char) -> bool {
-    c == '_' || c.is_alphanumeric()
 }
 
 /// Characters of a raw identifier after `r#`.
