@@ -29,12 +29,22 @@
 //! )
 //! ```
 //!
-//! Optional values are written without `Some(...)` (ron's `implicit_some` extension is on)
-//! and integers are accepted where numbers are expected. Parsing happens in two stages: ron
-//! deserialises into mirror types (syntax, unknown/missing fields, wrong types, unknown
-//! variants — located by ron), then the validator checks physics and names. Validation
-//! errors are located with a small RON scanner that maps the dotted field path
-//! (`bodies[1].mass`) back to a line and column, because serde values carry no positions.
+//! Optional values are written without `Some(...)` (RON's `implicit_some` extension is
+//! on) and integers are accepted where numbers are expected. Parsing happens in two stages:
+//! a RON reader (`schema/reader.rs`, written for this crate) deserialises into mirror types
+//! (syntax, unknown/missing fields, wrong types, unknown variants), then the validator
+//! checks physics and names.
+//!
+//! The reader is a serde `Deserializer` over the text's tokens that reads what ron 0.12
+//! reads, with ron's messages (a test compares the two on every model file of the
+//! repository and on random model-shaped texts). It is hand-written for two reasons: ron
+//! brought four crates (ron, bitflags, typeid, unicode-ident) into every program that reads
+//! model files at run time (the facade's `reference` feature), and its errors only said
+//! where its cursor stopped, while the reader's carry the byte range of the offending
+//! token and the end of the value before it, which the locator turns into the message's
+//! line, column and quoted token. Validation errors are located with a small RON scanner
+//! that maps the dotted field path (`bodies[1].mass`) back to a line and column, because
+//! serde values carry no positions.
 
 mod csv;
 mod raw;
@@ -839,6 +849,72 @@ mod tests {
             "colour",
         );
         assert_eq!(e.column, 24);
+    }
+
+    #[test]
+    fn a_missing_top_level_field_is_reported_at_the_opening_of_the_model() {
+        // As for a nested struct; ron stopped at the closing `)` (line 4).
+        let e = error_of("// a model without bodies\n(\n    name: \"x\",\n)\n");
+        assert_eq!(
+            (e.field.as_str(), e.line, e.column),
+            ("bodies", 2, 1),
+            "{e}"
+        );
+        assert!(e.message.contains("missing field named `bodies`"), "{e}");
+    }
+
+    #[test]
+    fn a_float_with_a_stray_suffix_is_reported_at_it() {
+        // ron read `5`, then wanted a comma before `u8`, and the error was moved back after
+        // `t_end:` on the line before, as for a missing comma.
+        let e = assert_rejected(
+            "simulation: (t_end: 5, integrator: Rk4)",
+            "simulation: (t_end:\n        5u8, integrator: Rk4)",
+            "simulation.t_end",
+            37,
+            "Expected float, found `5u8`",
+        );
+        assert_eq!(e.column, 9);
+    }
+
+    #[test]
+    fn an_invalid_escape_is_reported_at_its_backslash() {
+        // ron pointed at the start of the string (or of the text after the escape before).
+        let e = assert_rejected(
+            "\"test_chain\"",
+            r#""test\qchain""#,
+            "name",
+            3,
+            "Unknown escape character",
+        );
+        assert_eq!(e.column, 16);
+    }
+
+    #[test]
+    fn an_unclosed_block_comment_is_reported_where_it_opens() {
+        // ron stopped at the last `*` or `/` before the end of the text (line 34, in the
+        // profile `0.5*x - x*x`).
+        let e = assert_rejected(
+            "    name: \"test_chain\",\n",
+            "    /* name: \"test_chain\",\n",
+            "<top level>",
+            3,
+            "Unclosed block comment",
+        );
+        assert_eq!(e.column, 5);
+    }
+
+    #[test]
+    fn an_unknown_field_is_named_once() {
+        // The located message used to append ", found `colour`" after ron's, which names it.
+        let e = assert_rejected(
+            "mass: 0.5,",
+            "mass: 0.5, colour: 3,",
+            "bodies[1].colour",
+            21,
+            "Unexpected field named `colour` in `Body`, expected one of `name`",
+        );
+        assert_eq!(e.message.matches("colour").count(), 1, "{e}");
     }
 
     #[test]
