@@ -84,19 +84,17 @@ impl<'s> Reader<'s> {
                     end: token.end,
                     before,
                 };
+                Ok(token)
             }
             Err(e) => {
+                // The lexer's error, placed after the last token consumed.
                 let mut e = e.clone();
                 if let Some(place) = &mut e.place {
                     place.before = before;
                     self.mark = *place;
                 }
-                return Err(e);
+                Err(e)
             }
-        }
-        match &self.ahead[0] {
-            Ok(token) => Ok(token),
-            Err(e) => Err(e.clone()),
         }
     }
 
