@@ -29,16 +29,27 @@
 //! )
 //! ```
 //!
-//! Optional values are written without `Some(...)` (ron's `implicit_some` extension is on)
-//! and integers are accepted where numbers are expected. Parsing happens in two stages: ron
-//! deserialises into mirror types (syntax, unknown/missing fields, wrong types, unknown
-//! variants — located by ron), then the validator checks physics and names. Validation
-//! errors are located with a small RON scanner that maps the dotted field path
-//! (`bodies[1].mass`) back to a line and column, because serde values carry no positions.
+//! Optional values are written without `Some(...)` (RON's `implicit_some` extension is
+//! on) and integers are accepted where numbers are expected. Parsing happens in two stages:
+//! a RON reader (`schema/reader.rs`, written for this crate) deserialises into mirror types
+//! (syntax, unknown/missing fields, wrong types, unknown variants), then the validator
+//! checks physics and names.
+//!
+//! The reader is a serde `Deserializer` over the text's tokens that reads what ron 0.12
+//! reads, with ron's messages (a test compares the two on every model file of the
+//! repository and on random model-shaped texts). It is hand-written for two reasons: ron
+//! brought four crates (ron, bitflags, typeid, unicode-ident) into every program that reads
+//! model files at run time (the facade's `reference` feature), and its errors only said
+//! where its cursor stopped, while the reader's carry the byte range of the offending
+//! token and the end of the value before it, which the locator turns into the message's
+//! line, column and quoted token. Validation errors are located with a small RON scanner
+//! that maps the dotted field path (`bodies[1].mass`) back to a line and column, because
+//! serde values carry no positions.
 
 mod csv;
 mod raw;
 mod read;
+mod reader;
 mod scan;
 mod validate;
 
@@ -47,7 +58,6 @@ pub use validate::ranges;
 
 use crate::error::ModelError;
 use crate::model::{Model, ParameterMode};
-use ron::extensions::Extensions;
 use scan::Document;
 use std::path::Path;
 
@@ -109,8 +119,7 @@ pub fn parse_model_from(
 ) -> Result<Model, ModelError> {
     let source = without_bom(source);
     let at = Locator::new(file, source);
-    let options = ron::Options::default().with_default_extension(Extensions::IMPLICIT_SOME);
-    let parsed: raw::Model = options.from_str(source).map_err(|e| at.ron_error(&e))?;
+    let parsed: raw::Model = reader::from_str(source).map_err(|e| at.syntax_error(&e))?;
     let stem = file
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -204,66 +213,55 @@ impl<'a> Locator<'a> {
         self.at_offset(position, field, message)
     }
 
-    /// A ron syntax or type error, with the field path at its position.
+    /// A syntax or type error of the reader, with the field path at its position.
     ///
-    /// ron's span often starts at the whitespace before the offending token; the position is
-    /// moved onto it, and the token is quoted (`Expected comma, found \`kg\``). Where ron
-    /// only notices a missing `,` or closing bracket at the first token of a later line, the
-    /// error points just after the last value before it, where the character is missing. A
-    /// missing field is reported at the opening of the struct that lacks it.
-    fn ron_error(&self, error: &ron::error::SpannedError) -> ModelError {
-        use ron::Error as E;
-        let start = error.span.start;
-        let offset = scan::byte_offset(self.source, start.line, start.col);
-        let mut offset =
-            offset + (self.source[offset..].len() - self.source[offset..].trim_start().len());
+    /// The position is the offending token's, and the token is quoted (`Expected comma,
+    /// found \`kg\``). Where a `,` or closing bracket is missing before a token on a later
+    /// line, the error points just after the last value before it, where the character is
+    /// missing. A missing field is reported at the opening of the struct that lacks it.
+    fn syntax_error(&self, error: &reader::Error) -> ModelError {
+        use reader::Code;
+        let place = error.place.unwrap_or(reader::Place {
+            start: self.source.len(),
+            end: self.source.len(),
+            before: self.source.len(),
+        });
+        let clamp = |offset: usize| offset.min(self.source.len());
+        let (start, end, before) = (clamp(place.start), clamp(place.end), clamp(place.before));
+        let mut offset = start;
+        let mut field_offset = start;
         let mut message = error.code.to_string();
-        let (before, at) = scan::tokens_around(self.source, offset);
-        let missing_delimiter = matches!(
-            error.code,
-            E::ExpectedComma
-                | E::ExpectedStructLikeEnd
-                | E::ExpectedArrayEnd
-                | E::ExpectedMapEnd
-                | E::ExpectedOptionEnd
-        );
-        let mut field_offset = offset;
-        match (&error.code, before, at) {
-            (_, Some((_, end)), _)
-                if missing_delimiter && self.source[end..offset].contains('\n') =>
-            {
-                // `mass: 0.5` ⏎ `com: …`: the comma is missing after `0.5`, not before `com`.
-                offset = end;
-                field_offset = end - 1;
-                message = match self.document.group_at(field_offset) {
-                    Some(open) if !matches!(error.code, E::ExpectedComma) => {
-                        let (line, column) = scan::line_column(self.source, open);
-                        format!(
-                            "{message} after this value: the group opened at {line}:{column} \
-                             is not closed"
-                        )
-                    }
-                    _ => format!("{message} after this value"),
-                };
-            }
-            (E::ExpectedStringEnd, _, _) => {
+        let gap = self.source.get(before..start).unwrap_or("");
+        if error.code.is_missing_delimiter() && before > 0 && gap.contains('\n') {
+            // `mass: 0.5` ⏎ `com: …`: the comma is missing after `0.5`, not before `com`.
+            offset = before;
+            field_offset = before - 1;
+            message = match self.document.group_at(field_offset) {
+                Some(open) if error.code != Code::ExpectedComma => {
+                    let (line, column) = scan::line_column(self.source, open);
+                    format!(
+                        "{message} after this value: the group opened at {line}:{column} is \
+                         not closed"
+                    )
+                }
+                _ => format!("{message} after this value"),
+            };
+        } else {
+            if error.code == Code::ExpectedStringEnd {
                 message = format!("{message}: this string has no closing `\"`");
             }
-            (E::MissingStructField { .. }, _, _) => {}
-            (_, before, Some((token_start, token_end))) => {
-                let token = &self.source[token_start..token_end];
-                if token.chars().count() <= 40 && !message.contains("found") {
-                    message = format!("{message}, found `{token}`");
-                }
-                if let (E::ExpectedComma, Some((_, end))) = (&error.code, before) {
-                    // A stray token after a value belongs to that value's field.
-                    field_offset = end - 1;
-                }
+            let token = self.source.get(start..end).unwrap_or("");
+            let quotable = !token.is_empty() && token.chars().count() <= 40;
+            if quotable && !error.code.names_the_token() && !message.contains("found") {
+                message = format!("{message}, found `{token}`");
             }
-            _ => {}
+            if error.code == Code::ExpectedComma && before > 0 {
+                // A stray token after a value belongs to that value's field.
+                field_offset = before - 1;
+            }
         }
         let mut field = self.document.path_at(field_offset);
-        if let E::MissingStructField { field: missing, .. } = &error.code {
+        if let Code::MissingStructField { field: missing, .. } = &error.code {
             if let Some(open) = self.document.locate(&field).filter(|_| !field.is_empty()) {
                 offset = open;
             }
@@ -851,6 +849,72 @@ mod tests {
             "colour",
         );
         assert_eq!(e.column, 24);
+    }
+
+    #[test]
+    fn a_missing_top_level_field_is_reported_at_the_opening_of_the_model() {
+        // As for a nested struct; ron stopped at the closing `)` (line 4).
+        let e = error_of("// a model without bodies\n(\n    name: \"x\",\n)\n");
+        assert_eq!(
+            (e.field.as_str(), e.line, e.column),
+            ("bodies", 2, 1),
+            "{e}"
+        );
+        assert!(e.message.contains("missing field named `bodies`"), "{e}");
+    }
+
+    #[test]
+    fn a_float_with_a_stray_suffix_is_reported_at_it() {
+        // ron read `5`, then wanted a comma before `u8`, and the error was moved back after
+        // `t_end:` on the line before, as for a missing comma.
+        let e = assert_rejected(
+            "simulation: (t_end: 5, integrator: Rk4)",
+            "simulation: (t_end:\n        5u8, integrator: Rk4)",
+            "simulation.t_end",
+            37,
+            "Expected float, found `5u8`",
+        );
+        assert_eq!(e.column, 9);
+    }
+
+    #[test]
+    fn an_invalid_escape_is_reported_at_its_backslash() {
+        // ron pointed at the start of the string (or of the text after the escape before).
+        let e = assert_rejected(
+            "\"test_chain\"",
+            r#""test\qchain""#,
+            "name",
+            3,
+            "Unknown escape character",
+        );
+        assert_eq!(e.column, 16);
+    }
+
+    #[test]
+    fn an_unclosed_block_comment_is_reported_where_it_opens() {
+        // ron stopped at the last `*` or `/` before the end of the text (line 34, in the
+        // profile `0.5*x - x*x`).
+        let e = assert_rejected(
+            "    name: \"test_chain\",\n",
+            "    /* name: \"test_chain\",\n",
+            "<top level>",
+            3,
+            "Unclosed block comment",
+        );
+        assert_eq!(e.column, 5);
+    }
+
+    #[test]
+    fn an_unknown_field_is_named_once() {
+        // The located message used to append ", found `colour`" after ron's, which names it.
+        let e = assert_rejected(
+            "mass: 0.5,",
+            "mass: 0.5, colour: 3,",
+            "bodies[1].colour",
+            21,
+            "Unexpected field named `colour` in `Body`, expected one of `name`",
+        );
+        assert_eq!(e.message.matches("colour").count(), 1, "{e}");
     }
 
     #[test]

@@ -1,8 +1,8 @@
 //! The model file exactly as written: serde types that mirror the RON format one to one.
 //!
 //! Defaults for optional fields live here; everything physical is checked later in
-//! [`super::validate`]. The type names appear in ron's messages ("unexpected field named
-//! `foo` in `Joint`"), so they are named after the file's concepts.
+//! [`super::validate`]. The type names appear in the reader's messages ("Unexpected field
+//! named `foo` in `Joint`"), so they are named after the file's concepts.
 
 use camchain_runtime::kinds::Kind;
 use camchain_runtime::{IntegratorKind, LoopKind};

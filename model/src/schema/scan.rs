@@ -222,10 +222,13 @@ pub(super) fn line_column(source: &str, offset: usize) -> (usize, usize) {
 }
 
 /// The byte range `start..end` of a token.
+#[cfg(test)]
 pub(super) type Span = (usize, usize);
 
 /// Byte ranges of the token ending last at or before `offset` and of the token starting at
-/// `offset` (comments and whitespace are not tokens).
+/// `offset` (comments and whitespace are not tokens). Test-only: the reader's errors carry
+/// these ranges; the comparison with ron locates ron's errors with it.
+#[cfg(test)]
 pub(super) fn tokens_around(source: &str, offset: usize) -> (Option<Span>, Option<Span>) {
     let tokens = tokenize(source);
     let before = tokens
@@ -240,7 +243,9 @@ pub(super) fn tokens_around(source: &str, offset: usize) -> (Option<Span>, Optio
     (before, at)
 }
 
-/// Byte offset of the 1-based (line, column) position; clamped to the text.
+/// Byte offset of the 1-based (line, column) position; clamped to the text (test-only, as
+/// [`tokens_around`]).
+#[cfg(test)]
 pub(super) fn byte_offset(source: &str, line: usize, column: usize) -> usize {
     let line_start = if line <= 1 {
         0
@@ -425,7 +430,7 @@ fn tokenize(source: &str) -> Vec<Token> {
     while i < bytes.len() {
         let start = i;
         let (kind, end) = match bytes[i] {
-            b if b.is_ascii_whitespace() => (None, i + 1),
+            _ if blank_len(bytes, i) > 0 => (None, i + blank_len(bytes, i)),
             b'/' if bytes.get(i + 1) == Some(&b'/') => (None, line_comment_end(bytes, i)),
             b'/' if bytes.get(i + 1) == Some(&b'*') => (None, block_comment_end(bytes, i)),
             b'(' | b'[' | b'{' => (Some(Kind::Open), i + 1),
@@ -515,13 +520,34 @@ fn raw_string_end(bytes: &[u8], start: usize) -> usize {
     bytes.len()
 }
 
+/// Length in bytes of the whitespace character at `i` (0 if there is none): RON's
+/// whitespace, which has a few Unicode marks besides ASCII's (the line and paragraph
+/// separators, the left-to-right and right-to-left marks, NEL).
+fn blank_len(bytes: &[u8], i: usize) -> usize {
+    const UNICODE: [&[u8]; 5] = [
+        "\u{85}".as_bytes(),
+        "\u{200E}".as_bytes(),
+        "\u{200F}".as_bytes(),
+        "\u{2028}".as_bytes(),
+        "\u{2029}".as_bytes(),
+    ];
+    match bytes.get(i) {
+        Some(b' ' | b'\t' | b'\n' | b'\r' | b'\x0B' | b'\x0C') => 1,
+        Some(_) => UNICODE
+            .iter()
+            .find(|blank| bytes[i..].starts_with(blank))
+            .map_or(0, |blank| blank.len()),
+        None => 0,
+    }
+}
+
 /// End of a run of non-delimiter characters (identifier, number, `-inf`…).
 fn atom_end(bytes: &[u8], start: usize) -> usize {
     let mut i = start;
     while i < bytes.len() {
         let b = bytes[i];
         let comment = b == b'/' && matches!(bytes.get(i + 1), Some(b'/' | b'*'));
-        if b.is_ascii_whitespace() || b"()[]{},:\"".contains(&b) || comment {
+        if blank_len(bytes, i) > 0 || b"()[]{},:\"".contains(&b) || comment {
             break;
         }
         i += 1;
@@ -602,6 +628,16 @@ mod tests {
             Some("initial.hold[0]")
         );
         assert_eq!(path_at(1, "comment").as_deref(), Some(""));
+    }
+
+    #[test]
+    fn unicode_blanks_are_not_part_of_names() {
+        // RON reads U+2028 and U+200E as whitespace; a name next to them is the name alone.
+        let text = "(\u{2028}bodies\u{200E}: [(mass\u{2028}:\u{200E}1)])";
+        let doc = Document::parse(text);
+        let mass = text.find("1)").unwrap_or(0);
+        assert_eq!(doc.path_at(mass), "bodies[0].mass");
+        assert_eq!(doc.locate("bodies[0].mass"), Some(mass));
     }
 
     #[test]
