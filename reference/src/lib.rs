@@ -8,8 +8,8 @@
 //! the generated code against; and it lets a model file be simulated without rebuilding (the
 //! command line's `camchain simulate path.ron`).
 //!
-//! It depends on the model parser (`camchain-model`: ron, serde), which is why it is a
-//! crate of its own and not part of the runtime a simulating program links. A program reaches
+//! It depends on the model file's reader (`camchain-model`, with its own RON reader and
+//! expression parser, and serde), which is why it is a crate of its own and not part of the runtime a simulating program links. A program reaches
 //! it as `camchain::reference` with the `camchain` facade's `reference` feature.
 //!
 //! ```no_run
