@@ -83,10 +83,7 @@ pub enum RootChoice {
 const SCAN_STEPS: usize = 128;
 
 /// Assembles the model's own initial guess at t0, with the report.
-pub(crate) fn assemble<D: Dynamics + ?Sized>(
-    model: &D,
-    t0: f64,
-) -> Result<(State, AssemblyReport), SimError> {
+pub(crate) fn assemble(model: &dyn Dynamics, t0: f64) -> Result<(State, AssemblyReport), SimError> {
     let initial = &model.info().initial;
     assemble_from(model, t0, (&initial.q, &initial.qd), &initial.hold)
 }
@@ -94,8 +91,8 @@ pub(crate) fn assemble<D: Dynamics + ?Sized>(
 /// A consistent state at `t` from (q, q̇) with nothing held (what
 /// [`Simulate::state_at`](crate::Simulate::state_at) returns, and what a one-sided run
 /// restarts from at every lift-off and landing): [`assemble_from`] without its report.
-pub(crate) fn state_at<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn state_at(
+    model: &dyn Dynamics,
     t: f64,
     (q, qd): (&[f64], &[f64]),
 ) -> Result<State, SimError> {
@@ -106,8 +103,8 @@ pub(crate) fn state_at<D: Dynamics + ?Sized>(
 /// A consistent state at t0 from (q, q̇): held and driven coordinates keep their values, one
 /// coordinate per contact is solved from h = 0 (nearest root for one contact) and the
 /// velocities of the solved ones from J q̇ = 0 (16).
-pub(crate) fn assemble_from<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn assemble_from(
+    model: &dyn Dynamics,
     t0: f64,
     (q, qd): (&[f64], &[f64]),
     hold: &[bool],
@@ -167,8 +164,8 @@ fn restrict(ws: &Workspace, driven: &[bool], rows: &[usize]) -> Workspace {
 
 /// The values that differ between the guess and the assembled state (beyond a relative
 /// 1e-12, round-off of Newton's last step).
-fn changes<D: Dynamics + ?Sized>(
-    model: &D,
+fn changes(
+    model: &dyn Dynamics,
     (q, qd): (&[f64], &[f64]),
     (q_new, qd_new): (&[f64], &[f64]),
     driven: &[bool],
@@ -204,7 +201,7 @@ fn changes<D: Dynamics + ?Sized>(
 
 /// The model's length scale for Newton's tolerance: the largest coordinate of a contact
 /// point (ground frame) at q.
-fn length_scale<D: Dynamics + ?Sized>(model: &D, q: &[f64]) -> f64 {
+fn length_scale(model: &dyn Dynamics, q: &[f64]) -> f64 {
     let mut contacts = vec![ContactGeometry::default(); model.info().n_contacts()];
     model.contact_geometry(q, &vec![0.0; q.len()], &mut contacts);
     contacts
@@ -214,11 +211,7 @@ fn length_scale<D: Dynamics + ?Sized>(model: &D, q: &[f64]) -> f64 {
         .fold(1.0_f64, |m, x| m.max(x.abs()))
 }
 
-fn validate_model<D: Dynamics + ?Sized>(
-    model: &D,
-    driven: &[bool],
-    t0: f64,
-) -> Result<(), SimError> {
+fn validate_model(model: &dyn Dynamics, driven: &[bool], t0: f64) -> Result<(), SimError> {
     let info = model.info();
     let (n, nc) = (info.n(), info.n_constraints());
     let initial = &info.initial;
@@ -250,8 +243,8 @@ fn validate_model<D: Dynamics + ?Sized>(
 /// at the guess ([`independent_rows`]) are left out; at the solution the rank is checked
 /// again (a guess at a singular position looks redundant without being so) and the rows
 /// left out must hold there too.
-fn assemble_positions<D: Dynamics + ?Sized>(
-    model: &D,
+fn assemble_positions(
+    model: &dyn Dynamics,
     ws: &mut Workspace,
     driven: &[bool],
     hold: &[bool],
@@ -293,8 +286,8 @@ fn assemble_positions<D: Dynamics + ?Sized>(
 }
 
 /// Newton on the rows the workspace solves, from its q (h and J evaluated there).
-fn solve_rows<D: Dynamics + ?Sized>(
-    model: &D,
+fn solve_rows(
+    model: &dyn Dynamics,
     ws: &mut Workspace,
     solvable: &[bool],
     t0: f64,
@@ -326,12 +319,7 @@ fn solve_rows<D: Dynamics + ?Sized>(
 }
 
 /// The error of a failed assembly: with loops, the equation furthest from closing, named.
-fn open_constraint<D: Dynamics + ?Sized>(
-    model: &D,
-    ws: &mut Workspace,
-    t0: f64,
-    error: SimError,
-) -> SimError {
+fn open_constraint(model: &dyn Dynamics, ws: &mut Workspace, t0: f64, error: SimError) -> SimError {
     let info = model.info();
     if info.loops.is_empty() {
         return error;
@@ -363,11 +351,7 @@ fn worst(h: &[f64], rows: impl Iterator<Item = usize>) -> (usize, f64) {
 
 /// The rows left out as redundant must hold at the assembled q: otherwise they were not
 /// implied by the others, and the mechanism cannot be assembled with all of them.
-fn check_left_out<D: Dynamics + ?Sized>(
-    model: &D,
-    ws: &mut Workspace,
-    t0: f64,
-) -> Result<(), SimError> {
+fn check_left_out(model: &dyn Dynamics, ws: &mut Workspace, t0: f64) -> Result<(), SimError> {
     let info = model.info();
     let m = info.n_constraints();
     if ws.rows().len() == m {
@@ -399,7 +383,7 @@ fn check_left_out<D: Dynamics + ?Sized>(
 /// angle or to the model's length scale for a displacement; the first bracket (the
 /// nearer one when both sides change sign at the same distance) is refined by
 /// regula falsi. `None` when h changes sign nowhere within reach.
-fn nearest_root<D: Dynamics + ?Sized>(model: &D, ws: &Workspace, v: usize) -> Option<(f64, f64)> {
+fn nearest_root(model: &dyn Dynamics, ws: &Workspace, v: usize) -> Option<(f64, f64)> {
     let reach = match model.info().coordinates[v].kind {
         CoordinateKind::Revolute => PI,
         CoordinateKind::Prismatic => ws.length_scale(),

@@ -202,8 +202,8 @@ impl Point {
 /// The quantities at the state the workspace holds after a right-hand side at (t, q, q̇)
 /// (accelerations solved), into `point` (its vectors reused): multipliers, normal forces,
 /// residuals, energies.
-fn point_from_workspace<D: Dynamics + ?Sized>(
-    model: &D,
+fn point_from_workspace(
+    model: &dyn Dynamics,
     partition: &Partition,
     ws: &mut Workspace,
     (t, dissipated, driven_work): (f64, f64, f64),
@@ -233,8 +233,8 @@ fn point_from_workspace<D: Dynamics + ?Sized>(
 }
 
 /// The quantities at time `t` inside the last accepted step, from its dense output.
-fn point_interpolated<D: Dynamics + ?Sized>(
-    model: &D,
+fn point_interpolated(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     (ws, y): (&mut Workspace, &mut [f64]),
@@ -257,8 +257,8 @@ fn point_interpolated<D: Dynamics + ?Sized>(
 
 /// [`crate::Simulate::simulate_metrics`] and
 /// [`crate::Simulate::simulate_metrics_monitored`].
-pub(crate) fn run_metrics<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn run_metrics(
+    model: &dyn Dynamics,
     mut state: State,
     settings: &SimSettings,
     options: MetricsOptions,
@@ -324,8 +324,8 @@ impl Pace<'_> {
 /// The start, then every accepted step's end (and the grid, if asked); inside a step, a
 /// normal force that changes sign or may cross zero and come back is searched on the dense
 /// output for the first lift-off.
-fn adaptive_run<D: Dynamics + ?Sized>(
-    model: &D,
+fn adaptive_run(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     options: MetricsOptions,
@@ -477,8 +477,8 @@ impl StepStages {
 
 /// RK4: the start and the end of every step (a full evaluation each: RK4's last stage is
 /// not at the new point).
-fn fixed_run<D: Dynamics + ?Sized>(
-    model: &D,
+fn fixed_run(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     acc: &mut Accumulator,

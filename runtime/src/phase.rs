@@ -247,9 +247,9 @@ const MAX_PIECES: usize = 4096;
 
 impl Phase<'_, '_, '_> {
     /// Integrates until the grid is done or the watch stops the phase.
-    pub(crate) fn run<D: Dynamics + ?Sized>(
+    pub(crate) fn run(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         state: &mut State,
     ) -> Result<Option<Stop>, SimError> {
         if state.modified_since_last_step() {
@@ -270,11 +270,7 @@ impl Phase<'_, '_, '_> {
         outcome
     }
 
-    fn steps<D: Dynamics + ?Sized>(
-        &mut self,
-        model: &D,
-        state: &mut State,
-    ) -> Result<Option<Stop>, SimError> {
+    fn steps(&mut self, model: &dyn Dynamics, state: &mut State) -> Result<Option<Stop>, SimError> {
         let settings = self.settings;
         let mut sample_ws = state.engine.ws.clone();
         let mut y_out = state.engine.y.clone();
@@ -345,9 +341,9 @@ impl Phase<'_, '_, '_> {
     }
 
     /// The watched quantities at (t, y) of the current step's partition.
-    fn readings<D: Dynamics + ?Sized>(
+    fn readings(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         state: &State,
         ws: &mut Workspace,
         t: f64,
@@ -373,7 +369,7 @@ impl Phase<'_, '_, '_> {
 
     /// The watched quantities at the end of the step just accepted, from what its last
     /// right-hand side left: the logged multipliers, or the flight's state.
-    fn readings_at_end<D: Dynamics + ?Sized>(&self, model: &D, state: &State) -> Vec<Reading> {
+    fn readings_at_end(&self, model: &dyn Dynamics, state: &State) -> Vec<Reading> {
         match self.watch {
             Watch::Nothing => Vec::new(),
             Watch::Forces { .. } => {
@@ -413,9 +409,9 @@ impl Phase<'_, '_, '_> {
     /// The events inside the step (t0, t1]: sign changes between its ends and excursions
     /// across zero within it, located on the dense output; records them and returns the
     /// first one that stops the phase (with q, q̇ there).
-    fn scan_step<D: Dynamics + ?Sized>(
+    fn scan_step(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         state: &mut State,
         ws: &mut Workspace,
         (t0, before): (f64, &[Reading]),
@@ -449,9 +445,9 @@ impl Phase<'_, '_, '_> {
 
     /// The crossings of every contact's −λ in the step: between its ends, and inside it where
     /// the stages predict one (the exact value then searched on the dense output).
-    fn force_events<D: Dynamics + ?Sized>(
+    fn force_events(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         state: &mut State,
         ws: &mut Workspace,
         (t0, before): (f64, &[Reading]),
@@ -526,9 +522,9 @@ impl Phase<'_, '_, '_> {
     /// of at most [`PIECE_TURN`] of the cam's turn relative to the follower, each checked
     /// (see [`first_closing`]), the closing located to `tolerance`.
     #[allow(clippy::too_many_arguments)]
-    fn landing<D: Dynamics + ?Sized>(
+    fn landing(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         state: &mut State,
         ws: &mut Workspace,
         (t0, start): (f64, Reading),
@@ -589,9 +585,9 @@ impl Phase<'_, '_, '_> {
 
     /// Records the located crossings in time order up to the first that stops the phase,
     /// which is returned with q, q̇ and the quadratures there (its driver records it).
-    fn record_events<D: Dynamics + ?Sized>(
+    fn record_events(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         state: &mut State,
         ws: &mut Workspace,
         mut found: Vec<(f64, usize, Crossing)>,

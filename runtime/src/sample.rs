@@ -54,8 +54,8 @@ pub(crate) enum SampleLevel {
 }
 
 /// The sample at an interpolated y inside the last step (the partition of that step).
-pub(crate) fn sample_interpolated<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn sample_interpolated(
+    model: &dyn Dynamics,
     state: &State,
     ws: &mut Workspace,
     t: f64,
@@ -69,8 +69,8 @@ pub(crate) fn sample_interpolated<D: Dynamics + ?Sized>(
     complete_sample(model, partition, ws, t, quadratures, level)
 }
 
-pub(crate) fn sample_in_place<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn sample_in_place(
+    model: &dyn Dynamics,
     state: &mut State,
     level: SampleLevel,
 ) -> Result<Sample, SimError> {
@@ -81,8 +81,8 @@ pub(crate) fn sample_in_place<D: Dynamics + ?Sized>(
     sample
 }
 
-pub(crate) fn compute_sample<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn compute_sample(
+    model: &dyn Dynamics,
     state: &State,
     ws: &mut Workspace,
     level: SampleLevel,
@@ -96,8 +96,8 @@ pub(crate) fn compute_sample<D: Dynamics + ?Sized>(
 }
 
 /// The sample at the consistent q, q̇ held in `ws` (position level evaluated there).
-pub(crate) fn complete_sample<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn complete_sample(
+    model: &dyn Dynamics,
     partition: &Partition,
     ws: &mut Workspace,
     t: f64,

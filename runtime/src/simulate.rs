@@ -54,6 +54,13 @@ pub struct SimFailure {
 
 /// Constrained simulation of any [`Dynamics`] (blanket implementation).
 pub trait Simulate: Dynamics {
+    /// The model as a trait object: every method below runs the runtime's engine compiled
+    /// once, in this crate, for `dyn Dynamics`, rather than once more per model type in the
+    /// crate that calls it (22 built-in models made 22 copies of the engine, most of their
+    /// crate's compile time).
+    #[doc(hidden)]
+    fn as_dynamics(&self) -> &dyn Dynamics;
+
     /// Initial assembly (docs/method.md §5.9) at time `t0` from the model's initial guess: coordinates with
     /// `hold = true` keep their guess, driven ones take their prescribed value at t0; the
     /// dependent coordinates are chosen among the others by largest |J_i| and solved by
@@ -61,14 +68,14 @@ pub trait Simulate: Dynamics {
     /// kept, the dependent ones solve J q̇ = 0 (16). Then the integration partition is chosen
     /// among all non-driven coordinates.
     fn assemble(&self, t0: f64) -> Result<State, SimError> {
-        crate::assembly::assemble(self, t0).map(|(state, _)| state)
+        crate::assembly::assemble(self.as_dynamics(), t0).map(|(state, _)| state)
     }
 
     /// [`Simulate::assemble`], with a report of what assembly changed in the model's guess
     /// (solved coordinates, values set by drives, velocities from J q̇ = 0) and how it chose
     /// among the roots of h = 0 (the one nearest the guess, for one contact).
     fn assemble_reported(&self, t0: f64) -> Result<(State, AssemblyReport), SimError> {
-        crate::assembly::assemble(self, t0)
+        crate::assembly::assemble(self.as_dynamics(), t0)
     }
 
     /// A state at time `t` from given coordinates and velocities (e.g. to restart from a
@@ -76,7 +83,7 @@ pub trait Simulate: Dynamics {
     /// ones are re-solved by Newton (15) from the given values (which should be on the cam)
     /// and their velocities from (16); the others are kept.
     fn state_at(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<State, SimError> {
-        crate::assembly::state_at(self, t, (q, qd))
+        crate::assembly::state_at(self.as_dynamics(), t, (q, qd))
     }
 
     /// Advances `state` by `dt` with the model's default settings.
@@ -98,7 +105,14 @@ pub trait Simulate: Dynamics {
         let target = state.t + dt;
         let mut watchdog = crate::control::Watchdog::new(state.t, settings.rtol, settings.atol);
         let mut after_step = |t: f64, h: f64| watchdog.step(t, h, (target, target));
-        advance(self, state, target, settings, &mut stats, &mut after_step)?;
+        advance(
+            self.as_dynamics(),
+            state,
+            target,
+            settings,
+            &mut stats,
+            &mut after_step,
+        )?;
         Ok(stats)
     }
 
@@ -107,7 +121,7 @@ pub trait Simulate: Dynamics {
     /// y = (u, u̇, dissipated, driven work, v, v̇) into `dy` (length
     /// [`State::integrated_len`]). For custom integrators and benchmarks.
     fn derivative(&self, state: &mut State, dy: &mut [f64]) -> Result<(), SimError> {
-        check_belongs(self, state)?;
+        check_belongs(self.as_dynamics(), state)?;
         if dy.len() != state.integrated_len() {
             return Err(invalid(format!(
                 "dy has {} entries, the integrated vector {}",
@@ -122,16 +136,24 @@ pub trait Simulate: Dynamics {
             ws, y, at_step_end, ..
         } = &mut state.engine;
         *at_step_end = false;
-        evaluate_rhs(self, &state.partition, ws, state.t, y, dy, false)
+        evaluate_rhs(
+            self.as_dynamics(),
+            &state.partition,
+            ws,
+            state.t,
+            y,
+            dy,
+            false,
+        )
     }
 
     /// All outputs at the state: accelerations, multipliers, normal and drive loads,
     /// constraint residuals, contact geometry and energies.
     fn sample(&self, state: &State) -> Result<Sample, SimError> {
-        check_belongs(self, state)?;
+        check_belongs(self.as_dynamics(), state)?;
         check_finite_state(state)?;
         let mut ws = state.engine.ws.clone();
-        compute_sample(self, state, &mut ws, SampleLevel::Full)
+        compute_sample(self.as_dynamics(), state, &mut ws, SampleLevel::Full)
     }
 
     /// Simulates from `state` to `settings.t_end`, sampling at t0, t0 + dt_out, … and
@@ -144,7 +166,7 @@ pub trait Simulate: Dynamics {
         settings: &SimSettings,
     ) -> Result<Trajectory, Box<SimFailure>> {
         run(
-            self,
+            self.as_dynamics(),
             state,
             settings,
             (SampleLevel::Full, ContactLaw::Bilateral),
@@ -162,7 +184,7 @@ pub trait Simulate: Dynamics {
         settings: &SimSettings,
     ) -> Result<Trajectory, Box<SimFailure>> {
         run(
-            self,
+            self.as_dynamics(),
             state,
             settings,
             (SampleLevel::State, ContactLaw::Bilateral),
@@ -180,7 +202,13 @@ pub trait Simulate: Dynamics {
         settings: &SimSettings,
         options: MetricsOptions,
     ) -> Result<RunMetrics, Box<MetricsFailure>> {
-        crate::metrics::run_metrics(self, state, settings, options, &mut Unmonitored)
+        crate::metrics::run_metrics(
+            self.as_dynamics(),
+            state,
+            settings,
+            options,
+            &mut Unmonitored,
+        )
     }
 
     /// [`Simulate::simulate_metrics`] watched by `monitor` after every step (progress; a
@@ -192,7 +220,7 @@ pub trait Simulate: Dynamics {
         options: MetricsOptions,
         monitor: &mut dyn Monitor,
     ) -> Result<RunMetrics, Box<MetricsFailure>> {
-        crate::metrics::run_metrics(self, state, settings, options, monitor)
+        crate::metrics::run_metrics(self.as_dynamics(), state, settings, options, monitor)
     }
 
     /// [`Simulate::simulate`] with one-sided contact: the follower lifts off where the
@@ -207,7 +235,7 @@ pub trait Simulate: Dynamics {
     ) -> Result<Trajectory, Box<SimFailure>> {
         let law = ContactLaw::Unilateral { restitution };
         run(
-            self,
+            self.as_dynamics(),
             state,
             settings,
             (SampleLevel::Full, law),
@@ -226,7 +254,7 @@ pub trait Simulate: Dynamics {
     ) -> Result<Trajectory, Box<SimFailure>> {
         let law = ContactLaw::Unilateral { restitution };
         run(
-            self,
+            self.as_dynamics(),
             state,
             settings,
             (SampleLevel::Full, law),
@@ -246,7 +274,7 @@ pub trait Simulate: Dynamics {
         observe: &mut dyn FnMut(&Sample) -> Observed,
     ) -> Result<Trajectory, Box<SimFailure>> {
         run(
-            self,
+            self.as_dynamics(),
             state,
             settings,
             (SampleLevel::Full, ContactLaw::Bilateral),
@@ -268,17 +296,51 @@ pub trait Simulate: Dynamics {
         law: ContactLaw,
         monitor: &mut dyn Monitor,
     ) -> Result<Trajectory, Box<SimFailure>> {
-        run(self, state, settings, (SampleLevel::Full, law), monitor)
+        run(
+            self.as_dynamics(),
+            state,
+            settings,
+            (SampleLevel::Full, law),
+            monitor,
+        )
     }
 }
 
-impl<D: Dynamics + ?Sized> Simulate for D {}
+impl<D: Dynamics> Simulate for D {
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+}
+
+impl Simulate for dyn Dynamics + '_ {
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+}
+
+impl Simulate for dyn Dynamics + Sync + '_ {
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+}
+
+impl Simulate for dyn Dynamics + Send + '_ {
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+}
+
+impl Simulate for dyn Dynamics + Send + Sync + '_ {
+    fn as_dynamics(&self) -> &dyn Dynamics {
+        self
+    }
+}
 
 /// The simulation loop of every run: samples at t0, then integrates; adaptive integrators
 /// step freely and interpolate the output times (dense output), RK4 lands on them; a
 /// one-sided law alternates phases in contact and in flight ([`crate::unilateral`]).
-fn run<D: Dynamics + ?Sized>(
-    model: &D,
+fn run(
+    model: &dyn Dynamics,
     state: State,
     settings: &SimSettings,
     (level, law): (SampleLevel, ContactLaw),
@@ -327,8 +389,8 @@ fn run<D: Dynamics + ?Sized>(
 }
 
 /// Fixed steps that land on every output time.
-fn run_landing<D: Dynamics + ?Sized>(
-    model: &D,
+fn run_landing(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     level: SampleLevel,
@@ -353,8 +415,8 @@ fn run_landing<D: Dynamics + ?Sized>(
 /// a step are interpolated by the integrator's dense output and completed by Newton (15)
 /// and (16) from the interpolated u, u̇ and the interpolated v as starting point. Runs that
 /// compute full samples watch the normal forces (events, inside steps too).
-fn run_dense<D: Dynamics + ?Sized>(
-    model: &D,
+fn run_dense(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     level: SampleLevel,
@@ -385,8 +447,8 @@ fn run_dense<D: Dynamics + ?Sized>(
 
 /// After a failure: keeps the last accepted state as a final sample when it is newer than
 /// the last output (best effort: a failing sample is dropped).
-fn append_last_state<D: Dynamics + ?Sized>(
-    model: &D,
+fn append_last_state(
+    model: &dyn Dynamics,
     state: &mut State,
     record: &mut Recorder,
     level: SampleLevel,

@@ -334,10 +334,7 @@ fn setting_error(e: crate::settings::InvalidSetting) -> SimError {
     invalid(e.to_string())
 }
 
-pub(crate) fn check_belongs<D: Dynamics + ?Sized>(
-    model: &D,
-    state: &State,
-) -> Result<(), SimError> {
+pub(crate) fn check_belongs(model: &dyn Dynamics, state: &State) -> Result<(), SimError> {
     let n = model.info().n();
     let fits = state.q.len() == n && state.qd.len() == n && state.partition.n() == n;
     if fits && state.dependent().len() <= model.info().n_constraints() {
@@ -369,8 +366,8 @@ pub(crate) fn check_finite_state(state: &State) -> Result<(), SimError> {
 }
 
 /// Integrates until `state.t == t_target`, adding the work done to `stats` (also on error).
-pub(crate) fn advance<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn advance(
+    model: &dyn Dynamics,
     state: &mut State,
     t_target: f64,
     settings: &SimSettings,
@@ -399,8 +396,8 @@ pub(crate) fn advance<D: Dynamics + ?Sized>(
     result
 }
 
-fn advance_steps<D: Dynamics + ?Sized>(
-    model: &D,
+fn advance_steps(
+    model: &dyn Dynamics,
     state: &mut State,
     t_target: f64,
     settings: &SimSettings,
@@ -424,8 +421,8 @@ fn advance_steps<D: Dynamics + ?Sized>(
 }
 
 /// Step of the fixed step `dt`, shortened to land on `t_target`; returns the new time.
-pub(crate) fn rk4_step<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn rk4_step(
+    model: &dyn Dynamics,
     state: &mut State,
     t_target: f64,
     dt: f64,
@@ -455,8 +452,8 @@ pub(crate) fn rk4_step<D: Dynamics + ?Sized>(
 
 /// One accepted step of the chosen adaptive integrator towards `t_target` (clipped to land
 /// on it); returns the new time and keeps the controller's proposal for the next step.
-pub(crate) fn adaptive_step<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn adaptive_step(
+    model: &dyn Dynamics,
     state: &mut State,
     t_target: f64,
     settings: &SimSettings,
@@ -491,8 +488,8 @@ pub(crate) fn adaptive_step<D: Dynamics + ?Sized>(
 }
 
 /// What an adaptive step works on, borrowed from a [`State`].
-struct StepParts<'a, D: Dynamics + ?Sized> {
-    model: &'a D,
+struct StepParts<'a> {
+    model: &'a dyn Dynamics,
     partition: &'a Partition,
     ws: &'a mut Workspace,
     y: &'a mut Vec<f64>,
@@ -500,7 +497,7 @@ struct StepParts<'a, D: Dynamics + ?Sized> {
     stages: &'a mut StageLog,
 }
 
-impl<D: Dynamics + ?Sized> StepParts<'_, D> {
+impl StepParts<'_> {
     fn step<I: Adaptive>(
         self,
         integrator: &mut I,
@@ -549,8 +546,8 @@ pub(crate) fn add_phase_counters(stats: &mut Stats, state: &State, before: [Coun
 
 /// The checks every run makes before it starts; `keep`: the run keeps its samples (at most
 /// `MAX_SAMPLES` of them) rather than streaming them or keeping none.
-pub(crate) fn validate_run<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn validate_run(
+    model: &dyn Dynamics,
     state: &State,
     settings: &SimSettings,
     keep: bool,
@@ -579,8 +576,8 @@ pub(crate) fn add_counters_since(stats: &mut Stats, engine: &Engine, before: [Co
 
 /// Interpolates y at `t` inside the state's last accepted adaptive step (preparing the
 /// interpolant first: DOP853 spends three right-hand sides on it, once per step).
-pub(crate) fn interpolate_last_step<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn interpolate_last_step(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     t: f64,
@@ -622,8 +619,8 @@ fn clip_to_target(h: f64, remaining: f64) -> f64 {
 /// The right-hand side on y = (u, u̇, dissipated, driven work): Newton (15), velocities
 /// (16), reduced dynamics (17, 18), drive loads when there are driven coordinates, and the
 /// multipliers also without drives when `multipliers` is set.
-pub(crate) fn evaluate_rhs<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn evaluate_rhs(
+    model: &dyn Dynamics,
     partition: &Partition,
     ws: &mut Workspace,
     t: f64,
@@ -661,8 +658,8 @@ pub(crate) fn evaluate_rhs<D: Dynamics + ?Sized>(
 
 /// Full q, q̇ at (t, y): prescribed motion, u and u̇ from y, v by Newton (15) and v̇ by
 /// (16). Leaves J(q) evaluated and J_v factored in the workspace.
-pub(crate) fn load_state<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn load_state(
+    model: &dyn Dynamics,
     partition: &Partition,
     ws: &mut Workspace,
     t: f64,
@@ -692,8 +689,8 @@ pub(crate) fn load_state<D: Dynamics + ?Sized>(
 
 /// Newton (15) from the last evaluation's v; if that fails (e.g. after an overshooting
 /// trial stage), once more from v at the last accepted step.
-fn solve_positions_with_restart<D: Dynamics + ?Sized>(
-    model: &D,
+fn solve_positions_with_restart(
+    model: &dyn Dynamics,
     dependent: &[usize],
     ws: &mut Workspace,
     t: f64,
@@ -710,8 +707,8 @@ fn solve_positions_with_restart<D: Dynamics + ?Sized>(
 /// After an accepted step: writes t, q, q̇ and the quadratures back to the state, then
 /// re-chooses the dependent coordinates if the partition's conditioning fell below
 /// [`REPARTITION_RATIO`]. Returns true on a re-partition.
-pub(crate) fn finish_step<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn finish_step(
+    model: &dyn Dynamics,
     state: &mut State,
     t_new: f64,
 ) -> Result<bool, SimError> {
@@ -741,7 +738,7 @@ pub(crate) fn finish_step<D: Dynamics + ?Sized>(
 
 /// Switches to the best-conditioned dependent set when the current one's conditioning is
 /// below [`REPARTITION_RATIO`] and the new one is better. Uses J at the current q.
-fn repartition_if_needed<D: Dynamics + ?Sized>(model: &D, state: &mut State) -> bool {
+fn repartition_if_needed(model: &dyn Dynamics, state: &mut State) -> bool {
     let n = model.info().n();
     let ws = &state.engine.ws;
     let nc = ws.rows().len();

@@ -162,8 +162,8 @@ struct Impact {
 }
 
 /// The impact law of the module documentation at (q, q̇⁻) for contact `k`.
-fn impact<D: Dynamics + ?Sized>(
-    model: &D,
+fn impact(
+    model: &dyn Dynamics,
     t: f64,
     (q, qd): (&[f64], &[f64]),
     k: usize,
@@ -226,7 +226,7 @@ fn impact<D: Dynamics + ?Sized>(
 
 /// The flight samples of the detached model, completed with the contact's view: the gap
 /// as h, N = 0, the geometry under the point.
-fn complete_flight_sample<D: Dynamics + ?Sized>(model: &D, sample: &mut Sample) {
+fn complete_flight_sample(model: &dyn Dynamics, sample: &mut Sample) {
     let nc = model.info().n_contacts();
     let mut h = vec![0.0; nc];
     model.constraint(&sample.q, &mut h);
@@ -245,8 +245,8 @@ enum Mode<'a, D: ?Sized> {
     Flight(State, &'a Detached<'a, D>),
 }
 
-fn validate_unilateral<D: Dynamics + ?Sized>(
-    model: &D,
+fn validate_unilateral(
+    model: &dyn Dynamics,
     state: &State,
     settings: &SimSettings,
     (restitution, keep): (f64, bool),
@@ -285,8 +285,8 @@ fn validate_unilateral<D: Dynamics + ?Sized>(
 /// Runs `state` of `model` (one cam contact) to `settings.t_end` with one-sided contact and
 /// restitution `restitution` (see the module documentation), recording into `record`.
 /// Needs an adaptive integrator (events are located on its dense output).
-pub(crate) fn run_phases<D: Dynamics + ?Sized>(
-    model: &D,
+pub(crate) fn run_phases(
+    model: &dyn Dynamics,
     state: State,
     settings: &SimSettings,
     restitution: f64,
@@ -385,7 +385,7 @@ pub(crate) fn run_phases<D: Dynamics + ?Sized>(
 /// The gap of the (only) contact at (q, q̇): h, ḣ = J q̇, how fast the cam turns relative to
 /// the follower point (the point's speed in the cam frame over its distance from the frame's
 /// origin, at least a micrometre), and a bound on |ḣ| from both.
-fn gap_reading<D: Dynamics + ?Sized>(model: &D, n: usize, q: &[f64], qd: &[f64]) -> GapReading {
+fn gap_reading(model: &dyn Dynamics, n: usize, q: &[f64], qd: &[f64]) -> GapReading {
     let mut h = [0.0];
     model.constraint(q, &mut h);
     let mut j = vec![0.0; n];
@@ -414,8 +414,8 @@ fn gap_reading<D: Dynamics + ?Sized>(model: &D, n: usize, q: &[f64], qd: &[f64])
     }
 }
 
-fn run_phase<D: Dynamics + ?Sized>(
-    model: &D,
+fn run_phase(
+    model: &dyn Dynamics,
     state: &mut State,
     settings: &SimSettings,
     watch: &Watch,

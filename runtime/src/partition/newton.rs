@@ -78,9 +78,9 @@ impl Workspace {
     /// evaluations instead of two and three. On return h, J, the cache and the factored J_v
     /// are those of the returned q, and the pending correction is the one
     /// [`Self::polish_positions`] applies.
-    pub fn solve_positions<D: Dynamics + ?Sized>(
+    pub fn solve_positions(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         dependent: &[usize],
         t: f64,
     ) -> Result<usize, SimError> {
@@ -127,9 +127,9 @@ impl Workspace {
 
     /// Assembly fallback for (15): Newton with backtracking on ‖h‖₂ (Armijo condition),
     /// for starting points where plain Newton overshoots.
-    pub fn solve_positions_damped<D: Dynamics + ?Sized>(
+    pub fn solve_positions_damped(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         dependent: &[usize],
         t: f64,
     ) -> Result<usize, SimError> {
@@ -151,9 +151,9 @@ impl Workspace {
 
     /// One damped Newton step v ← v − α J_v⁻¹ h, halving α from 1 until ‖h‖₂ decreases
     /// (Armijo) or |h| meets the tolerance; returns the size of the correction made.
-    pub(super) fn backtracking_step<D: Dynamics + ?Sized>(
+    pub(super) fn backtracking_step(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         dependent: &[usize],
         t: f64,
         residual: f64,
@@ -189,9 +189,9 @@ impl Workspace {
     /// point has been asked to go where the cam is not), reported as
     /// [`SimError::NewtonFailed`]; at a point already on the cam it is the configuration
     /// itself that is singular ([`SimError::SingularConstraint`]).
-    pub(super) fn factor_jacobian_for_newton<D: Dynamics + ?Sized>(
+    pub(super) fn factor_jacobian_for_newton(
         &mut self,
-        _model: &D,
+        _model: &dyn Dynamics,
         dependent: &[usize],
         t: f64,
         residual: f64,
@@ -207,9 +207,9 @@ impl Workspace {
 
     /// Evaluates h and J at q (one [`Dynamics::position_terms`] call, which also fills the
     /// cache for the velocity level); returns max |h|.
-    pub(super) fn constraint_residual<D: Dynamics + ?Sized>(
+    pub(super) fn constraint_residual(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         t: f64,
     ) -> Result<f64, SimError> {
         self.evaluate_position_terms(model);
@@ -290,9 +290,9 @@ impl Workspace {
     }
 
     /// Evaluates h and J(q) (5b) and factors J_v (the `dependent` columns).
-    pub fn factor_jacobian<D: Dynamics + ?Sized>(
+    pub fn factor_jacobian(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         dependent: &[usize],
         t: f64,
     ) -> Result<(), SimError> {

@@ -12,9 +12,9 @@ impl Workspace {
     /// ([`Self::factor_jacobian`], or [`Self::solve_positions`] then
     /// [`Self::factor_current_jacobian`]: J factored and the cache filled) and q̈_d
     /// in the driven entries of q̈ (from [`Dynamics::prescribed`]).
-    pub fn solve_accelerations<D: Dynamics + ?Sized>(
+    pub fn solve_accelerations(
         &mut self,
-        model: &D,
+        model: &dyn Dynamics,
         partition: &Partition,
         t: f64,
     ) -> Result<(), SimError> {

@@ -185,7 +185,7 @@ impl Workspace {
     }
 
     /// h(q) of the solved rows into `self.h` (one `constraint` call).
-    pub(super) fn evaluate_h<D: Dynamics + ?Sized>(&mut self, model: &D) {
+    pub(super) fn evaluate_h(&mut self, model: &dyn Dynamics) {
         if self.m == self.nc {
             model.constraint(&self.q, &mut self.h);
         } else {
@@ -197,7 +197,7 @@ impl Workspace {
     }
 
     /// h and J at q without the cache (assembly).
-    pub fn evaluate_constraints<D: Dynamics + ?Sized>(&mut self, model: &D) {
+    pub fn evaluate_constraints(&mut self, model: &dyn Dynamics) {
         if self.m == self.nc {
             model.constraint(&self.q, &mut self.h);
             model.constraint_jacobian(&self.q, &mut self.jacobian);
@@ -295,7 +295,7 @@ impl Workspace {
     }
 
     /// h, J and the cache at the current q, by one [`Dynamics::position_terms`] call.
-    pub(super) fn evaluate_position_terms<D: Dynamics + ?Sized>(&mut self, model: &D) {
+    pub(super) fn evaluate_position_terms(&mut self, model: &dyn Dynamics) {
         let len = model.cache_len();
         if self.cache.len() != len {
             self.cache.resize(len, f64::NAN);
