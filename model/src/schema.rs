@@ -246,6 +246,17 @@ impl<'a> Locator<'a> {
                 }
                 _ => format!("{message} after this value"),
             };
+        } else if start >= self.source.len() && before > 0 {
+            // The file ends where a value or a delimiter was due: name the innermost group
+            // left open and the field it belongs to, not the top level.
+            field_offset = before - 1;
+            if let Some(open) = self.document.group_at(field_offset) {
+                let (line, column) = scan::line_column(self.source, open);
+                message =
+                    format!("the file ends inside the group opened at {line}:{column}: {message}");
+            } else {
+                message = format!("the file ends here: {message}");
+            }
         } else {
             if error.code == Code::ExpectedStringEnd {
                 message = format!("{message}: this string has no closing `\"`");
@@ -1001,6 +1012,55 @@ mod tests {
             "the group opened at 10:18 is not closed",
         );
         assert_eq!(e.column, 33, "just after the last comma");
+    }
+
+    #[test]
+    fn a_file_cut_off_names_the_group_left_open_and_its_field() {
+        // Cut after a comma, inside a value, and after a value: each names `bodies[0]`
+        // (opened by its `(` at 3:14, the `[` being at 3:13), not the top level.
+        for (source, field, line, column, text) in [
+            (
+                "(\n    name: \"x\",\n    bodies: [(name: \"b\", mass: 1.0,\n",
+                "bodies[0]",
+                4,
+                1,
+                "Expected identifier",
+            ),
+            (
+                "(\n    name: \"x\",\n    bodies: [(name: \"b\", mass: ",
+                "bodies[0].mass",
+                3,
+                32,
+                "Unexpected end of RON",
+            ),
+            (
+                "(\n    name: \"x\",\n    bodies: [(name: \"b\", mass: 1.0",
+                "bodies[0].mass",
+                3,
+                35,
+                "Expected comma",
+            ),
+        ] {
+            let e = error_of(source);
+            assert_eq!(
+                (e.field.as_str(), e.line, e.column),
+                (field, line, column),
+                "{e}"
+            );
+            assert!(
+                e.message
+                    .starts_with("the file ends inside the group opened at 3:14: "),
+                "{e}"
+            );
+            assert!(e.message.ends_with(text), "{e}");
+        }
+        // The whole file's group left open: the top level's own `(`.
+        let e = error_of("(\n    name: \"x\",\n");
+        assert!(
+            e.message
+                .starts_with("the file ends inside the group opened at 1:1: "),
+            "{e}"
+        );
     }
 
     #[test]
