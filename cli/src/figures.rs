@@ -16,7 +16,7 @@
 use super::kinematics::Geometry;
 use super::plots::{Figure, Frame, LinePanel, MechanismPanel, Panel, Row, Series, time_color};
 use super::summary::{LiftOff, unit};
-use camchain_runtime::{CoordinateKind, ModelInfo, Sample};
+use camchain_runtime::{JointKind, ModelInfo, Sample};
 use plotters::style::RGBColor;
 
 /// Width of a one-column figure, and of each column of a comparison (pixels).
@@ -93,10 +93,7 @@ fn time_range(samples: &[Sample]) -> (f64, f64) {
 /// "q4: rotation between body3 and body4".
 fn coordinate_title(run: &RunView, i: usize) -> String {
     let c = &run.info.coordinates[i];
-    let what = match c.kind {
-        CoordinateKind::Revolute => "rotation",
-        CoordinateKind::Prismatic => "displacement in the guide",
-    };
+    let what = c.kind.spec().motion;
     let between = run
         .geometry
         .filter(|g| g.n() == run.info.n())
@@ -266,11 +263,8 @@ pub fn contact(run: &RunView) -> Option<Figure> {
 type Reading = fn(&Sample, usize) -> f64;
 
 /// Units of a coordinate's displacement, velocity and acceleration.
-fn motion_units(kind: CoordinateKind) -> [&'static str; 3] {
-    match kind {
-        CoordinateKind::Revolute => ["rad", "rad/s", "rad/s²"],
-        CoordinateKind::Prismatic => ["m", "m/s", "m/s²"],
-    }
+fn motion_units(kind: JointKind) -> [&'static str; 3] {
+    kind.spec().units
 }
 
 /// `(cam angle in degrees within one turn, value)` split into one curve per revolution: a

@@ -6,17 +6,8 @@
 //! parsed profile and drive expressions.
 
 use crate::profile::Scalar;
-pub use camchain_runtime::{FollowerKind, IntegratorKind, LoopKind};
+pub use camchain_runtime::{FollowerKind, IntegratorKind, JointKind, LoopKind};
 use serde::Deserialize;
-
-/// Kind of one-degree-of-freedom joint between a body and its parent.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum JointKind {
-    /// Rotation about `axis` through `anchor`; the coordinate is an angle in radians.
-    Revolute,
-    /// Translation along `axis`; the coordinate is a displacement in metres.
-    Prismatic,
-}
 
 /// A linear spring-damper acting in a joint: generalised load `-k (q - rest) - c q̇`.
 #[derive(Debug, Clone, Copy, PartialEq)]

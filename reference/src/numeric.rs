@@ -25,8 +25,8 @@ use camchain_model::ModelError;
 use camchain_model::model::{Body, Contact, JointKind, Loop, Model, ParameterMode, Profile};
 use camchain_model::schema::{Files, load_model, parse_model_from};
 use camchain_runtime::{
-    ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, CoordinateKind, Dynamics,
-    Energy, InitialGuess, LoopInfo, ModelInfo, ParameterInfo, ProfileKind, SimSettings,
+    ContactGeometry, ContactInfo, ContactKinematics, CoordinateInfo, Dynamics, Energy,
+    InitialGuess, LoopInfo, ModelInfo, ParameterInfo, ProfileKind, SimSettings,
 };
 use nalgebra::{Rotation3, Unit};
 use std::path::Path;
@@ -104,10 +104,7 @@ pub fn loop_info(cut: &Loop) -> LoopInfo {
 fn coordinate_info(body: &Body) -> CoordinateInfo {
     CoordinateInfo {
         name: body.joint.coordinate.clone(),
-        kind: match body.joint.kind {
-            JointKind::Revolute => CoordinateKind::Revolute,
-            JointKind::Prismatic => CoordinateKind::Prismatic,
-        },
+        kind: body.joint.kind,
         driven: body.joint.prescribed.is_some(),
     }
 }
@@ -1144,8 +1141,8 @@ mod tests {
         assert_eq!(info.contacts, vec![ContactInfo::knife("A")]);
         assert!(!info.spatial);
         assert_eq!(info.coordinate_index("q3"), Some(2));
-        assert_eq!(info.coordinates[2].kind, CoordinateKind::Prismatic);
-        assert_eq!(info.coordinates[3].kind, CoordinateKind::Revolute);
+        assert_eq!(info.coordinates[2].kind, JointKind::Prismatic);
+        assert_eq!(info.coordinates[3].kind, JointKind::Revolute);
         assert!(info.coordinates.iter().all(|c| !c.driven));
         assert_eq!(info.defaults.integrator, IntegratorKind::Dopri5);
         assert_eq!(nm.model().name, "test");

@@ -11,7 +11,7 @@
 //! contacts, Newton (15) runs from the guess, with a backtracking Newton as fallback. The
 //! velocities of the solved coordinates then follow from J q̇ = 0 (16).
 
-use crate::dynamics::{ContactGeometry, CoordinateKind, Dynamics};
+use crate::dynamics::{ContactGeometry, Dynamics, JointKind};
 use crate::error::SimError;
 use crate::partition::{Partition, Workspace, independent_rows};
 use crate::stepping::{State, invalid};
@@ -385,8 +385,8 @@ fn check_left_out(model: &dyn Dynamics, ws: &mut Workspace, t0: f64) -> Result<(
 /// regula falsi. `None` when h changes sign nowhere within reach.
 fn nearest_root(model: &dyn Dynamics, ws: &Workspace, v: usize) -> Option<(f64, f64)> {
     let reach = match model.info().coordinates[v].kind {
-        CoordinateKind::Revolute => PI,
-        CoordinateKind::Prismatic => ws.length_scale(),
+        JointKind::Revolute => PI,
+        JointKind::Prismatic => ws.length_scale(),
     };
     let step = reach / SCAN_STEPS as f64;
     let mut q = ws.q().to_vec();

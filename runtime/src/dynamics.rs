@@ -9,24 +9,15 @@
 //! Matrices are dense row-major slices so that generated code can write them without
 //! allocation.
 
-pub use crate::kinds::{FollowerKind, IntegratorKind, LoopKind};
-
-/// Kind of a generalised coordinate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum CoordinateKind {
-    /// Angle of a revolute joint (rad).
-    Revolute,
-    /// Displacement of a prismatic joint (m).
-    Prismatic,
-}
+pub use crate::kinds::{FollowerKind, IntegratorKind, JointKind, LoopKind};
 
 /// Description of one generalised coordinate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CoordinateInfo {
     /// Name from the model file, e.g. `q3`.
     pub name: String,
-    /// Revolute or prismatic.
-    pub kind: CoordinateKind,
+    /// The kind of its joint: revolute (an angle) or prismatic (a displacement).
+    pub kind: JointKind,
     /// True when the joint's motion is prescribed (a driven joint).
     pub driven: bool,
 }

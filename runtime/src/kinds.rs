@@ -1,4 +1,4 @@
-//! The kinds the whole project names, each defined once: followers, loop joints and
+//! The kinds the whole project names, each defined once: joints, followers, loop joints and
 //! integrators.
 //!
 //! Every crate uses these enums: the model file's parser reads their keywords, the generator
@@ -104,6 +104,37 @@ pub trait Kind: Copy + Sized + 'static {
     /// The kind whose keyword is exactly `word`.
     fn from_keyword(word: &str) -> Option<Self> {
         Self::parse(word).filter(|k| k.keyword() == word)
+    }
+}
+
+/// A joint kind's names and the units of its coordinate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct JointSpec {
+    /// Its name in messages and output (`revolute`).
+    pub name: &'static str,
+    /// What its coordinate measures, in figure titles (`rotation`).
+    pub motion: &'static str,
+    /// The units of its coordinate, rate and acceleration (`rad`, `rad/s`, `rad/s²`).
+    pub units: [&'static str; 3],
+    /// The unit of the load that drives it (`N m`: a torque; `N`: a force).
+    pub load_unit: &'static str,
+}
+
+registry! {
+    /// The kind of a body's joint to its parent, and of the coordinate it carries
+    /// (docs/model-format.md, "Bodies").
+    pub enum JointKind: JointSpec, "joint kind" {
+        /// Rotation about the joint's axis; the coordinate is an angle.
+        Revolute => JointSpec { name: "revolute", motion: "rotation", units: ["rad", "rad/s", "rad/s²"], load_unit: "N m" },
+        /// Translation along the joint's axis; the coordinate is a displacement.
+        Prismatic => JointSpec { name: "prismatic", motion: "displacement in the guide", units: ["m", "m/s", "m/s²"], load_unit: "N" },
+    }
+}
+
+impl JointKind {
+    /// The unit of its coordinate (`rad`, `m`).
+    pub fn unit(self) -> &'static str {
+        self.spec().units[0]
     }
 }
 
@@ -242,6 +273,10 @@ mod tests {
             assert_eq!(FollowerKind::parse(k.keyword()), Some(k));
             assert_eq!(FollowerKind::parse(&k.name().to_uppercase()), Some(k));
         }
+        for &k in JointKind::ALL {
+            assert_eq!(JointKind::parse(k.keyword()), Some(k));
+            assert_eq!(JointKind::parse(k.name()), Some(k));
+        }
         for &k in LoopKind::ALL {
             assert_eq!(LoopKind::parse(k.keyword()), Some(k));
             assert_eq!(LoopKind::parse(k.name()), Some(k));
@@ -267,6 +302,8 @@ mod tests {
     #[test]
     fn specs_belong_to_their_variants() {
         assert_eq!(FollowerKind::Roller.outline(), Outline::Circle);
+        assert_eq!(JointKind::Revolute.unit(), "rad");
+        assert_eq!(JointKind::Prismatic.spec().load_unit, "N");
         assert_eq!(FollowerKind::Flat.label(), "flat face");
         assert_eq!(LoopKind::Revolute.equations(false).len(), 5);
         assert_eq!(LoopKind::PointOnLine.equations(true), ["normal"]);

@@ -361,12 +361,12 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
     coordinates: Vec::from([
         rt::CoordinateInfo {
             name: "cam_angle".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: true,
         },
         rt::CoordinateInfo {
             name: "lift".to_string(),
-            kind: rt::CoordinateKind::Prismatic,
+            kind: rt::JointKind::Prismatic,
             driven: false,
         },
     ]),

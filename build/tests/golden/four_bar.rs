@@ -630,17 +630,17 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
     coordinates: Vec::from([
         rt::CoordinateInfo {
             name: "q_crank".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: false,
         },
         rt::CoordinateInfo {
             name: "q_coupler".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: false,
         },
         rt::CoordinateInfo {
             name: "q_rocker".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: false,
         },
     ]),

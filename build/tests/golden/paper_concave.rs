@@ -456,22 +456,22 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
     coordinates: Vec::from([
         rt::CoordinateInfo {
             name: "q1".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: false,
         },
         rt::CoordinateInfo {
             name: "q2".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: false,
         },
         rt::CoordinateInfo {
             name: "q3".to_string(),
-            kind: rt::CoordinateKind::Prismatic,
+            kind: rt::JointKind::Prismatic,
             driven: false,
         },
         rt::CoordinateInfo {
             name: "q4".to_string(),
-            kind: rt::CoordinateKind::Revolute,
+            kind: rt::JointKind::Revolute,
             driven: false,
         },
     ]),

@@ -22,7 +22,7 @@ pub use digest::Digest;
 use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::{
-    ContactInfo, CoordinateKind, IntegratorKind, ModelInfo, ProfileKind, SimSettings, Stats,
+    ContactInfo, IntegratorKind, JointKind, ModelInfo, ProfileKind, SimSettings, Stats,
 };
 use std::fmt::Write;
 use std::time::Duration;
@@ -57,20 +57,14 @@ pub struct LiftOff {
     pub from_start: bool,
 }
 
-/// The unit of a coordinate.
-pub fn unit(kind: CoordinateKind) -> &'static str {
-    match kind {
-        CoordinateKind::Revolute => "rad",
-        CoordinateKind::Prismatic => "m",
-    }
+/// The unit of a coordinate (the joint kind's, from the registry).
+pub fn unit(kind: JointKind) -> &'static str {
+    kind.unit()
 }
 
 /// The unit of the load a drive exerts on a coordinate.
-pub(crate) fn drive_unit(kind: CoordinateKind) -> &'static str {
-    match kind {
-        CoordinateKind::Revolute => "N m",
-        CoordinateKind::Prismatic => "N",
-    }
+pub(crate) fn drive_unit(kind: JointKind) -> &'static str {
+    kind.spec().load_unit
 }
 
 /// A number in about 7 significant digits: fixed for ordinary magnitudes, scientific for
@@ -455,8 +449,8 @@ pub fn assembly_warnings(
             )),
             ChangeCause::Constraint => {
                 let limit = match coordinate.kind {
-                    CoordinateKind::Revolute => MOVED_ANGLE,
-                    CoordinateKind::Prismatic => MOVED_LENGTH * length_scale,
+                    JointKind::Revolute => MOVED_ANGLE,
+                    JointKind::Prismatic => MOVED_LENGTH * length_scale,
                 };
                 ((c.to - c.from).abs() > limit).then(|| {
                     format!(

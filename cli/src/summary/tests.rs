@@ -152,7 +152,7 @@ impl Lcg {
 fn synthetic_info(loops: usize) -> ModelInfo {
     let coordinate = |name: &str, driven| camchain_runtime::CoordinateInfo {
         name: name.into(),
-        kind: CoordinateKind::Revolute,
+        kind: JointKind::Revolute,
         driven,
     };
     let mut fixed = camchain_runtime::ContactInfo::knife("fixed");
@@ -318,7 +318,7 @@ fn synthetic_one_contact() -> ModelInfo {
 fn one_sided_info(cam_moves: bool) -> ModelInfo {
     let coordinate = |name: &str, driven| camchain_runtime::CoordinateInfo {
         name: name.into(),
-        kind: camchain_runtime::CoordinateKind::Revolute,
+        kind: camchain_runtime::JointKind::Revolute,
         driven,
     };
     let mut contact = camchain_runtime::ContactInfo::knife("face");

@@ -9,12 +9,9 @@ pub(super) fn info_static(model: &Model) -> String {
         .bodies
         .iter()
         .map(|b| {
-            let kind = match b.joint.kind {
-                JointKind::Revolute => "Revolute",
-                JointKind::Prismatic => "Prismatic",
-            };
+            let kind = b.joint.kind.keyword();
             format!(
-                "rt::CoordinateInfo {{ name: {:?}.to_string(), kind: rt::CoordinateKind::{kind}, driven: {} }}",
+                "rt::CoordinateInfo {{ name: {:?}.to_string(), kind: rt::JointKind::{kind}, driven: {} }}",
                 b.joint.coordinate,
                 b.joint.prescribed.is_some()
             )
@@ -130,7 +127,7 @@ mod tests {
         assert!(text.contains("loops: Vec::from([rt::LoopInfo { name: \"pin\".to_string(), kind: rt::LoopKind::Revolute, equations: Vec::from([\"x\".to_string(), \"y\".to_string()]) }])"), "{text}");
         assert!(text.contains("contacts: Vec::from([])"));
         let text = info_static(&model("double_pendulum"));
-        assert!(text.contains("rt::CoordinateInfo { name: \"q1\".to_string(), kind: rt::CoordinateKind::Revolute, driven: false }"));
+        assert!(text.contains("rt::CoordinateInfo { name: \"q1\".to_string(), kind: rt::JointKind::Revolute, driven: false }"));
         assert!(text.contains("defaults: rt::SimSettings { t_end: 10.0, dt_out: 0.01,"));
         assert!(text.contains("spatial: false"));
     }

@@ -5,7 +5,7 @@
 //! named `foo` in `Joint`"), so they are named after the file's concepts.
 
 use camchain_runtime::kinds::Kind;
-use camchain_runtime::{IntegratorKind, LoopKind};
+use camchain_runtime::{IntegratorKind, JointKind, LoopKind};
 use serde::de::{EnumAccess, MapAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::fmt;
@@ -158,16 +158,10 @@ pub(super) enum Inertia {
     },
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
-pub(super) enum JointKind {
-    Revolute,
-    Prismatic,
-}
-
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct Joint {
-    pub kind: JointKind,
+    pub kind: Keyword<JointKind>,
     pub axis: Vec3,
     #[serde(default)]
     pub anchor: Vec3,

@@ -1,7 +1,7 @@
 use super::*;
 use crate::dynamics::{
-    ContactGeometry, ContactKinematics, CoordinateInfo, CoordinateKind, Energy, InitialGuess,
-    IntegratorKind, ModelInfo,
+    ContactGeometry, ContactKinematics, CoordinateInfo, Energy, InitialGuess, IntegratorKind,
+    JointKind, ModelInfo,
 };
 use crate::partition::Workspace;
 use nalgebra::{DMatrix, DVector};
@@ -25,7 +25,7 @@ fn settings(
     }
 }
 
-fn coordinate(name: &str, kind: CoordinateKind, driven: bool) -> CoordinateInfo {
+fn coordinate(name: &str, kind: JointKind, driven: bool) -> CoordinateInfo {
     CoordinateInfo {
         name: name.to_string(),
         kind,
@@ -127,8 +127,8 @@ impl Bead {
             given_qd: vec![true; 2],
         };
         let coordinates = vec![
-            coordinate("x", CoordinateKind::Prismatic, false),
-            coordinate("y", CoordinateKind::Prismatic, false),
+            coordinate("x", JointKind::Prismatic, false),
+            coordinate("y", JointKind::Prismatic, false),
         ];
         let info = model_info("bead", coordinates, 1, initial);
         Self {
@@ -248,9 +248,9 @@ struct Points {
 impl Arm {
     fn new(cam: bool, drive: bool) -> Self {
         let coordinates = vec![
-            coordinate("s", CoordinateKind::Prismatic, drive),
-            coordinate("th1", CoordinateKind::Revolute, false),
-            coordinate("th2", CoordinateKind::Revolute, false),
+            coordinate("s", JointKind::Prismatic, drive),
+            coordinate("th1", JointKind::Revolute, false),
+            coordinate("th2", JointKind::Revolute, false),
         ];
         let initial = InitialGuess {
             q: vec![0.0, -std::f64::consts::FRAC_PI_2 + 0.3, 0.4],

@@ -7,9 +7,7 @@ use super::fields::{lookup, unique_names, unit_vector};
 use super::parameters::expression;
 use super::{Checked, Context, GROUND, location};
 use crate::error::ModelError;
-use crate::model::{
-    Body, Field, Joint, JointKind, JointLoad, Prescribed, RuntimeCheck, SpringDamper,
-};
+use crate::model::{Body, Field, Joint, JointLoad, Prescribed, RuntimeCheck, SpringDamper};
 use crate::schema::raw;
 use camchain_runtime::parameters::checks;
 use std::collections::HashMap;
@@ -287,10 +285,7 @@ pub(super) fn inertia(
 pub(super) fn joint(cx: &Context, path: &str, j: &raw::Joint, body: usize) -> Checked<Joint> {
     let axis = cx.vector(&format!("{path}.axis"), &j.axis, None)?;
     Ok(Joint {
-        kind: match j.kind {
-            raw::JointKind::Revolute => JointKind::Revolute,
-            raw::JointKind::Prismatic => JointKind::Prismatic,
-        },
+        kind: j.kind.0,
         axis: unit_vector(cx.at, &format!("{path}.axis"), "the joint axis", axis)?,
         anchor: cx.vector_of(&format!("{path}.anchor"), &j.anchor, |k| {
             Field::Anchor(body, k)
