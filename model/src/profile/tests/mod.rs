@@ -2,8 +2,7 @@
 
 use super::*;
 
-mod differential;
-mod oracle;
+mod corpus;
 mod property;
 use std::f64::consts::{E, PI};
 
