@@ -756,6 +756,18 @@ fn bad_grids_are_refused_with_the_cell() {
         ),
         "{spike}"
     );
+    // A spike with its x curvature finite (-3A) but not its y curvature (-3A/d²), and one
+    // with both finite (A = 3e301: 9e301 and 9e307) but not the cross curvature (27A/d²).
+    let narrow = [0.0, 1e-3, 2e-3];
+    for (spike, what) in [(1e303, "∂²S/∂y²"), (3e301, "∂⁴S/∂x²∂y²")] {
+        let mut z = vec![0.0; 9];
+        z[3 + 1] = spike;
+        let error = e(&[0.0, 1.0, 2.0], &narrow, &z, [NATURAL; 2]);
+        assert!(
+            matches!(error, SurfaceSplineError::Overflow { what: w, i: 1, j: 1, .. } if w == what),
+            "{error}"
+        );
+    }
     // check_grid refuses what new refuses, before any solve.
     assert!(check_grid(&x, &y, &zeros[..19], [NATURAL; 2]).is_err());
     assert_eq!(check_grid(&x, &y, &zeros, [PERIODIC, PERIODIC]), Ok(()));
