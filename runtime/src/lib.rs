@@ -51,6 +51,7 @@ pub mod settings;
 pub mod simulate;
 pub mod spline;
 pub mod stepping;
+pub mod surface_spline;
 pub mod unilateral;
 
 pub use control::{Cancel, Monitor, Observed, Progress};
