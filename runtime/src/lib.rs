@@ -24,6 +24,8 @@
 //! - [`motion_law`]: follower motion laws (dwell, cycloidal, harmonic, polynomials,
 //!   modified trapezoid and sine) in closed form, and programs of them over a turn.
 //! - [`spline`]: C² cubic splines through tables of points (profiles given as points).
+//! - [`surface_spline`]: C² bicubic spline surfaces z(x, y) through grids of points (spatial
+//!   cams given as points; not yet read from model files).
 //! - [`contact`]: contact parameters (Newton on the profile) and the checks that a
 //!   follower can follow its profile.
 //! - [`metrics`]: runs that keep a summary (extreme forces, lift-off, drift) instead of a
