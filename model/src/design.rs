@@ -315,12 +315,12 @@ pub fn profile_expressions(
     senses: Senses,
     law: &Arc<Tabulated>,
 ) -> [Scalar; 2] {
-    let theta = signed(-senses.turning, Scalar::Var);
+    let theta = signed(-senses.turning, Scalar::Var(0));
     let s = theta.clone().tabulated(law, 0);
     let ds = theta.tabulated(law, 1);
     let placed = place(g, senses, &s, &ds);
     // R(−σθ) = R(u).
-    let (cos, sin) = (Scalar::Var.cos(), Scalar::Var.sin());
+    let (cos, sin) = (Scalar::Var(0).cos(), Scalar::Var(0).sin());
     turn(&placed.contact, &cos, &sin)
 }
 

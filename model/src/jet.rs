@@ -244,10 +244,19 @@ pub fn eval_jet2(expr: &Scalar, x: f64, tables: &TableDerivative) -> Jet2 {
 /// Evaluates `expr` with its variable given as the jet `x` (the chain rule through an inner
 /// function: a profile at a point that itself moves).
 pub fn eval_on(expr: &Scalar, x: Jet2, tables: &TableDerivative) -> Jet2 {
-    let ev = |e: &Scalar| eval_on(e, x, tables);
+    eval_on_all(expr, &[x], tables)
+}
+
+/// [`eval_on`] with variable i given as the jet `vars[i]`: a surface z = f(x, y) along the
+/// line (x + t dx, y + t dy) gives its directional derivatives in t.
+pub fn eval_on_all(expr: &Scalar, vars: &[Jet2], tables: &TableDerivative) -> Jet2 {
+    let ev = |e: &Scalar| eval_on_all(e, vars, tables);
     match expr {
         Scalar::Const(c) => Jet2::constant(*c),
-        Scalar::Var => x,
+        Scalar::Var(i) => vars
+            .get(usize::from(*i))
+            .copied()
+            .unwrap_or(Jet2::constant(f64::NAN)),
         // Validated models hand the reference their expressions with every parameter
         // resolved to its value; an unresolved one has no value here.
         Scalar::Param(_) => Jet2::constant(f64::NAN),
@@ -274,7 +283,8 @@ pub fn eval_with(expr: &Scalar, x: f64, values: &[f64], tables: &TableDerivative
     let ev = |e: &Scalar| eval_with(e, x, values, tables);
     match expr {
         Scalar::Const(c) => *c,
-        Scalar::Var => x,
+        Scalar::Var(0) => x,
+        Scalar::Var(_) => f64::NAN,
         Scalar::Param(i) => values.get(*i).copied().unwrap_or(f64::NAN),
         Scalar::Neg(a) => -ev(a),
         Scalar::Add(a, b) => ev(a) + ev(b),
@@ -306,13 +316,38 @@ mod tests {
     const TOL: f64 = 1e-12;
 
     fn var() -> Box<Scalar> {
-        Box::new(Scalar::Var)
+        Box::new(Scalar::Var(0))
     }
     fn cst(c: f64) -> Box<Scalar> {
         Box::new(Scalar::Const(c))
     }
     fn call(f: Func, a: Box<Scalar>) -> Scalar {
         Scalar::Call(f, a)
+    }
+
+    /// f = x² y + sin y along the line (x + t dx, y + t dy): the jet in t carries the
+    /// directional derivatives f_x dx + f_y dy and [dx dy] H [dx dy]ᵀ, in closed form.
+    #[test]
+    fn a_surface_along_a_line_gives_its_directional_derivatives() {
+        let (x, y) = (|| Box::new(Scalar::Var(0)), || Box::new(Scalar::Var(1)));
+        let f = Scalar::Add(
+            Box::new(Scalar::Mul(Box::new(Scalar::Powi(x(), 2)), y())),
+            Box::new(call(Func::Sin, y())),
+        );
+        let (x0, y0, dx, dy) = (0.7, -1.3, 0.6, -0.8);
+        let along = |v: f64, d: f64| Jet2 { v, d1: d, d2: 0.0 };
+        let j = eval_on_all(&f, &[along(x0, dx), along(y0, dy)], &own_tables);
+        let (fx, fy) = (2.0 * x0 * y0, x0 * x0 + y0.cos());
+        let (fxx, fxy, fyy) = (2.0 * y0, 2.0 * x0, -y0.sin());
+        assert_relative_eq!(j.v, x0 * x0 * y0 + y0.sin(), max_relative = TOL);
+        assert_relative_eq!(j.d1, fx * dx + fy * dy, max_relative = TOL);
+        assert_relative_eq!(
+            j.d2,
+            fxx * dx * dx + 2.0 * fxy * dx * dy + fyy * dy * dy,
+            max_relative = TOL
+        );
+        // A variable not given is NaN, not another's value.
+        assert!(eval_on_all(&f, &[along(x0, dx)], &own_tables).v.is_nan());
     }
 
     fn check(expr: &Scalar, x: f64, expected: [f64; 3]) {

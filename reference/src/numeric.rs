@@ -683,7 +683,7 @@ mod tests {
     }
 
     fn var() -> Box<Scalar> {
-        Box::new(Scalar::Var)
+        Box::new(Scalar::Var(0))
     }
     fn cst(c: f64) -> Box<Scalar> {
         Box::new(Scalar::Const(c))
@@ -1157,7 +1157,10 @@ mod tests {
             Scalar::Const(-PI / 2.0),
             mul(
                 Scalar::Const(0.45),
-                Scalar::Call(Func::Sin, Box::new(mul(Scalar::Const(omega), Scalar::Var))),
+                Scalar::Call(
+                    Func::Sin,
+                    Box::new(mul(Scalar::Const(omega), Scalar::Var(0))),
+                ),
             ),
         );
         m.bodies[0].joint.prescribed = Some(Prescribed {
@@ -1275,7 +1278,7 @@ mod tests {
         let wavy = add(
             mul(
                 Scalar::Const(0.1),
-                Scalar::Call(Func::Sin, Box::new(mul(Scalar::Const(2.0), Scalar::Var))),
+                Scalar::Call(Func::Sin, Box::new(mul(Scalar::Const(2.0), Scalar::Var(0)))),
             ),
             polynomial(&[-0.3, 0.0, 0.05]),
         );
@@ -1285,7 +1288,7 @@ mod tests {
             Scalar::Div(
                 Box::new(mul(
                     Scalar::Powf(Box::new(polynomial(&[1.0, 0.0, 1.0])), cst(0.7)),
-                    Scalar::Call(Func::Exp, Box::new(mul(Scalar::Const(0.3), Scalar::Var))),
+                    Scalar::Call(Func::Exp, Box::new(mul(Scalar::Const(0.3), Scalar::Var(0)))),
                 )),
                 cst(10.0),
             ),

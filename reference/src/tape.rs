@@ -21,7 +21,8 @@ use std::sync::Arc;
 #[derive(Debug, Clone)]
 enum Entry {
     Const(f64),
-    Var,
+    /// Variable i of the expressions (a surface's y is 1).
+    Var(u8),
     Neg(usize),
     Add(usize, usize),
     Sub(usize, usize),
@@ -37,7 +38,7 @@ enum Entry {
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 enum Key {
     Const(u64),
-    Var,
+    Var(u8),
     Unary(u8, usize, i64),
     Binary(u8, usize, usize),
     Table(usize, u8, usize),
@@ -64,12 +65,17 @@ impl Tape {
 
     /// The expressions' values at x.
     pub fn eval(&self, x: f64) -> Vec<f64> {
+        self.eval_at(&[x])
+    }
+
+    /// The expressions' values with variable i at `vars[i]` (a surface's x and y).
+    pub fn eval_at(&self, vars: &[f64]) -> Vec<f64> {
         let mut values: Vec<f64> = Vec::with_capacity(self.entries.len());
         for entry in &self.entries {
             let v = |k: &usize| values[*k];
             let value = match entry {
                 Entry::Const(c) => *c,
-                Entry::Var => x,
+                Entry::Var(i) => vars.get(usize::from(*i)).copied().unwrap_or(f64::NAN),
                 Entry::Neg(a) => -v(a),
                 Entry::Add(a, b) => v(a) + v(b),
                 Entry::Sub(a, b) => v(a) - v(b),
@@ -88,12 +94,21 @@ impl Tape {
     /// The expressions' values with their first two derivatives, the variable given as the
     /// jet `x`.
     pub fn eval_jet(&self, x: Jet2) -> Vec<Jet2> {
+        self.eval_jet_at(&[x])
+    }
+
+    /// The expressions' jets with variable i given as the jet `vars[i]` (a surface along a
+    /// line through (x, y): its directional derivatives).
+    pub fn eval_jet_at(&self, vars: &[Jet2]) -> Vec<Jet2> {
         let mut values: Vec<Jet2> = Vec::with_capacity(self.entries.len());
         for entry in &self.entries {
             let v = |k: &usize| values[*k];
             let value = match entry {
                 Entry::Const(c) => Jet2::constant(*c),
-                Entry::Var => x,
+                Entry::Var(i) => vars
+                    .get(usize::from(*i))
+                    .copied()
+                    .unwrap_or(Jet2::constant(f64::NAN)),
                 Entry::Neg(a) => -v(a),
                 Entry::Add(a, b) => v(a) + v(b),
                 Entry::Sub(a, b) => v(a) - v(b),
@@ -136,7 +151,7 @@ impl Builder {
     fn add(&mut self, e: &Scalar) -> usize {
         let (key, entry) = match e {
             Scalar::Const(c) => (Key::Const(c.to_bits()), Entry::Const(*c)),
-            Scalar::Var => (Key::Var, Entry::Var),
+            Scalar::Var(i) => (Key::Var(*i), Entry::Var(*i)),
             Scalar::Param(_) => (Key::Const(f64::NAN.to_bits()), Entry::Const(f64::NAN)),
             Scalar::Neg(a) => {
                 let a = self.add(a);
@@ -188,6 +203,44 @@ mod tests {
     use super::*;
     use crate::jet::{eval_on, eval_with};
     use camchain_model::profile::parse_expression;
+
+    /// A surface's expression in x and y: the tape's values and jets along a line are the
+    /// tree's, bit for bit, and a variable not given is NaN.
+    #[test]
+    fn two_variables_evaluate_like_the_tree() {
+        let f = camchain_model::profile::parse_expression_in(
+            "x.powi(2) * y + (x * y).sin() - y / (1.0 + x * x)",
+            &["x", "y"],
+            &[],
+        )
+        .expect("parses");
+        let tape = Tape::new(&[&f]);
+        for (x, y) in [(0.3, -1.1), (-2.0, 0.5), (1.7, 2.4)] {
+            assert_eq!(
+                tape.eval_at(&[x, y])[0].to_bits(),
+                f.eval_at(&[x, y]).to_bits()
+            );
+            let line = [
+                Jet2 {
+                    v: x,
+                    d1: 0.6,
+                    d2: 0.0,
+                },
+                Jet2 {
+                    v: y,
+                    d1: -0.8,
+                    d2: 0.0,
+                },
+            ];
+            let from_tape = tape.eval_jet_at(&line)[0];
+            let from_tree = camchain_model::jet::eval_on_all(&f, &line, &crate::spline::derivative);
+            assert_eq!(
+                [from_tape.v, from_tape.d1, from_tape.d2].map(f64::to_bits),
+                [from_tree.v, from_tree.d1, from_tree.d2].map(f64::to_bits)
+            );
+        }
+        assert!(tape.eval(0.3)[0].is_nan());
+    }
 
     /// The tape gives the trees' values bit for bit (the same operations on the same
     /// operands), and merges what repeats.

@@ -7,10 +7,19 @@ use crate::profile::Scalar;
 /// Converts a one-variable [`Scalar`] to the DAG, the variable standing for `var` and
 /// parameter i for `params[i]` (its graph variable, or its value when it is folded).
 pub fn scalar_to_expr(g: &mut Graph, s: &Scalar, var: Id, params: &[Id]) -> Id {
-    let mut to = |e: &Scalar| scalar_to_expr(g, e, var, params);
+    scalar_to_expr_in(g, s, &[var], params)
+}
+
+/// [`scalar_to_expr`] for an expression of several variables, variable i standing for
+/// `vars[i]` (a surface's x and y); a variable past them is NaN.
+pub fn scalar_to_expr_in(g: &mut Graph, s: &Scalar, vars: &[Id], params: &[Id]) -> Id {
+    let mut to = |e: &Scalar| scalar_to_expr_in(g, e, vars, params);
     match s {
         Scalar::Const(c) => g.constant(*c),
-        Scalar::Var => var,
+        Scalar::Var(i) => vars
+            .get(usize::from(*i))
+            .copied()
+            .unwrap_or_else(|| g.constant(f64::NAN)),
         Scalar::Param(i) => params
             .get(*i)
             .copied()
@@ -92,7 +101,9 @@ const MAX_POLYNOMIAL_DEGREE: usize = 16;
 fn polynomial(s: &Scalar) -> Option<Vec<f64>> {
     let p = match s {
         Scalar::Const(c) => vec![*c],
-        Scalar::Var => vec![0.0, 1.0],
+        Scalar::Var(0) => vec![0.0, 1.0],
+        // Another variable is not a polynomial in the first.
+        Scalar::Var(_) => return None,
         Scalar::Neg(a) => polynomial(a)?.iter().map(|c| -c).collect(),
         Scalar::Add(a, b) => combine(&polynomial(a)?, &polynomial(b)?, 1.0),
         Scalar::Sub(a, b) => combine(&polynomial(a)?, &polynomial(b)?, -1.0),

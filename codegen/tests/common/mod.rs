@@ -43,7 +43,7 @@ fn body(name: &str, parent: Option<usize>, mass: f64, len: f64, izz: f64, joint:
 /// y = −0.595 x + 0.5 x² + 0.5 x³ as a Scalar tree.
 pub fn concave_profile() -> Scalar {
     use Scalar::*;
-    let x = || Box::new(Var);
+    let x = || Box::new(Var(0));
     let c = |v: f64| Box::new(Const(v));
     Add(
         Box::new(Add(
@@ -185,12 +185,12 @@ pub fn spatial_tree() -> Model {
             Box::new(Scalar::Const(0.2)),
             Box::new(Scalar::Call(
                 camchain_codegen::profile::Func::Sin,
-                Box::new(Scalar::Var),
+                Box::new(Scalar::Var(0)),
             )),
         )),
         Box::new(Scalar::Mul(
             Box::new(Scalar::Const(0.1)),
-            Box::new(Scalar::Powi(Box::new(Scalar::Var), 2)),
+            Box::new(Scalar::Powi(Box::new(Scalar::Var(0)), 2)),
         )),
     );
     let s = 0.6f64;

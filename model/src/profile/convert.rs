@@ -14,12 +14,12 @@ use super::{
 pub(super) fn convert(
     source: &str,
     tree: &Node,
-    variable: Option<&str>,
+    variables: &[&str],
     parameters: &[&str],
 ) -> Result<Scalar, ExprError> {
     let mut converter = Converter {
         source,
-        variable,
+        variables,
         parameters,
         depth: 0,
     };
@@ -74,8 +74,8 @@ impl Value {
 /// Converts the syntax tree to [`Scalar`], checking every node.
 struct Converter<'a> {
     source: &'a str,
-    /// The expression's variable, if it has one.
-    variable: Option<&'a str>,
+    /// The expression's variables (none for a value of the parameters alone), by index.
+    variables: &'a [&'a str],
     /// The model's parameter names, by index.
     parameters: &'a [&'a str],
     /// Current depth of the recursion through [`Converter::expr`].
@@ -155,8 +155,10 @@ impl<'a> Converter<'a> {
     fn path(&self, segments: &[(usize, usize)], at: usize) -> Result<Value, ExprError> {
         let names: Vec<&str> = segments.iter().map(|&s| self.text(s)).collect();
         if let [name] = names.as_slice() {
-            if Some(*name) == self.variable {
-                return Ok(Value::variable(Scalar::Var));
+            if let Some(i) = self.variables.iter().position(|v| v == name) {
+                // At most two variables (a surface's x and y): the index fits.
+                let index = u8::try_from(i).unwrap_or(u8::MAX);
+                return Ok(Value::variable(Scalar::Var(index)));
             }
             if let Some(i) = self.parameters.iter().position(|p| p == name) {
                 return Ok(Value::variable(Scalar::Param(i)));
@@ -174,14 +176,19 @@ impl<'a> Converter<'a> {
             } else {
                 format!("the parameters are {}", self.parameters.join(", "))
             };
-            match self.variable {
-                Some(v) => format!(
+            match self.variables {
+                [] => {
+                    format!("unknown name `{written}`: {parameters}; the constants are PI and E")
+                }
+                [v] => format!(
                     "unknown name `{written}`: the only variable allowed here is `{v}`; \
                      the constants are PI and E; {parameters}"
                 ),
-                None => {
-                    format!("unknown name `{written}`: {parameters}; the constants are PI and E")
-                }
+                [first @ .., last] => format!(
+                    "unknown name `{written}`: the variables allowed here are `{}` and `{last}`; \
+                     the constants are PI and E; {parameters}",
+                    first.join("`, `")
+                ),
             }
         };
         Err(ExprError::new(at, message))

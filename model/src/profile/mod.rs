@@ -59,13 +59,14 @@ pub enum Func {
     Atan,
 }
 
-/// Expression tree of one scalar variable.
+/// Expression tree in one scalar variable, or two for a surface z = f(x, y).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Scalar {
     /// A finite constant.
     Const(f64),
-    /// The variable (`x` for a profile, `t` for a drive).
-    Var,
+    /// Variable number `.0` of the expression: 0 is a profile's `x`, `θ` or `s`, a drive's
+    /// `t`; 1 is a surface's `y` (z = f(x, y)). A variable past those given evaluates to NaN.
+    Var(u8),
     /// A parameter of the model, by its index in the model's parameter list. Resolve it
     /// ([`Scalar::resolve`]) before evaluating: [`Scalar::eval`] gives NaN for it.
     Param(usize),
@@ -151,22 +152,28 @@ impl Tabulated {
 }
 
 impl Scalar {
-    /// Plain `f64` evaluation with the variable set to `v`, using the same `f64` methods the
-    /// generated code calls; used by validation, tests and quick numeric checks.
+    /// Plain `f64` evaluation with the (first) variable set to `v`, using the same `f64`
+    /// methods the generated code calls; used by validation, tests and quick numeric checks.
     pub fn eval(&self, v: f64) -> f64 {
+        self.eval_at(&[v])
+    }
+
+    /// [`Scalar::eval`] with variable i set to `vars[i]` (a surface's x and y).
+    pub fn eval_at(&self, vars: &[f64]) -> f64 {
+        let ev = |e: &Scalar| e.eval_at(vars);
         match self {
             Scalar::Const(c) => *c,
-            Scalar::Var => v,
+            Scalar::Var(i) => vars.get(usize::from(*i)).copied().unwrap_or(f64::NAN),
             Scalar::Param(_) => f64::NAN,
-            Scalar::Neg(a) => -a.eval(v),
-            Scalar::Add(a, b) => a.eval(v) + b.eval(v),
-            Scalar::Sub(a, b) => a.eval(v) - b.eval(v),
-            Scalar::Mul(a, b) => a.eval(v) * b.eval(v),
-            Scalar::Div(a, b) => a.eval(v) / b.eval(v),
-            Scalar::Powi(a, n) => a.eval(v).powi(*n),
-            Scalar::Powf(a, b) => a.eval(v).powf(b.eval(v)),
-            Scalar::Call(f, a) => apply(*f, a.eval(v)),
-            Scalar::Table(t, order, a) => t.derivative(*order, a.eval(v)),
+            Scalar::Neg(a) => -ev(a),
+            Scalar::Add(a, b) => ev(a) + ev(b),
+            Scalar::Sub(a, b) => ev(a) - ev(b),
+            Scalar::Mul(a, b) => ev(a) * ev(b),
+            Scalar::Div(a, b) => ev(a) / ev(b),
+            Scalar::Powi(a, n) => ev(a).powi(*n),
+            Scalar::Powf(a, b) => ev(a).powf(ev(b)),
+            Scalar::Call(f, a) => apply(*f, ev(a)),
+            Scalar::Table(t, order, a) => t.derivative(*order, ev(a)),
         }
     }
 }
@@ -178,7 +185,7 @@ impl Scalar {
         let r = |a: &Scalar| Box::new(a.resolve(values, replace));
         match self {
             Scalar::Param(i) if replace(*i) => Scalar::Const(values[*i]),
-            Scalar::Const(_) | Scalar::Var | Scalar::Param(_) => self.clone(),
+            Scalar::Const(_) | Scalar::Var(_) | Scalar::Param(_) => self.clone(),
             Scalar::Neg(a) => Scalar::Neg(r(a)),
             Scalar::Add(a, b) => Scalar::Add(r(a), r(b)),
             Scalar::Sub(a, b) => Scalar::Sub(r(a), r(b)),
@@ -201,7 +208,7 @@ impl Scalar {
         fn walk(s: &Scalar, out: &mut Vec<usize>) {
             match s {
                 Scalar::Param(i) => out.push(*i),
-                Scalar::Const(_) | Scalar::Var => {}
+                Scalar::Const(_) | Scalar::Var(_) => {}
                 Scalar::Neg(a)
                 | Scalar::Powi(a, _)
                 | Scalar::Call(_, a)
@@ -368,10 +375,20 @@ pub fn parse_expression_with(
     variable: Option<&str>,
     parameters: &[&str],
 ) -> Result<Scalar, ExprError> {
+    parse_expression_in(source, variable.as_slice(), parameters)
+}
+
+/// [`parse_expression_with`] for an expression of several variables: `variables[i]` becomes
+/// [`Scalar::Var`]`(i)` (a surface z = f(x, y) has `["x", "y"]`).
+pub fn parse_expression_in(
+    source: &str,
+    variables: &[&str],
+    parameters: &[&str],
+) -> Result<Scalar, ExprError> {
     let tokens = lex::tokens(source)?;
     lex::screen(source, &tokens)?;
     let tree = parse::parse(source, &tokens)?;
-    convert::convert(source, &tree, variable, parameters)
+    convert::convert(source, &tree, variables, parameters)
 }
 
 /// Deepest nesting of parentheses and prefix operators (`-(-(x))` is 4 deep) accepted.

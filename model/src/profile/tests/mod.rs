@@ -109,14 +109,14 @@ fn tree_shape_follows_rust_precedence() {
     let want = Scalar::Sub(
         Box::new(Scalar::Const(1.0)),
         Box::new(Scalar::Mul(
-            Box::new(Scalar::Var),
+            Box::new(Scalar::Var(0)),
             Box::new(Scalar::Const(2.0)),
         )),
     );
     assert_eq!(parsed, want);
     assert_eq!(
         parse_x("-x.powi(2)"),
-        Scalar::Neg(Box::new(Scalar::Powi(Box::new(Scalar::Var), 2)))
+        Scalar::Neg(Box::new(Scalar::Powi(Box::new(Scalar::Var(0)), 2)))
     );
 }
 
@@ -126,7 +126,7 @@ fn tree_shape_follows_rust_precedence() {
 #[test]
 fn signs_methods_and_associativity_follow_rust() {
     let b = Box::new;
-    let (x, two) = (|| b(Scalar::Var), || b(Scalar::Const(2.0)));
+    let (x, two) = (|| b(Scalar::Var(0)), || b(Scalar::Const(2.0)));
     assert_eq!(
         parse_x("-2.0.powi(2)"),
         Scalar::Neg(b(Scalar::Powi(two(), 2)))
@@ -323,4 +323,44 @@ fn hostile_inputs_are_refused_in_a_small_stack() {
         })
         .map(std::thread::JoinHandle::join);
     assert!(matches!(outcome, Ok(Ok(()))), "{outcome:?}");
+}
+
+/// A surface's expression in x and y: each name becomes its own variable, evaluates at a
+/// point, and an unknown name lists both variables.
+#[test]
+fn two_variables_parse_as_a_surface_expression() {
+    let f = match parse_expression_in("x*x - y.powi(2) + a*y", &["x", "y"], &["a"]) {
+        Ok(f) => f.resolve_all(&[0.5]),
+        Err(e) => panic!("{e}"),
+    };
+    let (x, y) = (|| Box::new(Scalar::Var(0)), || Box::new(Scalar::Var(1)));
+    let a = Box::new(Scalar::Const(0.5));
+    let expected = Scalar::Add(
+        Box::new(Scalar::Sub(
+            Box::new(Scalar::Mul(x(), x())),
+            Box::new(Scalar::Powi(y(), 2)),
+        )),
+        Box::new(Scalar::Mul(a, y())),
+    );
+    assert_eq!(f, expected);
+    // 1.5² − (−2)² + 0.5 · (−2), exact in binary.
+    assert_eq!(f.eval_at(&[1.5, -2.0]), 2.25 - 4.0 - 1.0);
+    // One variable given: the second is not there.
+    assert!(f.eval(1.5).is_nan());
+    let e = match parse_expression_in("x + z", &["x", "y"], &[]) {
+        Err(e) => e,
+        Ok(f) => panic!("accepted {f:?}"),
+    };
+    assert_eq!(e.offset, 4, "{e}");
+    assert!(
+        e.message
+            .contains("the variables allowed here are `x` and `y`"),
+        "{e}"
+    );
+    // A one-variable expression still refuses `y`.
+    let e = error_x("x + y");
+    assert!(
+        e.message.contains("the only variable allowed here is `x`"),
+        "{e}"
+    );
 }

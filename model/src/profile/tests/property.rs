@@ -35,7 +35,7 @@ impl Tree {
         let b = |t: &Tree| Box::new(t.scalar());
         match self {
             Tree::Const(v, _) => Scalar::Const(*v),
-            Tree::Var => Scalar::Var,
+            Tree::Var => Scalar::Var(0),
             Tree::Named(pi, _) => Scalar::Const(if *pi {
                 std::f64::consts::PI
             } else {

@@ -100,7 +100,8 @@ pub(super) fn table_profile(
             }
             let (x, y) = columns(&points.values);
             let spline = spline(cx, &field, &points, &x, &y, ends)?;
-            let f = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
+            let f =
+                Scalar::Var(0).tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
             let range = (x[0], x[x.len() - 1]);
             let source = described("a spline");
             Ok((Profile::Explicit { source, f }, range))
@@ -120,7 +121,8 @@ pub(super) fn table_profile(
             one_turn(cx, &field, &points, &theta, table.degrees)?;
             closes(cx, &field, &points, "a polar table")?;
             let spline = spline(cx, &field, &points, &theta, &r, Ends::Periodic)?;
-            let r = Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
+            let r =
+                Scalar::Var(0).tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
             let source = described("a periodic spline");
             Ok((Profile::Polar { source, r }, (0.0, TAU)))
         }
@@ -197,8 +199,8 @@ fn parametric(
     let profile = Profile::Parametric {
         x_source: described.clone(),
         y_source: described,
-        x: Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table_x"), sx), 0),
-        y: Scalar::Var.tabulated(&Tabulated::spline(format!("{name}_table_y"), sy), 0),
+        x: Scalar::Var(0).tabulated(&Tabulated::spline(format!("{name}_table_x"), sx), 0),
+        y: Scalar::Var(0).tabulated(&Tabulated::spline(format!("{name}_table_y"), sy), 0),
     };
     Ok((profile, (0.0, length)))
 }
