@@ -45,8 +45,14 @@ pub struct Relative {
     pub y_axis: V3,
     /// The cam's axis x̂ × ŷ, ground coordinates.
     pub axis: V3,
-    /// The follower point's coordinate along the cam's axis (0 in a planar model).
+    /// The follower point's coordinate along the cam's axis Z (0 in a planar model).
     pub height: Id,
+    /// ∂Z/∂q_j for every coordinate (J3: what a cam surface z = f(x, y) needs beside J1, J2).
+    pub height_columns: Vec<Id>,
+    /// The velocity-product part of Z̈ ((J3 q̇)_q q̇).
+    pub height_convective: Id,
+    /// Ż = J3 q̇.
+    pub height_rate: Id,
     /// ∂ω_r/∂q̇_j: the follower's angular velocity relative to the cam, about the cam's
     /// axis, per unit rate of joint j.
     pub spin_columns: Vec<Id>,
@@ -263,6 +269,7 @@ pub fn relative(
         vec3::label(g, y_axis, &format!("{name}_cam_y_axis"));
     }
     let mut columns = vec![[g.zero(); 2]; n];
+    let mut height_columns = vec![g.zero(); n];
     let marker_local = s.field3(
         g,
         model,
@@ -296,6 +303,7 @@ pub fn relative(
             g.label(j1, format!("{name}_j1_{coordinate}"));
             g.label(j2, format!("{name}_j2_{coordinate}"));
             columns[j] = [j1, j2];
+            height_columns[j] = vec3::dot(g, axis, column);
         },
     );
     let origin_local = s.field3(g, model, |k| Field::Origin(index, k), contact.origin);
@@ -339,6 +347,8 @@ pub fn relative(
                 g.label(j1, format!("{name}_j1_{coordinate}"));
                 g.label(j2, format!("{name}_j2_{coordinate}"));
                 columns[j] = [j1, j2];
+                let j3 = vec3::dot(g, axis, column);
+                height_columns[j] = g.neg(j3);
             }
             // ṙ = Σ col_f q̇ − Σ col_c(o_C) q̇, then the moving frame's terms.
             let mut r_dot = vec3::zero(g);
@@ -371,6 +381,8 @@ pub fn relative(
     };
     let xy = [vec3::dot(g, x_axis, r), vec3::dot(g, y_axis, r)];
     let height = vec3::dot(g, axis, r);
+    let height_convective = vec3::dot(g, axis, accel);
+    let height_rate = dot_list(g, &height_columns, &s.qd);
     let convective = [vec3::dot(g, x_axis, accel), vec3::dot(g, y_axis, accel)];
     let j1: Vec<Id> = columns.iter().map(|c| c[0]).collect();
     let j2: Vec<Id> = columns.iter().map(|c| c[1]).collect();
@@ -414,6 +426,9 @@ pub fn relative(
         y_axis,
         axis,
         height,
+        height_columns,
+        height_convective,
+        height_rate,
         spin_columns,
         spin,
         direction,

@@ -5,7 +5,8 @@
 //! - J against central differences of h (h itself through the contact parameter's Newton
 //!   solve, so the envelope theorem behind J is checked, not assumed);
 //! - c against the second difference of h along the straight path q + τ q̇ (q̈ = 0);
-//! - the follower point's cam-frame J1, J2 and convective terms against differences of X, Y;
+//! - the follower point's cam-frame J1, J2, J3 and convective terms against differences of
+//!   X, Y and Z (Z along the cam's axis: what a cam surface z = f(x, y) will need);
 //! - J against the symbolic derivative of h through the implicit contact parameter
 //!   (ds*/dq by the implicit-function theorem: a third route, exact to rounding).
 
@@ -29,6 +30,8 @@ fn unit(n: usize, k: usize) -> Vec<f64> {
 fn every_kind_on_every_chain_agrees_with_finite_differences() {
     let mut rng = Rng(0x2545_f491_4f6c_dd1d);
     let mut worst = [0.0f64; 4];
+    // The largest |∂Z/∂q| met: the spatial chains must make the J3 check a real one.
+    let mut largest_height_column = 0.0f64;
     for kind in &KINDS {
         for chain in chains(kind) {
             let source = scene(kind, chain);
@@ -58,7 +61,10 @@ fn every_kind_on_every_chain_agrees_with_finite_differences() {
                         (c.jacobian[k], c.h),
                         (r.columns[k][0], r.xy[0]),
                         (r.columns[k][1], r.xy[1]),
+                        (r.height_columns[k], r.height),
                     ];
+                    let j3 = at(&[r.height_columns[k]], &q)[0];
+                    largest_height_column = largest_height_column.max(j3.abs());
                     for (j, (sym, f)) in pairs.into_iter().enumerate() {
                         let (s, f) = (at(&[sym], &q)[0], fd(f));
                         let error = (s - f).abs();
@@ -80,6 +86,7 @@ fn every_kind_on_every_chain_agrees_with_finite_differences() {
                     (c.bias, c.h),
                     (r.convective[0], r.xy[0]),
                     (r.convective[1], r.xy[1]),
+                    (r.height_convective, r.height),
                 ]
                 .into_iter()
                 .enumerate()
@@ -93,8 +100,13 @@ fn every_kind_on_every_chain_agrees_with_finite_differences() {
         }
     }
     eprintln!(
-        "largest differences: J {:.1e}, J1/J2 {:.1e}, convective {:.1e}",
+        "largest differences: J {:.1e}, J1/J2/J3 {:.1e}, convective {:.1e}",
         worst[0], worst[1], worst[2]
+    );
+    // Joint columns of order 0.1 m per radian on the spatial chains' links.
+    assert!(
+        largest_height_column > 1e-2,
+        "no chain moves the follower along the cam's axis: {largest_height_column}"
     );
 }
 
