@@ -972,7 +972,7 @@ mod tests {
             "kind: Slider",
             "bodies[1].joint.kind",
             24,
-            "variant named `Slider`",
+            "variant named `Slider` in enum `JointKind`",
         );
     }
 

@@ -70,6 +70,7 @@ macro_rules! registry {
 
         impl Kind for $kind {
             const FAMILY: &'static str = $family;
+            const TYPE_NAME: &'static str = stringify!($kind);
             const KEYWORDS: &'static [&'static str] = &[$(stringify!($variant)),+];
 
             fn keyword(self) -> &'static str {
@@ -95,6 +96,8 @@ macro_rules! registry {
 pub trait Kind: Copy + Sized + 'static {
     /// The family's name in messages (`follower`, `loop kind`, `integrator`).
     const FAMILY: &'static str;
+    /// The enum's name (`JointKind`): what a file's parser calls the enum in its messages.
+    const TYPE_NAME: &'static str;
     /// Every kind's keyword, in the order of the registry.
     const KEYWORDS: &'static [&'static str];
     /// The kind's keyword, as the model file and generated code spell it.

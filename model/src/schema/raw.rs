@@ -417,7 +417,7 @@ pub(super) struct Keyword<K>(pub K);
 
 impl<'de, K: Kind> Deserialize<'de> for Keyword<K> {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        deserializer.deserialize_enum(K::FAMILY, K::KEYWORDS, KeywordVisitor(PhantomData))
+        deserializer.deserialize_enum(K::TYPE_NAME, K::KEYWORDS, KeywordVisitor(PhantomData))
     }
 }
 
