@@ -36,12 +36,21 @@ pub fn header(info: &ModelInfo) -> Vec<String> {
         } else {
             &["x", "y"]
         };
+        let surface = info.contacts[k].profile.is_surface();
         columns.extend(axes.iter().map(|a| format!("{contact}_{a}")));
         columns.extend(["cam_x", "cam_y"].map(|a| format!("{contact}_{a}")));
+        if surface {
+            columns.push(format!("{contact}_cam_z"));
+        }
         if info.contacts[k].cam_coordinate.is_some() {
             columns.push(format!("{contact}_cam_angle"));
         }
         columns.push(format!("{contact}_normal_force"));
+        if surface {
+            // On a cam surface the normal's direction is not the cam plane's: its ground
+            // components.
+            columns.extend(["x", "y", "z"].map(|a| format!("{contact}_normal_{a}")));
+        }
         if info.contacts[k].cam_moves {
             columns.push(format!("{contact}_pressure_angle"));
         }
@@ -70,12 +79,19 @@ pub fn row(info: &ModelInfo, sample: &Sample) -> Vec<f64> {
     values.extend(&sample.qd);
     let dims = if info.spatial { 3 } else { 2 };
     for (k, (contact, about)) in sample.contacts.iter().zip(&info.contacts).enumerate() {
+        let surface = about.profile.is_surface();
         values.extend(&contact.position[..dims]);
         values.extend([contact.x, contact.y]);
+        if surface {
+            values.push(contact.z);
+        }
         if let Some(i) = about.cam_coordinate {
             values.push(sample.q[i]);
         }
         values.push(sample.normal_force[k]);
+        if surface {
+            values.extend(contact.normal);
+        }
         if about.cam_moves {
             values.push(contact.pressure_angle());
         }
@@ -134,6 +150,7 @@ mod tests {
             "double_pendulum",
             "eccentric_roller",
             "paper_rotating",
+            "paraboloid_orbit",
         ] {
             let model = models::by_name(name).unwrap();
             let info = model.info();
@@ -180,5 +197,24 @@ mod tests {
         ] {
             assert!(values[at(column)] != 0.0, "{column}");
         }
+        // A cam surface adds the contact point's height and the normal's direction.
+        let model = models::by_name("paraboloid_orbit").unwrap();
+        let columns = header(model.info());
+        let sample = model.sample(&model.assemble(0.0).unwrap()).unwrap();
+        let values = row(model.info(), &sample);
+        let at = |name: &str| columns.iter().position(|c| c == name).unwrap();
+        // z = c r0² = 2 · 0.1² on the orbit's start (x = r0, y = 0), the normal
+        // (−2 c r0, 0, 1)/√(1 + (2 c r0)²): the paraboloid's closed form, to rounding.
+        assert!((values[at("bowl_cam_z")] - 0.02).abs() < 1e-15);
+        let w = (1.0f64 + 0.16).sqrt();
+        for (axis, expected) in [("x", -0.4 / w), ("y", 0.0), ("z", 1.0 / w)] {
+            let got = values[at(&format!("bowl_normal_{axis}"))];
+            assert!(
+                (got - expected).abs() < 1e-15,
+                "normal_{axis}: {got} vs {expected}"
+            );
+        }
+        // A plane profile has neither.
+        assert!(!driven.iter().any(|c| c == "A_cam_z" || c == "A_normal_x"));
     }
 }

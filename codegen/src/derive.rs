@@ -284,6 +284,9 @@ impl Derivation {
             {
                 f(group, id);
             }
+            if let Some(z) = &mut c.cam_height {
+                f(group, z);
+            }
             c.jacobian.iter_mut().for_each(|id| f(group + 1, id));
             f(group + 1, &mut c.bias);
             f(group + 1, &mut c.sliding);

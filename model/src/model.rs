@@ -200,7 +200,8 @@ impl Follower<f64> {
     }
 }
 
-/// A cam profile: a curve in the cam plane, given by expressions with symbolic derivatives.
+/// A cam profile: a curve in the cam plane, or a surface over it, given by expressions with
+/// symbolic derivatives.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Profile {
     /// y = f(x) (the paper's form, eq. 3); the cam's material is below the curve (y < f(x)).
@@ -230,24 +231,43 @@ pub enum Profile {
         /// Parsed y(s).
         y: Scalar,
     },
+    /// A surface z = f(x, y) over the cam plane, z along the cam's axis x̂ × ŷ; the cam's
+    /// material is below it (z < f(x, y)), the follower above. A spatial cam: the follower
+    /// point moves on it in three dimensions (docs/method.md, "Cam surfaces").
+    Surface {
+        /// f as written (variables `x` and `y`).
+        source: String,
+        /// Parsed f.
+        f: Scalar,
+    },
 }
 
 impl Profile {
-    /// `explicit`, `polar` or `parametric`.
+    /// `explicit`, `polar`, `parametric` or `surface`.
     pub fn kind_name(&self) -> &'static str {
         match self {
             Profile::Explicit { .. } => "explicit",
             Profile::Polar { .. } => "polar",
             Profile::Parametric { .. } => "parametric",
+            Profile::Surface { .. } => "surface",
         }
     }
 
-    /// The name of the profile's variable in its expressions.
+    /// The name of the profile's (first) variable in its expressions: a surface's second
+    /// is `y`.
     pub fn variable(&self) -> &'static str {
         match self {
-            Profile::Explicit { .. } => "x",
+            Profile::Explicit { .. } | Profile::Surface { .. } => "x",
             Profile::Polar { .. } => "theta",
             Profile::Parametric { .. } => "s",
+        }
+    }
+
+    /// True for a surface over the cam plane (a spatial cam), false for a plane curve.
+    pub fn is_surface(&self) -> bool {
+        match self {
+            Profile::Surface { .. } => true,
+            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => false,
         }
     }
 }
@@ -289,10 +309,11 @@ pub struct Contact {
 }
 
 impl Contact {
-    /// The profile's expression of the one-variable field `Field::Profile(c)` (f, r or x(s)).
+    /// The profile's expression of the field `Field::Profile(c)` (f, r, x(s), or a
+    /// surface's f(x, y)).
     pub fn profile_expression(&self) -> &Scalar {
         match &self.profile {
-            Profile::Explicit { f, .. } => f,
+            Profile::Explicit { f, .. } | Profile::Surface { f, .. } => f,
             Profile::Polar { r, .. } => r,
             Profile::Parametric { x, .. } => x,
         }
@@ -488,7 +509,8 @@ pub enum Field {
     Origin(usize, usize),
     /// Component k of loop l's point on side s (0 for A, 1 for B).
     LoopPoint(usize, usize, usize),
-    /// The profile of contact c: f(x), r(θ), or x(s) of a parametric one.
+    /// The profile of contact c: f(x), r(θ), x(s) of a parametric one, or a surface's
+    /// f(x, y).
     Profile(usize),
     /// y(s) of contact c's parametric profile.
     ProfileY(usize),

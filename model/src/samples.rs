@@ -8,7 +8,7 @@
 //! parametric (x(s), y(s)), follower on the right. The curvature is side · (c′ × c″)/|c′|³,
 //! positive where the profile is hollow seen from the follower.
 
-use crate::jet::{Jet2, eval_on, own_tables};
+use crate::jet::{Jet2, eval_on, eval_on_all, own_tables};
 use crate::model::Profile;
 use camchain_runtime::contact::ProfileSample;
 
@@ -16,15 +16,20 @@ use camchain_runtime::contact::ProfileSample;
 /// profiles), −1 on the right (polar and parametric ones).
 pub fn follower_side(profile: &Profile) -> f64 {
     match profile {
-        Profile::Explicit { .. } => 1.0,
+        Profile::Explicit { .. } | Profile::Surface { .. } => 1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
     }
 }
 
-/// c, c′, c″ of `profile` at `s`, cam-frame components.
+/// c, c′, c″ of `profile` at `s`, cam-frame components; for a surface z = f(x, y), its trace
+/// on the plane y = 0, (x, f(x, 0)) in that plane's (x, z) components.
 pub fn curve(profile: &Profile, s: f64) -> [[f64; 2]; 3] {
     let at = Jet2::variable(s);
     match profile {
+        Profile::Surface { f, .. } => {
+            let z = eval_on_all(f, &[at, Jet2::constant(0.0)], &own_tables);
+            [[s, z.v], [1.0, z.d1], [0.0, z.d2]]
+        }
         Profile::Explicit { f, .. } => {
             let y = eval_on(f, at, &own_tables);
             [[s, y.v], [1.0, y.d1], [0.0, y.d2]]
@@ -60,7 +65,9 @@ pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> 
             let s = range.0 + (range.1 - range.0) * k as f64 / samples.max(1) as f64;
             let radius = match profile {
                 Profile::Polar { r, .. } => r.eval(s),
-                Profile::Explicit { .. } | Profile::Parametric { .. } => f64::NAN,
+                Profile::Explicit { .. } | Profile::Parametric { .. } | Profile::Surface { .. } => {
+                    f64::NAN
+                }
             };
             ProfileSample {
                 at: s,

@@ -12,6 +12,10 @@
 //!   optimum, where the generated code tracks a local one from a guess.
 //! - A flat face's convective term from the general three-dimensional rotation of its
 //!   normal (the generator uses the planar form).
+//! - A cam surface z = f(x, y) ([`surface`]): its gradient and Hessian from jets along
+//!   lines, its curvature from the shape operator's invariants.
+
+mod surface;
 
 use crate::jet::Jet2;
 use crate::motion::{Motion, Pose, Vec3, vec3};
@@ -67,6 +71,8 @@ struct Seen {
     v: [f64; 2],
     /// The velocity-product part of P̈.
     a: [f64; 2],
+    /// The same three along the cam's axis: Z, Ż and the velocity-product part of Z̈.
+    height: [f64; 3],
     /// A flat face's unit normal m (from the cam into the follower), ṁ and m̈°.
     m: [f64; 2],
     m_dot: [f64; 2],
@@ -138,7 +144,7 @@ impl ContactConst {
             follower: contact.follower,
             profile: contact.profile.clone(),
             tape: match &contact.profile {
-                Profile::Explicit { f, .. } => Tape::new(&[f]),
+                Profile::Explicit { f, .. } | Profile::Surface { f, .. } => Tape::new(&[f]),
                 Profile::Polar { r, .. } => Tape::new(&[r]),
                 Profile::Parametric { x, y, .. } => Tape::new(&[x, y]),
             },
@@ -214,6 +220,7 @@ impl ContactConst {
             p: cam2(r),
             v: cam2(rel_v),
             a: cam2(rel_a),
+            height: [r, rel_v, rel_a].map(|v| f.axis.dot(&v)),
             m: cam2(face),
             m_dot: cam2(m_dot),
             m_acc: cam2(m_acc),
@@ -226,7 +233,13 @@ impl ContactConst {
         let at = Jet2::variable(s);
         let values = self.tape.eval_jet(at);
         let [x, y] = match &self.profile {
+            // A surface's trace on its plane y = 0 (the model's samples give the same); its
+            // contacts do not read it ([`surface`]).
             Profile::Explicit { .. } => [at, values[0]],
+            Profile::Surface { .. } => {
+                let on_trace = self.tape.eval_jet_at(&[at, Jet2::constant(0.0)]);
+                [at, on_trace[0]]
+            }
             Profile::Polar { .. } => {
                 let r = values[0];
                 [r * at.cos(), r * at.sin()]
@@ -242,9 +255,13 @@ impl ContactConst {
 
     /// c(s) alone, in plain arithmetic (what the search compares).
     fn profile_point(&self, s: f64) -> [f64; 2] {
+        match &self.profile {
+            Profile::Surface { .. } => return [s, self.tape.eval_at(&[s, 0.0])[0]],
+            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => {}
+        }
         let values = self.tape.eval(s);
         match &self.profile {
-            Profile::Explicit { .. } => [s, values[0]],
+            Profile::Explicit { .. } | Profile::Surface { .. } => [s, values[0]],
             Profile::Polar { .. } => [values[0] * s.cos(), values[0] * s.sin()],
             Profile::Parametric { .. } => [values[0], values[1]],
         }
@@ -253,7 +270,7 @@ impl ContactConst {
     /// +1 when the follower is on the left of increasing s (explicit), −1 otherwise.
     fn side(&self) -> f64 {
         match self.profile {
-            Profile::Explicit { .. } => 1.0,
+            Profile::Explicit { .. } | Profile::Surface { .. } => 1.0,
             _ => -1.0,
         }
     }
@@ -341,6 +358,17 @@ impl ContactConst {
         let columns: Vec<Seen> = (0..n).map(|j| self.seen(poses, &unit(j), &rest)).collect();
         let frame = self.frame(poses);
         let point = self.point(poses);
+        let direction = {
+            let own = &unit(self.body)[self.body];
+            let d = match self.own_joint {
+                JointKind::Revolute => own.point_velocity(&(point - poses[self.body].origin)),
+                JointKind::Prismatic => own.vel,
+            };
+            d / d.norm()
+        };
+        if self.profile.is_surface() {
+            return self.on_surface(&seen, &columns, &frame, point, direction);
+        }
         let x = seen.p;
         // The contact point sits at the follower point's height along the cam's axis.
         let height = frame.axis.dot(&(point - frame.origin));
@@ -417,19 +445,12 @@ impl ContactConst {
                 seen.v[1] + seen.spin * swing[1],
             ]
         };
-        let direction = {
-            let own = &unit(self.body)[self.body];
-            let d = match self.own_joint {
-                JointKind::Revolute => own.point_velocity(&(point - poses[self.body].origin)),
-                JointKind::Prismatic => own.vel,
-            };
-            d / d.norm()
-        };
         let normal3 = vector(normal);
         let geometry = ContactGeometry {
             position: to_ground(contact).into(),
             x: contact[0],
             y: contact[1],
+            z: 0.0,
             follower: point.into(),
             normal: normal3.into(),
             axis: frame.axis.into(),
@@ -447,6 +468,10 @@ impl ContactConst {
             j2: columns.iter().map(|c| c.v[1]).collect(),
             conv1: seen.a[0],
             conv2: seen.a[1],
+            // Written for a cam surface only, as the generated code does.
+            z: 0.0,
+            j3: vec![0.0; n],
+            conv3: 0.0,
         };
         Evaluated {
             h,

@@ -84,6 +84,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
             Profile::Explicit { .. } => ProfileKind::Explicit,
             Profile::Polar { .. } => ProfileKind::Polar,
             Profile::Parametric { .. } => ProfileKind::Parametric,
+            Profile::Surface { .. } => ProfileKind::Surface,
         },
         cam_coordinate: c
             .cam_body

@@ -64,6 +64,18 @@ pub enum ProfileKind {
     Polar,
     /// (x(s), y(s)).
     Parametric,
+    /// A surface z = f(x, y) over the cam plane (a spatial cam).
+    Surface,
+}
+
+impl ProfileKind {
+    /// True for a surface over the cam plane, false for a plane curve.
+    pub fn is_surface(self) -> bool {
+        match self {
+            ProfileKind::Surface => true,
+            ProfileKind::Explicit | ProfileKind::Polar | ProfileKind::Parametric => false,
+        }
+    }
 }
 
 /// Static description of one contact.
@@ -203,6 +215,9 @@ pub struct ContactGeometry {
     pub x: f64,
     /// The contact point's y in the cam frame.
     pub y: f64,
+    /// The contact point's z in the cam frame, along the cam's axis: the height of a cam
+    /// surface z = f(x, y) there; 0 for a plane profile, whose points are given in its plane.
+    pub z: f64,
     /// The follower point (the knife edge, the centre of a roller or of a curved face's arc,
     /// the marker on the flat face), ground coordinates.
     pub follower: [f64; 3],
@@ -236,6 +251,7 @@ impl Default for ContactGeometry {
             position: [0.0; 3],
             x: 0.0,
             y: 0.0,
+            z: 0.0,
             follower: [0.0; 3],
             normal: [0.0; 3],
             axis: [0.0, 0.0, 1.0],
@@ -252,7 +268,10 @@ impl Default for ContactGeometry {
 impl ContactGeometry {
     /// The pressure angle (rad): the angle between the contact normal and the follower's
     /// direction of motion, in [−π/2, π/2], positive when the normal is turned from the
-    /// direction counterclockwise about the cam's axis.
+    /// direction counterclockwise about the cam's axis. On a cam surface the normal need not
+    /// lie in a plane with the direction and the axis: the magnitude is then the angle in
+    /// space between the two, its sign that of the turn about the axis (positive when there
+    /// is none).
     pub fn pressure_angle(&self) -> f64 {
         let (n, a) = (self.normal, self.axis);
         let mut d = self.direction;
@@ -264,7 +283,10 @@ impl ContactGeometry {
             d[2] * n[0] - d[0] * n[2],
             d[0] * n[1] - d[1] * n[0],
         ];
-        dot3(cross, a).atan2(dot3(d, n))
+        let about_axis = dot3(cross, a);
+        let magnitude = dot3(cross, cross).sqrt();
+        let sign = if about_axis < 0.0 { -1.0 } else { 1.0 };
+        (sign * magnitude).atan2(dot3(d, n))
     }
 }
 
@@ -274,8 +296,9 @@ fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// First- and second-order kinematics of a contact's follower point in the cam frame
 /// (diagnostics and tests): X, Y its cam-frame coordinates, J1 = ∂X/∂q, J2 = ∂Y/∂q, and the
-/// velocity-product parts of Ẍ and Ÿ. For a cam on a moving body these are the relative
-/// kinematics the constraint is written with.
+/// velocity-product parts of Ẍ and Ÿ; on a cam surface also Z, J3 = ∂Z/∂q and that of Z̈.
+/// For a cam on a moving body these are the relative kinematics the constraint is written
+/// with.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ContactKinematics {
     /// Geometry at (q, q̇).
@@ -288,19 +311,26 @@ pub struct ContactKinematics {
     pub j1: Vec<f64>,
     /// J2 = ∂Y/∂q.
     pub j2: Vec<f64>,
+    /// Z: the follower point's height along the cam's axis (written for a cam surface).
+    pub z: f64,
+    /// J3 = ∂Z/∂q (written for a cam surface).
+    pub j3: Vec<f64>,
     /// (J1 q̇)_q q̇: convective part of Ẍ.
     pub conv1: f64,
     /// (J2 q̇)_q q̇: convective part of Ÿ.
     pub conv2: f64,
+    /// (J3 q̇)_q q̇: convective part of Z̈ (written for a cam surface).
+    pub conv3: f64,
 }
 
 impl ContactKinematics {
-    /// Zero kinematics with J1 and J2 of length `n` (the number of coordinates), ready for
+    /// Zero kinematics with J1, J2 and J3 of length `n` (the number of coordinates), ready for
     /// [`Dynamics::contact_kinematics_into`].
     pub fn new(n: usize) -> Self {
         ContactKinematics {
             j1: vec![0.0; n],
             j2: vec![0.0; n],
+            j3: vec![0.0; n],
             ..Default::default()
         }
     }

@@ -170,9 +170,10 @@ pub fn compare_dynamics_at(
                 let ck = m.contact_kinematics(&q, &qd, k);
                 let g = ck.geometry;
                 let mut v = geometry_values(&g, m.info().contacts[k].profile);
-                v.extend([ck.x, ck.y, ck.conv1, ck.conv2]);
+                v.extend([ck.x, ck.y, ck.conv1, ck.conv2, ck.z, ck.conv3]);
                 v.extend(ck.j1);
                 v.extend(ck.j2);
+                v.extend(ck.j3);
                 v
             });
             assert_close_recorded(
@@ -221,10 +222,12 @@ pub fn geometry_values(
     for vector in [g.position, g.follower, g.normal, g.axis, g.direction] {
         v.extend(vector);
     }
-    v.extend([g.x, g.y, g.force_scale, g.curvature, g.sliding_speed]);
+    v.extend([g.x, g.y, g.z, g.force_scale, g.curvature, g.sliding_speed]);
     match profile {
         camchain::runtime::ProfileKind::Polar => v.extend([g.parameter.cos(), g.parameter.sin()]),
-        _ => v.push(g.parameter),
+        camchain::runtime::ProfileKind::Explicit
+        | camchain::runtime::ProfileKind::Parametric
+        | camchain::runtime::ProfileKind::Surface => v.push(g.parameter),
     }
     v
 }

@@ -21,5 +21,6 @@ mod mushroom;
 mod parameters;
 mod random_compiled;
 mod simulation;
+mod surfaces;
 mod tables;
 mod unilateral;

@@ -87,6 +87,7 @@ fn profile_kind(contact: &Contact) -> &'static str {
         Profile::Explicit { .. } => "explicit profile",
         Profile::Polar { .. } => "polar profile",
         Profile::Parametric { .. } => "parametric profile",
+        Profile::Surface { .. } => "surface",
     }
 }
 

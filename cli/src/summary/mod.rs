@@ -108,6 +108,7 @@ pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
         ProfileKind::Explicit => "an explicit profile y = f(x)",
         ProfileKind::Polar => "a polar profile r(θ)",
         ProfileKind::Parametric => "a parametric profile (x(s), y(s))",
+        ProfileKind::Surface => "a surface z = f(x, y)",
     };
     let turned = contact
         .cam_coordinate
@@ -505,6 +506,9 @@ fn material_side(profile: ProfileKind) -> &'static str {
             "the cam lies on the side y < f(x) of its frame and pushes towards +y"
         }
         ProfileKind::Polar => "the cam is the region r < r(θ) of its frame and pushes outwards",
+        ProfileKind::Surface => {
+            "the cam lies below its surface, z < f(x, y) in its frame, and pushes towards +z"
+        }
         ProfileKind::Parametric => {
             "the cam lies on the left of its curve as s increases (inside a curve traced \
              counterclockwise) and pushes to the right"

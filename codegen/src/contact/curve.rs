@@ -7,7 +7,7 @@
 //! follower and the curvature signed so that it is positive where the profile is hollow seen
 //! from the follower.
 
-use crate::expr::scalar::value_and_derivatives;
+use crate::expr::scalar::{scalar_to_expr_in, value_and_derivatives};
 use crate::expr::{Graph, Id};
 use crate::kinematics::Symbols;
 use crate::model::{Field, Model, Profile};
@@ -55,6 +55,23 @@ pub fn curve(
     params: &[Id],
 ) -> CurvePoint {
     match profile {
+        // A surface's trace on its plane y = 0, (x, f(x, 0)) in that plane's (x, z)
+        // components: what the model's samples give too (`camchain_model::samples`). The
+        // contacts on a surface do not read it (their own module does).
+        Profile::Surface { .. } => {
+            let x = g.var(&format!("__cam_{name}"));
+            let zero = g.zero();
+            let f = scalar_to_expr_in(g, first, &[x, zero], params);
+            let d1 = g.diff(f, x);
+            let d2 = g.diff(d1, x);
+            let [f, d1, d2] = [f, d1, d2].map(|e| g.substitute(e, x, at));
+            let one = g.one();
+            CurvePoint {
+                point: [at, f],
+                d1: [one, d1],
+                d2: [zero, d2],
+            }
+        }
         Profile::Explicit { .. } => {
             let placeholder = format!("__cam_{name}");
             let [f, d1, d2] = value_and_derivatives(g, first, &placeholder, at, params);
@@ -112,7 +129,7 @@ fn combine(g: &mut Graph, a: Id, u: [Id; 2], b: Id, v: [Id; 2]) -> [Id; 2] {
 /// profiles), −1 on the right (polar and parametric ones).
 pub fn follower_side(profile: &Profile) -> f64 {
     match profile {
-        Profile::Explicit { .. } => 1.0,
+        Profile::Explicit { .. } | Profile::Surface { .. } => 1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
     }
 }
@@ -267,12 +284,22 @@ mod tests {
                 x: parse("0.05*s.cos() + 0.004*(3.0*s).sin()", "s"),
                 y: parse("0.042*s.sin()", "s"),
             },
+            // Its trace on y = 0 is the explicit profile's.
+            Profile::Surface {
+                source: String::new(),
+                f: crate::profile::parse_expression_in(
+                    "0.045 - 2.0*x*x + 0.3*x.powi(3) + 0.7*x*y - (3.0*y).sin()",
+                    &["x", "y"],
+                    &[],
+                )
+                .expect("parses"),
+            },
         ];
         for profile in &profiles {
             let mut g = Graph::new();
             let at = g.var("s");
             let (first, second) = match profile {
-                Profile::Explicit { f, .. } => (f, None),
+                Profile::Explicit { f, .. } | Profile::Surface { f, .. } => (f, None),
                 Profile::Polar { r, .. } => (r, None),
                 Profile::Parametric { x, y, .. } => (x, Some(y)),
             };

@@ -48,7 +48,9 @@ pub fn flat(
     let objective = g.neg(extent);
     let guess = match contact.profile {
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
-        Profile::Explicit { .. } | Profile::Parametric { .. } => Guess::Scan,
+        Profile::Explicit { .. } | Profile::Parametric { .. } | Profile::Surface { .. } => {
+            Guess::Scan
+        }
     };
     let solution = g.implicit(
         &format!("{name}_parameter"),
@@ -113,6 +115,7 @@ pub fn flat(
         bias,
         position,
         cam_point: at.point,
+        cam_height: None,
         normal: m_ground,
         force_scale: g.one(),
         parameter: solution,

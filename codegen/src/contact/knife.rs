@@ -70,6 +70,7 @@ pub fn explicit(
         bias,
         position: rel.point,
         cam_point: rel.xy,
+        cam_height: None,
         normal,
         force_scale: stretch,
         parameter: x,

@@ -6,8 +6,8 @@
 //! - [`curve`]: the profile as a curve c(s) (explicit, polar, parametric);
 //! - the kinds: [`knife`] (a knife edge on y = f(x), the paper's eqs. 1–8, in closed form),
 //!   [`nearest`] (a roller, or a knife edge, on any profile: the profile point nearest the
-//!   follower point, found by Newton) and [`flat`] (a flat face: the profile's extreme point
-//!   along the face's normal).
+//!   follower point, found by Newton), [`flat`] (a flat face: the profile's extreme point
+//!   along the face's normal) and [`surface`] (a point on a cam surface z = f(x, y)).
 //!
 //! A new kind is one more module here returning [`ContactTerms`] (with the [`Formulas`] the
 //! generated docs quote), and one more arm in [`contact_terms`]; the emitter, the runtime and
@@ -18,6 +18,7 @@ pub mod flat;
 pub mod knife;
 pub mod nearest;
 pub mod relative;
+pub mod surface;
 
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3};
@@ -38,6 +39,8 @@ pub struct ContactTerms {
     pub position: V3,
     /// The contact point in the cam frame.
     pub cam_point: [Id; 2],
+    /// Its height along the cam's axis on a cam surface (`None` for a plane profile).
+    pub cam_height: Option<Id>,
     /// Unit normal, ground coordinates, from the cam into the follower.
     pub normal: V3,
     /// |∂h/∂(displacement along the normal)|: N = −λ · force_scale.
@@ -86,6 +89,9 @@ pub fn contact_terms(
             ));
             let rel = relative::relative(g, model, kin, s, index);
             match (&contact.follower, &contact.profile) {
+                (Follower::Knife, Profile::Surface { .. }) => {
+                    surface::point(g, model, s, index, rel)
+                }
                 (Follower::Knife, Profile::Explicit { .. }) => {
                     knife::explicit(g, model, s, index, rel)
                 }

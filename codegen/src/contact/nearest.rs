@@ -47,7 +47,7 @@ pub fn nearest(
     };
     let objective = dot2(g, d, d);
     let guess = match contact.profile {
-        Profile::Explicit { .. } => Guess::Input(0),
+        Profile::Explicit { .. } | Profile::Surface { .. } => Guess::Input(0),
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
         Profile::Parametric { .. } => Guess::Scan,
     };
@@ -115,6 +115,7 @@ pub fn nearest(
         bias,
         position,
         cam_point: at.point,
+        cam_height: None,
         normal,
         force_scale: g.one(),
         parameter: solution,

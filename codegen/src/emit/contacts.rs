@@ -27,6 +27,10 @@ pub(super) fn contact_output_roots(c: &ContactTerms) -> Vec<Id> {
         .collect();
     roots.extend([c.force_scale, c.parameter, c.curvature, c.sliding]);
     roots.extend(r.columns.iter().flatten());
+    if let Some(z) = c.cam_height {
+        roots.extend([z, r.height, r.height_convective]);
+        roots.extend(&r.height_columns);
+    }
     roots
 }
 
@@ -57,6 +61,9 @@ pub(super) fn geometry_outputs(g: &mut Graph, c: &ContactTerms, prefix: &str) ->
         (format!("{prefix}curvature"), c.curvature),
         (format!("{prefix}sliding_speed"), c.sliding),
     ]);
+    if let Some(z) = c.cam_height {
+        outputs.push((format!("{prefix}z"), z));
+    }
     outputs
 }
 
@@ -141,6 +148,13 @@ pub(super) fn contact_kinematics_specs(
             }
             outputs.push(("out.conv1".to_string(), r.convective[0]));
             outputs.push(("out.conv2".to_string(), r.convective[1]));
+            if c.cam_height.is_some() {
+                outputs.push(("out.z".to_string(), r.height));
+                for (i, &j3) in r.height_columns.iter().enumerate() {
+                    outputs.push((format!("out.j3[{i}]"), j3));
+                }
+                outputs.push(("out.conv3".to_string(), r.height_convective));
+            }
             FunctionSpec {
                 doc: format!(
                     "Geometry of contact `{}` and its follower point's cam-frame kinematics, \

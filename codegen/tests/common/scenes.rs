@@ -42,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 12] = [
+pub const KINDS: [Kind; 13] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -138,6 +138,17 @@ pub const KINDS: [Kind; 12] = [
         offset: 0.0,
         planar_only: true,
         turn: 3.1,
+    },
+    // A surface over the cam plane with every second derivative non-zero and varying, its
+    // height near the follower's (the marker sits in the chain's plane, the cam plane's
+    // z = 0 within millimetres): the knife edge touches it in three dimensions.
+    Kind {
+        name: "knife on surface",
+        follower: "",
+        profile: "surface: \"0.001 + 0.3*x*y - 0.5*x*x + 0.002*(30.0*y).sin() + 0.4*y*y*x\",",
+        offset: 0.0,
+        planar_only: false,
+        turn: 0.4,
     },
 ];
 

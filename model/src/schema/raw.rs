@@ -236,6 +236,9 @@ pub(super) struct Contact {
     /// A parametric profile (x(s), y(s)).
     #[serde(default)]
     pub parametric: Option<Parametric>,
+    /// A surface z = f(x, y) over the cam plane.
+    #[serde(default)]
+    pub surface: Option<String>,
     /// A profile through a table of points.
     #[serde(default)]
     pub table: Option<Table>,

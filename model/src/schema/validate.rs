@@ -167,7 +167,7 @@ impl Context<'_> {
             raw::Number::Value(v) => return Ok(*v),
             raw::Number::Expr(source) => source,
         };
-        let (folded, resolved) = self.table.expression(field, source, None)?;
+        let (folded, resolved) = self.table.expression(field, source, &[])?;
         let runtime = folded.parameters();
         match key {
             Some(key) => {

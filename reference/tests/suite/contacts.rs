@@ -31,7 +31,17 @@ fn derived(d: &Derivation, q: &[f64], qd: &[f64]) -> Vec<f64> {
     ids.extend(r.xy);
     ids.extend(r.convective);
     ids.extend(r.columns.iter().flatten());
+    // A surface's height there and the follower point's Z, J3 and convective term (written
+    // for a surface only: 0 otherwise, as the reference gives them).
+    if c.cam_height.is_some() {
+        ids.extend(c.cam_height);
+        ids.extend([r.height, r.height_convective]);
+        ids.extend(&r.height_columns);
+    }
     let mut v = d.eval(&ids, 0.0, q, qd);
+    if c.cam_height.is_none() {
+        v.extend(std::iter::repeat_n(0.0, 3 + r.height_columns.len()));
+    }
     // The direction of the follower's own joint, normalised as the outputs give it.
     let dir = d.eval(&r.direction, 0.0, q, qd);
     let norm = dir.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -61,6 +71,8 @@ fn numeric(m: &NumericModel, q: &[f64], qd: &[f64]) -> Vec<f64> {
     for i in 0..n {
         v.extend([k.j1[i], k.j2[i]]);
     }
+    v.extend([g.z, k.z, k.conv3]);
+    v.extend(&k.j3);
     v.extend(g.direction);
     v
 }

@@ -195,6 +195,7 @@ impl Dynamics for Bead {
             j2: vec![0.0, 1.0],
             conv1: 0.0,
             conv2: 0.0,
+            ..ContactKinematics::new(2)
         };
     }
     fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
@@ -401,6 +402,7 @@ impl Dynamics for Arm {
             j2: p.jacobian[2][1].to_vec(),
             conv1: p.convective[2][0],
             conv2: p.convective[2][1],
+            ..ContactKinematics::new(q.len())
         };
     }
     fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {

@@ -365,6 +365,6 @@ pub(super) fn prescribed(
 ) -> Checked<Prescribed> {
     Ok(Prescribed {
         source: source.to_string(),
-        expr: expression(cx, field, source, "t", Field::Drive(body))?,
+        expr: expression(cx, field, source, &["t"], Field::Drive(body))?,
     })
 }

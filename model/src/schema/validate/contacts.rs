@@ -180,8 +180,9 @@ impl From<Profile> for Shaped {
     }
 }
 
-/// The profile: exactly one of `profile` (explicit), `polar`, `parametric`, `table` (through
-/// points) and `law` (designed from the follower's motion).
+/// The profile: exactly one of `profile` (explicit), `polar`, `parametric`, `surface` (a
+/// surface z = f(x, y)), `table` (through points) and `law` (designed from the follower's
+/// motion).
 fn profile(
     cx: &Context,
     path: &str,
@@ -194,6 +195,7 @@ fn profile(
         ("profile", c.profile.is_some()),
         ("polar", c.polar.is_some()),
         ("parametric", c.parametric.is_some()),
+        ("surface", c.surface.is_some()),
         ("table", c.table.is_some()),
         ("law", c.law.is_some()),
     ];
@@ -203,15 +205,16 @@ fn profile(
             [] => (
                 format!("{path}.marker"),
                 "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
-                 `polar: \"r(theta)\"`, `parametric: (x: \"x(s)\", y: \"y(s)\")`, `table: (…)` \
-                 (through points) or `law: (…)` (designed from the follower's motion)"
+                 `polar: \"r(theta)\"`, `parametric: (x: \"x(s)\", y: \"y(s)\")`, `surface: \
+                 \"f(x, y)\"` (a surface z = f(x, y)), `table: (…)` (through points) or `law: \
+                 (…)` (designed from the follower's motion)"
                     .to_string(),
             ),
             [.., last] => (
                 format!("{path}.{last}"),
                 format!(
-                    "give only one of `profile`, `polar`, `parametric`, `table` and `law` (this \
-                     contact gives {})",
+                    "give only one of `profile`, `polar`, `parametric`, `surface`, `table` and \
+                     `law` (this contact gives {})",
                     named
                         .iter()
                         .map(|n| format!("`{n}`"))
@@ -238,12 +241,15 @@ fn profile(
             design: Some(design),
         });
     }
+    if let Some(source) = &c.surface {
+        return surface(cx, path, source, i, follower).map(Shaped::from);
+    }
     if let Some(source) = &c.profile {
         let f = expression(
             cx,
             &format!("{path}.profile"),
             source,
-            "x",
+            &["x"],
             Field::Profile(i),
         )?;
         return Ok(Profile::Explicit {
@@ -257,7 +263,7 @@ fn profile(
             cx,
             &format!("{path}.polar"),
             source,
-            "theta",
+            &["theta"],
             Field::Profile(i),
         )?;
         return Ok(Profile::Polar {
@@ -274,14 +280,14 @@ fn profile(
         cx,
         &format!("{path}.parametric.x"),
         &p.x,
-        "s",
+        &["s"],
         Field::Profile(i),
     )?;
     let y = expression(
         cx,
         &format!("{path}.parametric.y"),
         &p.y,
-        "s",
+        &["s"],
         Field::ProfileY(i),
     )?;
     Ok(Profile::Parametric {
@@ -291,6 +297,38 @@ fn profile(
         y,
     }
     .into())
+}
+
+/// A surface z = f(x, y): an expression of `x`, `y` and the parameters, followed by a point
+/// (a knife edge).
+fn surface(
+    cx: &Context,
+    path: &str,
+    source: &str,
+    i: usize,
+    follower: &Follower,
+) -> Checked<Profile> {
+    let f = expression(
+        cx,
+        &format!("{path}.surface"),
+        source,
+        &["x", "y"],
+        Field::Profile(i),
+    )?;
+    match follower.kind().outline() {
+        Outline::Point => Ok(Profile::Surface {
+            source: source.to_string(),
+            f,
+        }),
+        Outline::Circle | Outline::Line => Err(cx.at.error(
+            &format!("{path}.follower"),
+            format!(
+                "a {} cannot follow a surface: a surface takes a point follower (`follower: \
+                 Knife`)",
+                follower.kind().label()
+            ),
+        )),
+    }
 }
 
 fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
@@ -321,6 +359,12 @@ fn contact_range(
     covers: Option<(f64, f64)>,
 ) -> Checked<Option<(f64, f64)>> {
     let field = format!("{path}.range");
+    if c.range.is_some() && profile.is_surface() {
+        return Err(at.error(
+            &field,
+            "a surface has no `range`: the follower point may be anywhere over the cam plane",
+        ));
+    }
     if let Some((a, b)) = c.range {
         finite(at, &format!("{field}[0]"), a)?;
         finite(at, &format!("{field}[1]"), b)?;
@@ -338,11 +382,13 @@ fn contact_range(
     let needs = match (profile, follower.kind().outline()) {
         (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
         (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
-        (Profile::Explicit { .. }, Outline::Point) => None,
-        (Profile::Explicit { .. }, Outline::Circle | Outline::Line) => Some(format!(
-            "a {} on an explicit profile",
-            follower.kind().label()
-        )),
+        (Profile::Explicit { .. } | Profile::Surface { .. }, Outline::Point) => None,
+        (Profile::Explicit { .. } | Profile::Surface { .. }, Outline::Circle | Outline::Line) => {
+            Some(format!(
+                "a {} on an explicit profile",
+                follower.kind().label()
+            ))
+        }
     };
     match needs {
         None => Ok(None),
@@ -442,6 +488,7 @@ fn profile_field(contact: &Contact) -> &'static str {
         Profile::Explicit { .. } => "profile",
         Profile::Polar { .. } => "polar",
         Profile::Parametric { .. } => "parametric",
+        Profile::Surface { .. } => "surface",
     }
 }
 

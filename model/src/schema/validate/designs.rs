@@ -419,7 +419,7 @@ impl Context<'_> {
         let (folded, value) = match n {
             raw::Number::Value(v) => (Scalar::Const(*v), *v),
             raw::Number::Expr(source) => {
-                let (folded, resolved) = self.table.expression(field, source, None)?;
+                let (folded, resolved) = self.table.expression(field, source, &[])?;
                 (folded, resolved.eval(0.0))
             }
         };

@@ -5,7 +5,7 @@ use super::super::Locator;
 use super::fields::{finite, unique_names};
 use super::{Checked, Context, Options, location};
 use crate::model::{Body, Field, Parameter, ParameterMode, RuntimeCheck};
-use crate::profile::{Scalar, parse_expression_with};
+use crate::profile::{Scalar, parse_expression_in, parse_expression_with};
 use crate::schema::raw;
 use camchain_runtime::parameters::{Bound, checks};
 use std::cell::RefCell;
@@ -231,16 +231,17 @@ impl<'a> Table<'a> {
         }
     }
 
-    /// Parses `source` (with `variable`, if any) and folds the constant parameters in:
-    /// (the expression with only run-time parameters left, the fully resolved one).
+    /// Parses `source` (of `variables`, none for a value of the parameters alone) and folds
+    /// the constant parameters in: (the expression with only run-time parameters left, the
+    /// fully resolved one).
     pub(super) fn expression(
         &self,
         field: &str,
         source: &str,
-        variable: Option<&str>,
+        variables: &[&str],
     ) -> Checked<(Scalar, Scalar)> {
         let names: Vec<&str> = self.names.iter().map(String::as_str).collect();
-        let parsed = parse_expression_with(source, variable, &names)
+        let parsed = parse_expression_in(source, variables, &names)
             .map_err(|e| self.at.error_in_string(field, e.offset, e.message))?;
         let folded = parsed.resolve(&self.values, &|i| self.constant[i]);
         let resolved = parsed.resolve_all(&self.values);
@@ -333,17 +334,17 @@ impl<'a> Table<'a> {
     }
 }
 
-/// Parses an expression of `variable` and the parameters, locating errors inside the
-/// string literal; records it under `key` when it uses run-time parameters and returns it
-/// with every parameter resolved.
+/// Parses an expression of `variables` (`["x"]`, a surface's `["x", "y"]`) and the
+/// parameters, locating errors inside the string literal; records it under `key` when it
+/// uses run-time parameters and returns it with every parameter resolved.
 pub(super) fn expression(
     cx: &Context,
     field: &str,
     source: &str,
-    variable: &str,
+    variables: &[&str],
     key: Field,
 ) -> Checked<Scalar> {
-    let (folded, resolved) = cx.table.expression(field, source, Some(variable))?;
+    let (folded, resolved) = cx.table.expression(field, source, variables)?;
     cx.table.record(key, folded);
     Ok(resolved)
 }

@@ -1,0 +1,270 @@
+//! A point (knife edge) on a cam surface z = f(x, y): the paper's contact with one more
+//! argument (docs/method.md §13). With (X, Y, Z) the follower point in the cam frame
+//! ([`Relative`], Z along the cam's axis x̂ × ŷ):
+//!
+//! ```text
+//! h = Z − f(X, Y)                                                         (S1)
+//! J = J3 − f_x J1 − f_y J2                                                (S2)
+//! c = c3 − f_x c1 − f_y c2 − (f_xx Ẋ² + 2 f_xy Ẋ Ẏ + f_yy Ẏ²)             (S3)
+//! ```
+//!
+//! As for y = f(x), h is not a distance: |∇h| = √(1 + f_x² + f_y²) is the factor between λ
+//! and the normal force. The gradient and Hessian of f are derived symbolically from the
+//! expression, like f′ and f″ of a plane profile.
+
+use super::relative::Relative;
+use super::{ContactTerms, Formulas};
+use crate::expr::scalar::scalar_to_expr_in;
+use crate::expr::{Graph, Id};
+use crate::kinematics::{Symbols, V3, vec3};
+use crate::model::{Field, Model};
+
+/// f and its derivatives at the follower point's (X, Y).
+struct Derivatives {
+    f: Id,
+    fx: Id,
+    fy: Id,
+    fxx: Id,
+    fxy: Id,
+    fyy: Id,
+}
+
+/// f, ∇f and the Hessian of contact `index`'s surface at (x, y), symbolic.
+fn derivatives(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    [x, y]: [Id; 2],
+) -> Derivatives {
+    let contact = &model.contacts[index];
+    let name = &contact.name;
+    let expression = s.expression(model, Field::Profile(index), contact.profile_expression());
+    let (px, py) = (
+        g.var(&format!("__surface_{name}_x")),
+        g.var(&format!("__surface_{name}_y")),
+    );
+    let f = scalar_to_expr_in(g, expression, &[px, py], &s.params);
+    let fx = g.diff(f, px);
+    let fy = g.diff(f, py);
+    let fxx = g.diff(fx, px);
+    let fxy = g.diff(fx, py);
+    let fyy = g.diff(fy, py);
+    let mut at = |e: Id| {
+        let e = g.substitute(e, px, x);
+        g.substitute(e, py, y)
+    };
+    let d = Derivatives {
+        f: at(f),
+        fx: at(fx),
+        fy: at(fy),
+        fxx: at(fxx),
+        fxy: at(fxy),
+        fyy: at(fyy),
+    };
+    for (id, what) in [
+        (d.fx, "fx"),
+        (d.fy, "fy"),
+        (d.fxx, "fxx"),
+        (d.fxy, "fxy"),
+        (d.fyy, "fyy"),
+    ] {
+        g.label(id, format!("{name}_{what}"));
+    }
+    d
+}
+
+/// The terms of contact `index`, a point on a surface z = f(x, y).
+pub fn point(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    rel: Relative,
+) -> ContactTerms {
+    let name = model.contacts[index].name.clone();
+    let [x, y] = rel.xy;
+    let d = derivatives(g, model, s, index, [x, y]);
+    let h = g.sub(rel.height, d.f);
+    let jacobian = rel
+        .columns
+        .iter()
+        .zip(&rel.height_columns)
+        .map(|(&[j1, j2], &j3)| {
+            let a = g.mul(d.fx, j1);
+            let b = g.mul(d.fy, j2);
+            let ab = g.add(a, b);
+            g.sub(j3, ab)
+        })
+        .collect();
+    let [vx, vy] = rel.velocity;
+    let bias = {
+        let a = g.mul(d.fx, rel.convective[0]);
+        let b = g.mul(d.fy, rel.convective[1]);
+        let xx = {
+            let sq = g.mul(vx, vx);
+            g.mul(d.fxx, sq)
+        };
+        let xy = {
+            let p = g.mul(vx, vy);
+            let p = g.mul(d.fxy, p);
+            g.scale(2.0, p)
+        };
+        let yy = {
+            let sq = g.mul(vy, vy);
+            g.mul(d.fyy, sq)
+        };
+        let subtracted = g.sum([a, b, xx, xy, yy]);
+        g.sub(rel.height_convective, subtracted)
+    };
+    // What the outputs report (S4)–(S6): the unit normal (−f_x, −f_y, 1)/W with
+    // W = √(1 + f_x² + f_y²), the larger principal curvature, the sliding speed.
+    let one = g.one();
+    let gradient2 = {
+        let a = g.mul(d.fx, d.fx);
+        let b = g.mul(d.fy, d.fy);
+        g.add(a, b)
+    };
+    let stretch2 = g.add(one, gradient2);
+    let stretch = g.sqrt(stretch2);
+    g.label(stretch, format!("{name}_stretch"));
+    let unit = [g.neg(d.fx), g.neg(d.fy), one].map(|c| g.div(c, stretch));
+    for (&id, axis) in unit.iter().zip(["x", "y", "z"]) {
+        g.label(id, format!("{name}_cam_normal_{axis}"));
+    }
+    let normal = to_ground_vector(g, &rel, unit);
+    let curvature = principal_curvature(g, &d, stretch, &name);
+    let sliding = {
+        let v = [vx, vy, rel.height_rate];
+        let along = dot(g, v, unit);
+        g.label(along, format!("{name}_normal_speed"));
+        let tangential: Vec<Id> = (0..3)
+            .map(|k| {
+                let n = g.mul(along, unit[k]);
+                g.sub(v[k], n)
+            })
+            .collect();
+        for (&id, axis) in tangential.iter().zip(["x", "y", "z"]) {
+            g.label(id, format!("{name}_slip_{axis}"));
+        }
+        let squares: Vec<Id> = tangential.iter().map(|&t| g.mul(t, t)).collect();
+        let sum = g.sum(squares);
+        g.sqrt(sum)
+    };
+    let position = {
+        let in_plane = rel.to_ground(g, [x, y]);
+        let lift = g.sub(d.f, rel.height);
+        let lift = vec3::scale(g, lift, rel.axis);
+        vec3::add(g, in_plane, lift)
+    };
+    vec3::label(g, position, &format!("{name}_contact"));
+    ContactTerms {
+        h,
+        jacobian,
+        bias,
+        position,
+        cam_point: [x, y],
+        cam_height: Some(d.f),
+        normal,
+        force_scale: stretch,
+        parameter: x,
+        curvature,
+        sliding,
+        relative: rel,
+        formulas: Formulas {
+            kind: "a point on a surface z = f(x, y)".to_string(),
+            h: "h = Z − f(X, Y), eq. (S1)",
+            jacobian: "J = J3 − f_x J1 − f_y J2, eq. (S2)",
+            bias: "eq. (S3)",
+        },
+    }
+}
+
+fn dot(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> Id {
+    let products: Vec<Id> = (0..3).map(|k| g.mul(a[k], b[k])).collect();
+    g.sum(products)
+}
+
+/// The ground vector of cam-frame components (x, y, z).
+fn to_ground_vector(g: &mut Graph, rel: &Relative, [x, y, z]: [Id; 3]) -> V3 {
+    let in_plane = rel.vector_to_ground(g, [x, y]);
+    let up = vec3::scale(g, z, rel.axis);
+    vec3::add(g, in_plane, up)
+}
+
+/// The larger principal curvature of the surface (S5), positive where it is hollow seen from
+/// above (from the follower): the larger eigenvalue of G⁻¹ II, with the first fundamental
+/// form G = I + ∇f ∇fᵀ and the second II = Hess f / W. With G = L Lᵀ (Cholesky) the
+/// eigenvalues are those of the symmetric A = L⁻¹ II L⁻ᵀ, whose discriminant
+/// ((A11 − A22)/2)² + A12² is a sum of squares: never negative by round-off.
+fn principal_curvature(g: &mut Graph, d: &Derivatives, stretch: Id, name: &str) -> Id {
+    let one = g.one();
+    // L = [[l11, 0], [l21, l22]]: l11 = √(1 + f_x²), l21 = f_x f_y / l11, l22 = W / l11.
+    let fx2 = g.mul(d.fx, d.fx);
+    let g11 = g.add(one, fx2);
+    let l11 = g.sqrt(g11);
+    let fxfy = g.mul(d.fx, d.fy);
+    let l21 = g.div(fxfy, l11);
+    let l22 = g.div(stretch, l11);
+    // L⁻¹ = [[u, 0], [v, w]].
+    let u = g.div(one, l11);
+    let w = g.div(one, l22);
+    let v = {
+        let p = g.mul(l11, l22);
+        let r = g.div(l21, p);
+        g.neg(r)
+    };
+    let [a, b, c] = [d.fxx, d.fxy, d.fyy].map(|e| g.div(e, stretch));
+    let a11 = {
+        let uu = g.mul(u, u);
+        g.mul(uu, a)
+    };
+    let a12 = {
+        let va = g.mul(v, a);
+        let wb = g.mul(w, b);
+        let s = g.add(va, wb);
+        g.mul(u, s)
+    };
+    let a22 = {
+        let vv = g.mul(v, v);
+        let t1 = g.mul(vv, a);
+        let vw = g.mul(v, w);
+        let t2 = g.mul(vw, b);
+        let t2 = g.scale(2.0, t2);
+        let ww = g.mul(w, w);
+        let t3 = g.mul(ww, c);
+        g.sum([t1, t2, t3])
+    };
+    let mean = {
+        let s = g.add(a11, a22);
+        g.scale(0.5, s)
+    };
+    let half_gap = {
+        let s = g.sub(a11, a22);
+        g.scale(0.5, s)
+    };
+    let discriminant = {
+        let p = g.mul(half_gap, half_gap);
+        let q = g.mul(a12, a12);
+        g.add(p, q)
+    };
+    for (id, what) in [
+        (g11, "g11"),
+        (l11, "l11"),
+        (l21, "l21"),
+        (l22, "l22"),
+        (u, "inv_l11"),
+        (v, "inv_l21"),
+        (w, "inv_l22"),
+        (a11, "shape_11"),
+        (a12, "shape_12"),
+        (a22, "shape_22"),
+        (mean, "mean_curvature"),
+        (half_gap, "curvature_half_gap"),
+        (discriminant, "curvature_discriminant"),
+    ] {
+        g.label(id, format!("{name}_{what}"));
+    }
+    let root = g.sqrt(discriminant);
+    g.add(mean, root)
+}

@@ -1,0 +1,111 @@
+//! Cam surfaces in a model file: what is accepted, and every misuse refused at the field it
+//! concerns (file, line, column and field named).
+
+use camchain_model::model::Profile;
+use camchain_model::schema::parse_model;
+use std::path::Path;
+
+/// A particle on three slides and a surface under it; each line of interest stands alone.
+const BASE: &str = r#"(
+    name: "surface_test",
+    gravity: (0.0, 0.0, -9.81),
+    parameters: [(name: "c", value: 2.0, unit: "1/m")],
+    bodies: [
+        (name: "sx", parent: "ground", mass: 1e-9, inertia: Izz(1e-9),
+         joint: (kind: Prismatic, axis: (1.0, 0.0, 0.0), coordinate: "x")),
+        (name: "sy", parent: "sx", mass: 1e-9, inertia: Izz(1e-9),
+         joint: (kind: Prismatic, axis: (0.0, 1.0, 0.0), coordinate: "y")),
+        (name: "p", parent: "sy", mass: 1.0, inertia: Izz(1e-9),
+         joint: (kind: Prismatic, axis: (0.0, 0.0, 1.0), coordinate: "z")),
+    ],
+    markers: [(name: "tip", body: "p", position: (0.0, 0.0, 0.0))],
+    contacts: [(
+        marker: "tip",
+        surface: "c*(x*x + y*y) + 0.1*(x*y).sin()",
+    )],
+    initial: (q: {"x": 0.1}, hold: ["x", "y"]),
+)
+"#;
+
+fn edited(old: &str, new: &str) -> String {
+    assert_eq!(BASE.matches(old).count(), 1, "{old:?} must occur once");
+    BASE.replace(old, new)
+}
+
+fn rejected(source: &str, field: &str, line: usize, text: &str) -> camchain_model::ModelError {
+    match parse_model(source, Path::new("models/surface.ron")) {
+        Ok(m) => panic!("should be rejected, parsed {}", m.name),
+        Err(e) => {
+            assert_eq!(e.field, field, "{e}");
+            assert_eq!(e.line, line, "{e}");
+            assert!(e.message.contains(text), "{e} lacks {text:?}");
+            assert!(e.to_string().starts_with("models/surface.ron:"), "{e}");
+            e
+        }
+    }
+}
+
+#[test]
+fn a_surface_parses_as_a_function_of_x_and_y() {
+    let model = parse_model(BASE, Path::new("models/surface.ron")).expect("parses");
+    let contact = &model.contacts[0];
+    let Profile::Surface { f, source } = &contact.profile else {
+        panic!("a surface: {:?}", contact.profile)
+    };
+    assert_eq!(source, "c*(x*x + y*y) + 0.1*(x*y).sin()");
+    // Evaluated at (x, y) = (0.3, -0.2) with c = 2: 2·0.13 + 0.1 sin(−0.06).
+    let expected = 2.0 * 0.13 + 0.1 * (-0.06f64).sin();
+    assert!((f.eval_at(&[0.3, -0.2]) - expected).abs() < 1e-15);
+    assert!(contact.profile.is_surface());
+    assert_eq!(contact.range, None);
+}
+
+#[test]
+fn a_surface_expression_names_only_x_y_and_parameters() {
+    let e = rejected(
+        &edited("0.1*(x*y).sin()", "0.1*(x*z).sin()"),
+        "contacts[0].surface",
+        16,
+        "unknown name `z`: the variables allowed here are `x` and `y`",
+    );
+    // `z` is byte 23 of the expression, whose quote is at column 18.
+    assert_eq!(e.column, 18 + 1 + 23);
+}
+
+#[test]
+fn a_surface_takes_a_point_follower_only() {
+    for follower in [
+        "Roller(radius: 0.01)",
+        "Flat(normal: (0.0, 0.0, 1.0))",
+        "Mushroom(radius: 0.05, normal: (0.0, 0.0, -1.0))",
+    ] {
+        rejected(
+            &edited(
+                "marker: \"tip\",\n",
+                &format!("marker: \"tip\", follower: {follower},\n"),
+            ),
+            "contacts[0].follower",
+            15,
+            "a surface takes a point follower",
+        );
+    }
+}
+
+#[test]
+fn a_surface_has_no_range_and_no_second_profile() {
+    rejected(
+        &edited(
+            "marker: \"tip\",\n",
+            "marker: \"tip\", range: (0.0, 1.0),\n",
+        ),
+        "contacts[0].range",
+        15,
+        "a surface has no `range`",
+    );
+    rejected(
+        &edited("marker: \"tip\",\n", "marker: \"tip\", profile: \"x*x\",\n"),
+        "contacts[0].surface",
+        16,
+        "give only one of",
+    );
+}

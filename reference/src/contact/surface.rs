@@ -1,0 +1,124 @@
+//! A point on a cam surface z = f(x, y), by the reference's own routes (docs/method.md §13):
+//!
+//! - the follower point's Z, Ż and the velocity-product part of Z̈ come from the full
+//!   recursions like X and Y ([`Seen`]);
+//! - f's gradient and Hessian from forward-mode jets of f along lines through (X, Y): along
+//!   x̂ and ŷ for f_x, f_xx, f_y, f_yy, along x̂ + ŷ for f_xy; the convective term's
+//!   Ẋᵀ H Ẋ as the second derivative of f along the velocity itself;
+//! - the principal curvature from the shape operator G⁻¹ II's mean and Gaussian curvatures
+//!   (the generator takes a Cholesky route).
+
+use super::{CamFrame, ContactConst, Evaluated, Seen};
+use crate::jet::Jet2;
+use crate::motion::Vec3;
+use camchain_runtime::{ContactGeometry, ContactKinematics};
+
+/// f, ∇f and the Hessian [f_xx, f_xy, f_yy] at a point.
+struct Local {
+    f: f64,
+    gradient: [f64; 2],
+    hessian: [f64; 3],
+}
+
+impl ContactConst {
+    /// f along the line (x, y) + t (dx, dy): the value and the first two derivatives in t.
+    fn along(&self, [x, y]: [f64; 2], [dx, dy]: [f64; 2]) -> Jet2 {
+        let line = |at: f64, d: f64| Jet2 {
+            v: at,
+            d1: d,
+            d2: 0.0,
+        };
+        self.tape.eval_jet_at(&[line(x, dx), line(y, dy)])[0]
+    }
+
+    fn local(&self, p: [f64; 2]) -> Local {
+        let (ex, ey, diagonal) = (
+            self.along(p, [1.0, 0.0]),
+            self.along(p, [0.0, 1.0]),
+            self.along(p, [1.0, 1.0]),
+        );
+        Local {
+            f: ex.v,
+            gradient: [ex.d1, ey.d1],
+            hessian: [ex.d2, 0.5 * (diagonal.d2 - ex.d2 - ey.d2), ey.d2],
+        }
+    }
+
+    /// h, J, c and the outputs of a point on this contact's surface.
+    pub(super) fn on_surface(
+        &self,
+        seen: &Seen,
+        columns: &[Seen],
+        frame: &CamFrame,
+        point: Vec3,
+        direction: Vec3,
+    ) -> Evaluated {
+        let p = seen.p;
+        let Local {
+            f,
+            gradient: [fx, fy],
+            hessian,
+        } = self.local(p);
+        let h = seen.height[0] - f;
+        let jacobian: Vec<f64> = columns
+            .iter()
+            .map(|c| c.height[1] - fx * c.v[0] - fy * c.v[1])
+            .collect();
+        let curve_of_path = self.along(p, seen.v).d2;
+        let bias = seen.height[2] - fx * seen.a[0] - fy * seen.a[1] - curve_of_path;
+        let stretch = (1.0 + fx * fx + fy * fy).sqrt();
+        let unit = [-fx / stretch, -fy / stretch, 1.0 / stretch];
+        let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
+        let velocity = [seen.v[0], seen.v[1], seen.height[1]];
+        let along: f64 = (0..3).map(|k| velocity[k] * unit[k]).sum();
+        let sliding = (0..3)
+            .map(|k| (velocity[k] - along * unit[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let position = frame.origin + frame.x * p[0] + frame.y * p[1] + frame.axis * f;
+        let geometry = ContactGeometry {
+            position: position.into(),
+            x: p[0],
+            y: p[1],
+            z: f,
+            follower: point.into(),
+            normal: normal.into(),
+            axis: frame.axis.into(),
+            force_scale: stretch,
+            parameter: p[0],
+            curvature: larger_principal_curvature([fx, fy], hessian),
+            direction: direction.into(),
+            sliding_speed: sliding,
+        };
+        let kinematics = ContactKinematics {
+            geometry,
+            x: p[0],
+            y: p[1],
+            j1: columns.iter().map(|c| c.v[0]).collect(),
+            j2: columns.iter().map(|c| c.v[1]).collect(),
+            conv1: seen.a[0],
+            conv2: seen.a[1],
+            z: seen.height[0],
+            j3: columns.iter().map(|c| c.height[1]).collect(),
+            conv3: seen.height[2],
+        };
+        Evaluated {
+            h,
+            jacobian,
+            bias,
+            geometry,
+            kinematics,
+        }
+    }
+}
+
+/// The larger eigenvalue of the shape operator G⁻¹ II of z = f(x, y) with the upward normal:
+/// mean curvature H = tr/2 and Gaussian curvature K = det, κ = H + √(H² − K).
+fn larger_principal_curvature([fx, fy]: [f64; 2], [a, b, c]: [f64; 3]) -> f64 {
+    let w2 = 1.0 + fx * fx + fy * fy;
+    let w = w2.sqrt();
+    // G = [[1 + fx², fx fy], [fx fy, 1 + fy²]], det G = w²; II = [[a, b], [b, c]] / w.
+    let gaussian = (a * c - b * b) / (w2 * w2);
+    let mean = ((1.0 + fy * fy) * a - 2.0 * fx * fy * b + (1.0 + fx * fx) * c) / (2.0 * w2 * w);
+    mean + (mean * mean - gaussian).max(0.0).sqrt()
+}
