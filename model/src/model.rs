@@ -240,6 +240,18 @@ pub enum Profile {
         /// Parsed f.
         f: Scalar,
     },
+    /// A barrel (cylindrical) cam: the pitch surface z = f(θ) of a groove or rib on a
+    /// cylinder about the cam's axis, θ the follower point's angle about that axis from x̂.
+    /// The follower point (a roller's centre) stays on it; the cam's material is on the side
+    /// z < f(θ) of the point touched (docs/method.md §13.4).
+    Barrel {
+        /// f as written (variable `theta`), or the motion law's description.
+        source: String,
+        /// Parsed f, or the law's tabulated displacement.
+        f: Scalar,
+        /// The pitch cylinder's radius R (m): where the roller's centre runs.
+        radius: f64,
+    },
 }
 
 impl Profile {
@@ -250,6 +262,7 @@ impl Profile {
             Profile::Polar { .. } => "polar",
             Profile::Parametric { .. } => "parametric",
             Profile::Surface { .. } => "surface",
+            Profile::Barrel { .. } => "barrel",
         }
     }
 
@@ -258,15 +271,16 @@ impl Profile {
     pub fn variable(&self) -> &'static str {
         match self {
             Profile::Explicit { .. } | Profile::Surface { .. } => "x",
-            Profile::Polar { .. } => "theta",
+            Profile::Polar { .. } | Profile::Barrel { .. } => "theta",
             Profile::Parametric { .. } => "s",
         }
     }
 
-    /// True for a surface over the cam plane (a spatial cam), false for a plane curve.
+    /// True for a surface (a spatial cam: over the cam plane, or a barrel's), false for a
+    /// plane curve.
     pub fn is_surface(&self) -> bool {
         match self {
-            Profile::Surface { .. } => true,
+            Profile::Surface { .. } | Profile::Barrel { .. } => true,
             Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => false,
         }
     }
@@ -313,7 +327,9 @@ impl Contact {
     /// surface's f(x, y)).
     pub fn profile_expression(&self) -> &Scalar {
         match &self.profile {
-            Profile::Explicit { f, .. } | Profile::Surface { f, .. } => f,
+            Profile::Explicit { f, .. }
+            | Profile::Surface { f, .. }
+            | Profile::Barrel { f, .. } => f,
             Profile::Polar { r, .. } => r,
             Profile::Parametric { x, .. } => x,
         }

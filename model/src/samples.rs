@@ -16,19 +16,24 @@ use camchain_runtime::contact::ProfileSample;
 /// profiles), −1 on the right (polar and parametric ones).
 pub fn follower_side(profile: &Profile) -> f64 {
     match profile {
-        Profile::Explicit { .. } | Profile::Surface { .. } => 1.0,
+        Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
     }
 }
 
 /// c, c′, c″ of `profile` at `s`, cam-frame components; for a surface z = f(x, y), its trace
-/// on the plane y = 0, (x, f(x, 0)) in that plane's (x, z) components.
+/// on the plane y = 0, (x, f(x, 0)) in that plane's (x, z) components; for a barrel cam, its
+/// pitch curve developed on the plane, (R θ, f(θ)).
 pub fn curve(profile: &Profile, s: f64) -> [[f64; 2]; 3] {
     let at = Jet2::variable(s);
     match profile {
         Profile::Surface { f, .. } => {
             let z = eval_on_all(f, &[at, Jet2::constant(0.0)], &own_tables);
             [[s, z.v], [1.0, z.d1], [0.0, z.d2]]
+        }
+        Profile::Barrel { f, radius, .. } => {
+            let z = eval_on(f, at, &own_tables);
+            [[radius * s, z.v], [*radius, z.d1], [0.0, z.d2]]
         }
         Profile::Explicit { f, .. } => {
             let y = eval_on(f, at, &own_tables);
@@ -65,9 +70,10 @@ pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> 
             let s = range.0 + (range.1 - range.0) * k as f64 / samples.max(1) as f64;
             let radius = match profile {
                 Profile::Polar { r, .. } => r.eval(s),
-                Profile::Explicit { .. } | Profile::Parametric { .. } | Profile::Surface { .. } => {
-                    f64::NAN
-                }
+                Profile::Explicit { .. }
+                | Profile::Parametric { .. }
+                | Profile::Surface { .. }
+                | Profile::Barrel { .. } => f64::NAN,
             };
             ProfileSample {
                 at: s,

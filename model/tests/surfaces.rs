@@ -109,3 +109,83 @@ fn a_surface_has_no_range_and_no_second_profile() {
         "give only one of",
     );
 }
+
+/// BASE with its surface replaced by a barrel cam.
+fn barrel(fields: &str) -> String {
+    edited(
+        "surface: \"c*(x*x + y*y) + 0.1*(x*y).sin()\",",
+        &format!("barrel: ({fields}),"),
+    )
+}
+
+#[test]
+fn a_barrel_groove_parses_and_closes_round_the_cylinder() {
+    let source = barrel("radius: 0.06, groove: \"0.01*theta.sin()\"");
+    let model = parse_model(&source, Path::new("models/surface.ron")).expect("parses");
+    let Profile::Barrel { f, radius, .. } = &model.contacts[0].profile else {
+        panic!("a barrel: {:?}", model.contacts[0].profile)
+    };
+    assert_eq!(*radius, 0.06);
+    assert!((f.eval(1.0) - 0.01 * 1.0f64.sin()).abs() < 1e-17);
+    // 0.01 θ grows round the cylinder: refused at the groove's text.
+    rejected(
+        &barrel("radius: 0.06, groove: \"0.01*theta\""),
+        "contacts[0].barrel.groove",
+        16,
+        "must close round the cylinder",
+    );
+}
+
+#[test]
+fn a_barrel_designed_from_a_law_is_its_base_plus_the_law() {
+    let source = barrel(
+        "radius: 0.06, law: (base: 0.02, segments: [Dwell(degrees: 60), Rise(law: Cycloidal, \
+         lift: 0.03, degrees: 120), Dwell(degrees: 60), Return(law: Cycloidal, degrees: 120)])",
+    );
+    let model = parse_model(&source, Path::new("models/surface.ron")).expect("parses");
+    let f = model.contacts[0].profile_expression();
+    // Counterclockwise: the follower at the cam frame's angle θ = −φ reads the law at φ: in
+    // the dwell after the rise (φ = 200°) the groove is at base + lift; in the first dwell
+    // (φ = 30°) at base.
+    assert!((f.eval(-200f64.to_radians()) - 0.05).abs() < 1e-15);
+    assert!((f.eval(-30f64.to_radians()) - 0.02).abs() < 1e-15);
+    // The middle of the rise (φ = 120°): base + lift/2 (the cycloid's midpoint).
+    assert!((f.eval(-120f64.to_radians()) - 0.035).abs() < 1e-15);
+}
+
+#[test]
+fn a_barrel_needs_a_radius_a_groove_and_a_roller() {
+    rejected(
+        &barrel("radius: -0.06, groove: \"0.01*theta.sin()\""),
+        "contacts[0].barrel.radius",
+        16,
+        "pitch radius",
+    );
+    rejected(
+        &barrel("radius: 0.06"),
+        "contacts[0].barrel",
+        16,
+        "needs its groove",
+    );
+    rejected(
+        &barrel(
+            "radius: 0.06, groove: \"0.01*theta.sin()\", law: (segments: [Dwell(degrees: 360)])",
+        ),
+        "contacts[0].barrel.law",
+        16,
+        "not both",
+    );
+    rejected(
+        &edited(
+            "marker: \"tip\",\n",
+            "marker: \"tip\", follower: Flat(normal: (0.0, 0.0, 1.0)),\n",
+        )
+        .replace(
+            "surface: \"c*(x*x + y*y) + 0.1*(x*y).sin()\",",
+            "barrel: (radius: 0.06, groove: \"0.01*theta.sin()\"),",
+        ),
+        "contacts[0].follower",
+        15,
+        "cannot run in a barrel cam's groove",
+    );
+}

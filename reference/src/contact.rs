@@ -144,7 +144,9 @@ impl ContactConst {
             follower: contact.follower,
             profile: contact.profile.clone(),
             tape: match &contact.profile {
-                Profile::Explicit { f, .. } | Profile::Surface { f, .. } => Tape::new(&[f]),
+                Profile::Explicit { f, .. }
+                | Profile::Surface { f, .. }
+                | Profile::Barrel { f, .. } => Tape::new(&[f]),
                 Profile::Polar { r, .. } => Tape::new(&[r]),
                 Profile::Parametric { x, y, .. } => Tape::new(&[x, y]),
             },
@@ -236,6 +238,8 @@ impl ContactConst {
             // A surface's trace on its plane y = 0 (the model's samples give the same); its
             // contacts do not read it ([`surface`]).
             Profile::Explicit { .. } => [at, values[0]],
+            // A barrel's pitch curve developed at its radius, (R θ, g(θ)).
+            Profile::Barrel { radius, .. } => [at * Jet2::constant(*radius), values[0]],
             Profile::Surface { .. } => {
                 let on_trace = self.tape.eval_jet_at(&[at, Jet2::constant(0.0)]);
                 [at, on_trace[0]]
@@ -257,11 +261,15 @@ impl ContactConst {
     fn profile_point(&self, s: f64) -> [f64; 2] {
         match &self.profile {
             Profile::Surface { .. } => return [s, self.tape.eval_at(&[s, 0.0])[0]],
-            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => {}
+            Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. }
+            | Profile::Barrel { .. } => {}
         }
         let values = self.tape.eval(s);
         match &self.profile {
             Profile::Explicit { .. } | Profile::Surface { .. } => [s, values[0]],
+            Profile::Barrel { radius, .. } => [radius * s, values[0]],
             Profile::Polar { .. } => [values[0] * s.cos(), values[0] * s.sin()],
             Profile::Parametric { .. } => [values[0], values[1]],
         }
@@ -270,8 +278,8 @@ impl ContactConst {
     /// +1 when the follower is on the left of increasing s (explicit), −1 otherwise.
     fn side(&self) -> f64 {
         match self.profile {
-            Profile::Explicit { .. } | Profile::Surface { .. } => 1.0,
-            _ => -1.0,
+            Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
+            Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
         }
     }
 

@@ -85,6 +85,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
             Profile::Polar { .. } => ProfileKind::Polar,
             Profile::Parametric { .. } => ProfileKind::Parametric,
             Profile::Surface { .. } => ProfileKind::Surface,
+            Profile::Barrel { .. } => ProfileKind::Barrel,
         },
         cam_coordinate: c
             .cam_body

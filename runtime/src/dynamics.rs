@@ -66,13 +66,15 @@ pub enum ProfileKind {
     Parametric,
     /// A surface z = f(x, y) over the cam plane (a spatial cam).
     Surface,
+    /// A barrel cam's pitch surface z = g(θ) on a cylinder about the cam's axis.
+    Barrel,
 }
 
 impl ProfileKind {
     /// True for a surface over the cam plane, false for a plane curve.
     pub fn is_surface(self) -> bool {
         match self {
-            ProfileKind::Surface => true,
+            ProfileKind::Surface | ProfileKind::Barrel => true,
             ProfileKind::Explicit | ProfileKind::Polar | ProfileKind::Parametric => false,
         }
     }

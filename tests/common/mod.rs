@@ -213,7 +213,8 @@ pub fn compare_dynamics_at(
 }
 
 /// Every number of a contact's geometry, for comparisons. The angle of a polar profile's
-/// contact point is defined modulo 2π: its cosine and sine are compared instead.
+/// contact point, or of a barrel's, is defined modulo 2π: its cosine and sine are compared
+/// instead.
 pub fn geometry_values(
     g: &camchain::runtime::ContactGeometry,
     profile: camchain::runtime::ProfileKind,
@@ -224,7 +225,10 @@ pub fn geometry_values(
     }
     v.extend([g.x, g.y, g.z, g.force_scale, g.curvature, g.sliding_speed]);
     match profile {
-        camchain::runtime::ProfileKind::Polar => v.extend([g.parameter.cos(), g.parameter.sin()]),
+        // An angle: modulo 2π.
+        camchain::runtime::ProfileKind::Polar | camchain::runtime::ProfileKind::Barrel => {
+            v.extend([g.parameter.cos(), g.parameter.sin()])
+        }
         camchain::runtime::ProfileKind::Explicit
         | camchain::runtime::ProfileKind::Parametric
         | camchain::runtime::ProfileKind::Surface => v.push(g.parameter),

@@ -88,6 +88,7 @@ fn profile_kind(contact: &Contact) -> &'static str {
         Profile::Polar { .. } => "polar profile",
         Profile::Parametric { .. } => "parametric profile",
         Profile::Surface { .. } => "surface",
+        Profile::Barrel { .. } => "barrel cam",
     }
 }
 

@@ -109,6 +109,7 @@ pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
         ProfileKind::Polar => "a polar profile r(θ)",
         ProfileKind::Parametric => "a parametric profile (x(s), y(s))",
         ProfileKind::Surface => "a surface z = f(x, y)",
+        ProfileKind::Barrel => "a barrel cam's groove z = g(θ)",
     };
     let turned = contact
         .cam_coordinate
@@ -508,6 +509,10 @@ fn material_side(profile: ProfileKind) -> &'static str {
         ProfileKind::Polar => "the cam is the region r < r(θ) of its frame and pushes outwards",
         ProfileKind::Surface => {
             "the cam lies below its surface, z < f(x, y) in its frame, and pushes towards +z"
+        }
+        ProfileKind::Barrel => {
+            "the groove's lower flank pushes towards +z; its upper flank pulls (a groove holds \
+             the follower both ways)"
         }
         ProfileKind::Parametric => {
             "the cam lies on the left of its curve as s increases (inside a curve traced \

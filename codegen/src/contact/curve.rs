@@ -72,6 +72,18 @@ pub fn curve(
                 d2: [zero, d2],
             }
         }
+        // A barrel's pitch curve developed on the plane at its radius R, (R θ, g(θ)), as the
+        // model's samples give it.
+        Profile::Barrel { radius, .. } => {
+            let placeholder = format!("__cam_{name}");
+            let [f, d1, d2] = value_and_derivatives(g, first, &placeholder, at, params);
+            let (zero, r) = (g.zero(), g.constant(*radius));
+            CurvePoint {
+                point: [g.mul(r, at), f],
+                d1: [r, d1],
+                d2: [zero, d2],
+            }
+        }
         Profile::Explicit { .. } => {
             let placeholder = format!("__cam_{name}");
             let [f, d1, d2] = value_and_derivatives(g, first, &placeholder, at, params);
@@ -129,7 +141,7 @@ fn combine(g: &mut Graph, a: Id, u: [Id; 2], b: Id, v: [Id; 2]) -> [Id; 2] {
 /// profiles), −1 on the right (polar and parametric ones).
 pub fn follower_side(profile: &Profile) -> f64 {
     match profile {
-        Profile::Explicit { .. } | Profile::Surface { .. } => 1.0,
+        Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
     }
 }
@@ -299,7 +311,9 @@ mod tests {
             let mut g = Graph::new();
             let at = g.var("s");
             let (first, second) = match profile {
-                Profile::Explicit { f, .. } | Profile::Surface { f, .. } => (f, None),
+                Profile::Explicit { f, .. }
+                | Profile::Surface { f, .. }
+                | Profile::Barrel { f, .. } => (f, None),
                 Profile::Polar { r, .. } => (r, None),
                 Profile::Parametric { x, y, .. } => (x, Some(y)),
             };

@@ -48,9 +48,10 @@ pub fn flat(
     let objective = g.neg(extent);
     let guess = match contact.profile {
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
-        Profile::Explicit { .. } | Profile::Parametric { .. } | Profile::Surface { .. } => {
-            Guess::Scan
-        }
+        Profile::Explicit { .. }
+        | Profile::Parametric { .. }
+        | Profile::Surface { .. }
+        | Profile::Barrel { .. } => Guess::Scan,
     };
     let solution = g.implicit(
         &format!("{name}_parameter"),

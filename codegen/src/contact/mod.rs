@@ -89,8 +89,11 @@ pub fn contact_terms(
             ));
             let rel = relative::relative(g, model, kin, s, index);
             match (&contact.follower, &contact.profile) {
-                (Follower::Knife, Profile::Surface { .. }) => {
-                    surface::point(g, model, s, index, rel)
+                (Follower::Knife, Profile::Surface { .. } | Profile::Barrel { .. }) => {
+                    surface::point(g, model, s, index, rel, None)
+                }
+                (Follower::Roller { radius }, Profile::Barrel { .. }) => {
+                    surface::point(g, model, s, index, rel, Some(*radius))
                 }
                 (Follower::Knife, Profile::Explicit { .. }) => {
                     knife::explicit(g, model, s, index, rel)

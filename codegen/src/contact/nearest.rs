@@ -48,6 +48,7 @@ pub fn nearest(
     let objective = dot2(g, d, d);
     let guess = match contact.profile {
         Profile::Explicit { .. } | Profile::Surface { .. } => Guess::Input(0),
+        Profile::Barrel { .. } => Guess::Angle { x: 0, y: 1 },
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
         Profile::Parametric { .. } => Guess::Scan,
     };

@@ -11,13 +11,20 @@
 //! As for y = f(x), h is not a distance: |∇h| = √(1 + f_x² + f_y²) is the factor between λ
 //! and the normal force. The gradient and Hessian of f are derived symbolically from the
 //! expression, like f′ and f″ of a plane profile.
+//!
+//! A barrel cam's pitch surface z = g(θ), θ the point's angle about the cam's axis, is the
+//! same contact with f(x, y) = g(θ(x, y)) (§13.4): θ is the contact parameter (the polar
+//! angle, by the generated code's Newton solve started from atan2, exact at once), g′ and
+//! g″ are symbolic, and the chain rule through θ_x = −y/r², θ_y = x/r² gives ∇f and the
+//! Hessian. A roller in the groove has its centre on the pitch surface: the same h, its
+//! contact point the radius away on the flank below.
 
 use super::relative::Relative;
 use super::{ContactTerms, Formulas};
-use crate::expr::scalar::scalar_to_expr_in;
-use crate::expr::{Graph, Id};
+use crate::expr::scalar::{scalar_to_expr_in, value_and_derivatives};
+use crate::expr::{Graph, Guess, Id, Implicit};
 use crate::kinematics::{Symbols, V3, vec3};
-use crate::model::{Field, Model};
+use crate::model::{Field, Model, Profile};
 
 /// f and its derivatives at the follower point's (X, Y).
 struct Derivatives {
@@ -29,7 +36,159 @@ struct Derivatives {
     fyy: Id,
 }
 
-/// f, ∇f and the Hessian of contact `index`'s surface at (x, y), symbolic.
+/// A barrel's pitch surface at the follower point: the derivatives of f(x, y) = g(θ), and
+/// what its outputs read.
+struct Barrel {
+    /// The point's angle θ about the axis (the contact parameter).
+    angle: Id,
+    /// The developed pitch curve's curvature at the point's radius r: (g″/r²)/(1 + (g′/r)²)^{3/2}.
+    curvature: Id,
+}
+
+/// f, ∇f and the Hessian of contact `index`'s surface at (x, y), symbolic; for a barrel
+/// also its angle and developed curvature.
+fn surface_at(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    xy: [Id; 2],
+) -> (Derivatives, Option<Barrel>) {
+    match &model.contacts[index].profile {
+        Profile::Barrel { .. } => {
+            let (d, b) = barrel(g, model, s, index, xy);
+            (d, Some(b))
+        }
+        Profile::Surface { .. }
+        | Profile::Explicit { .. }
+        | Profile::Polar { .. }
+        | Profile::Parametric { .. } => (derivatives(g, model, s, index, xy), None),
+    }
+}
+
+/// f = g(θ(x, y)) of a barrel cam, by the chain rule through the polar angle.
+fn barrel(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    [x, y]: [Id; 2],
+) -> (Derivatives, Barrel) {
+    let contact = &model.contacts[index];
+    let name = &contact.name;
+    // θ: the root of ψ(u) = y cos u − x sin u with ψ′ = −(x cos u + y sin u) = −r < 0,
+    // the maximum of x cos u + y sin u.
+    let u = g.var(&format!("__barrel_{name}_u"));
+    let (px, py) = (
+        g.var(&format!("__barrel_{name}_px")),
+        g.var(&format!("__barrel_{name}_py")),
+    );
+    let (cos, sin) = (g.cos(u), g.sin(u));
+    let (xc, ys, xs, yc) = (
+        g.mul(px, cos),
+        g.mul(py, sin),
+        g.mul(px, sin),
+        g.mul(py, cos),
+    );
+    let residual = g.sub(yc, xs);
+    let along = g.add(xc, ys);
+    let derivative = g.neg(along);
+    let angle = g.implicit(
+        &format!("{name}_parameter"),
+        Implicit {
+            description: format!(
+                "contact {name}: the follower point's angle about the barrel's axis"
+            ),
+            unknown: u,
+            placeholders: vec![px, py],
+            input_names: vec!["x", "y"],
+            inputs: vec![x, y],
+            residual,
+            derivative,
+            objective: derivative,
+            guess: Guess::Angle { x: 0, y: 1 },
+            range: (0.0, std::f64::consts::TAU),
+        },
+    );
+    let expression = s.expression(model, Field::Profile(index), contact.profile_expression());
+    let [value, g1, g2] =
+        value_and_derivatives(g, expression, &format!("__barrel_{name}"), angle, &s.params);
+    for (id, what) in [(g1, "dg"), (g2, "ddg")] {
+        g.label(id, format!("{name}_{what}"));
+    }
+    // θ_x = −y/r², θ_y = x/r²; θ_xx = 2xy/r⁴ = −θ_yy, θ_xy = (y² − x²)/r⁴.
+    let r2 = {
+        let a = g.mul(x, x);
+        let b = g.mul(y, y);
+        g.add(a, b)
+    };
+    g.label(r2, format!("{name}_radius_sq"));
+    let r4 = g.mul(r2, r2);
+    let tx = {
+        let n = g.neg(y);
+        g.div(n, r2)
+    };
+    let ty = g.div(x, r2);
+    let xy2 = {
+        let p = g.mul(x, y);
+        g.scale(2.0, p)
+    };
+    let txx = g.div(xy2, r4);
+    let tyy = g.neg(txx);
+    let txy = {
+        let a = g.mul(y, y);
+        let b = g.mul(x, x);
+        let d = g.sub(a, b);
+        g.div(d, r4)
+    };
+    let fx = g.mul(g1, tx);
+    let fy = g.mul(g1, ty);
+    let second = |g: &mut Graph, a: Id, b: Id, ab: Id| {
+        let p = g.mul(a, b);
+        let t1 = g.mul(g2, p);
+        let t2 = g.mul(g1, ab);
+        g.add(t1, t2)
+    };
+    let fxx = second(g, tx, tx, txx);
+    let fxy = second(g, tx, ty, txy);
+    let fyy = second(g, ty, ty, tyy);
+    for (id, what) in [
+        (fx, "fx"),
+        (fy, "fy"),
+        (fxx, "fxx"),
+        (fxy, "fxy"),
+        (fyy, "fyy"),
+    ] {
+        g.label(id, format!("{name}_{what}"));
+    }
+    // The developed pitch curve (r θ, g(θ)) at radius r: slope g′/r, curvature
+    // (g″/r²)/(1 + (g′/r)²)^{3/2}, positive where hollow seen from above.
+    let curvature = {
+        let one = g.one();
+        let slope2 = {
+            let a = g.mul(g1, g1);
+            g.div(a, r2)
+        };
+        let stretch2 = g.add(one, slope2);
+        let stretch = g.sqrt(stretch2);
+        let cube = g.mul(stretch2, stretch);
+        let bend = g.div(g2, r2);
+        g.div(bend, cube)
+    };
+    (
+        Derivatives {
+            f: value,
+            fx,
+            fy,
+            fxx,
+            fxy,
+            fyy,
+        },
+        Barrel { angle, curvature },
+    )
+}
+
+/// f, ∇f and the Hessian of contact `index`'s surface z = f(x, y) at (x, y), symbolic.
 fn derivatives(
     g: &mut Graph,
     model: &Model,
@@ -74,17 +233,19 @@ fn derivatives(
     d
 }
 
-/// The terms of contact `index`, a point on a surface z = f(x, y).
+/// The terms of contact `index`, a point (or a roller's centre, `radius` its radius, in a
+/// barrel's groove) on a surface z = f(x, y).
 pub fn point(
     g: &mut Graph,
     model: &Model,
     s: &Symbols,
     index: usize,
     rel: Relative,
+    radius: Option<f64>,
 ) -> ContactTerms {
     let name = model.contacts[index].name.clone();
     let [x, y] = rel.xy;
-    let d = derivatives(g, model, s, index, [x, y]);
+    let (d, barrel) = surface_at(g, model, s, index, [x, y]);
     let h = g.sub(rel.height, d.f);
     let jacobian = rel
         .columns
@@ -133,7 +294,10 @@ pub fn point(
         g.label(id, format!("{name}_cam_normal_{axis}"));
     }
     let normal = to_ground_vector(g, &rel, unit);
-    let curvature = principal_curvature(g, &d, stretch, &name);
+    let curvature = match &barrel {
+        Some(b) => b.curvature,
+        None => principal_curvature(g, &d, stretch, &name),
+    };
     let sliding = {
         let v = [vx, vy, rel.height_rate];
         let along = dot(g, v, unit);
@@ -151,28 +315,47 @@ pub fn point(
         let sum = g.sum(squares);
         g.sqrt(sum)
     };
-    let position = {
+    // The point on the surface over (X, Y); a roller's centre is on the pitch surface and
+    // its contact point the radius below it along the normal, on the flank under it.
+    let mut position = {
         let in_plane = rel.to_ground(g, [x, y]);
         let lift = g.sub(d.f, rel.height);
         let lift = vec3::scale(g, lift, rel.axis);
         vec3::add(g, in_plane, lift)
     };
+    let mut cam_point = [x, y];
+    let mut cam_height = d.f;
+    if let Some(rho) = radius {
+        // The roller's radius may be read at run time.
+        let rho = s.field(g, model, Field::Radius(index), rho);
+        let down = vec3::scale(g, rho, normal);
+        position = vec3::sub(g, position, down);
+        let [a, b, c] = unit.map(|k| g.mul(rho, k));
+        cam_point = [g.sub(x, a), g.sub(y, b)];
+        cam_height = g.sub(d.f, c);
+    }
     vec3::label(g, position, &format!("{name}_contact"));
     ContactTerms {
         h,
         jacobian,
         bias,
         position,
-        cam_point: [x, y],
-        cam_height: Some(d.f),
+        cam_point,
+        cam_height: Some(cam_height),
         normal,
         force_scale: stretch,
-        parameter: x,
+        parameter: barrel.as_ref().map_or(x, |b| b.angle),
         curvature,
         sliding,
         relative: rel,
         formulas: Formulas {
-            kind: "a point on a surface z = f(x, y)".to_string(),
+            kind: match (&barrel, radius) {
+                (None, _) => "a point on a surface z = f(x, y)".to_string(),
+                (Some(_), None) => "a point on a barrel cam's pitch surface z = g(θ)".to_string(),
+                (Some(_), Some(_)) => {
+                    "a roller in a barrel cam's groove, its centre on z = g(θ)".to_string()
+                }
+            },
             h: "h = Z − f(X, Y), eq. (S1)",
             jacobian: "J = J3 − f_x J1 − f_y J2, eq. (S2)",
             bias: "eq. (S3)",

@@ -42,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 13] = [
+pub const KINDS: [Kind; 15] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -149,6 +149,24 @@ pub const KINDS: [Kind; 13] = [
         offset: 0.0,
         planar_only: false,
         turn: 0.4,
+    },
+    // A barrel cam's pitch surface z = g(θ) about the cam frame's axis, followed by a point
+    // and by a roller's centre (the groove's flank the radius away).
+    Kind {
+        name: "knife on barrel",
+        follower: "",
+        profile: "barrel: (radius: 0.045, groove: \"0.002*theta.sin() + 0.001*(2.0*theta).cos()\"),",
+        offset: 0.0,
+        planar_only: false,
+        turn: 3.1,
+    },
+    Kind {
+        name: "roller on barrel",
+        follower: "follower: Roller(radius: 0.01),",
+        profile: "barrel: (radius: 0.045, groove: \"0.002*theta.sin() + 0.001*(2.0*theta).cos()\"),",
+        offset: 0.0,
+        planar_only: false,
+        turn: 3.1,
     },
 ];
 

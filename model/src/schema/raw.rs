@@ -239,6 +239,9 @@ pub(super) struct Contact {
     /// A surface z = f(x, y) over the cam plane.
     #[serde(default)]
     pub surface: Option<String>,
+    /// A barrel cam: the pitch surface z = f(θ) on a cylinder about the cam's axis.
+    #[serde(default)]
+    pub barrel: Option<Barrel>,
     /// A profile through a table of points.
     #[serde(default)]
     pub table: Option<Table>,
@@ -253,6 +256,31 @@ pub(super) struct Contact {
 
 /// The follower's shape and dimensions, as written.
 pub(super) type Follower = crate::model::Follower<Number>;
+
+/// `barrel: (radius: R, groove: "f(theta)")` or `barrel: (radius: R, law: (…))`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Barrel {
+    pub radius: Number,
+    /// The pitch surface z = f(θ) as an expression of `theta`.
+    #[serde(default)]
+    pub groove: Option<String>,
+    /// The pitch surface designed from the follower's motion law.
+    #[serde(default)]
+    pub law: Option<BarrelLaw>,
+}
+
+/// `law: (base: z₀, turning: …, segments: […])` of a barrel cam: the follower's travel along
+/// the cam's axis over a turn, from the height z₀.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BarrelLaw {
+    #[serde(default)]
+    pub base: Number,
+    #[serde(default)]
+    pub turning: Turning,
+    pub segments: Vec<LawSegment>,
+}
 
 /// `parametric: (x: "…", y: "…")`.
 #[derive(Debug, Deserialize)]

@@ -11,6 +11,7 @@ use crate::model::{
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 
+mod barrels;
 mod bodies;
 mod contacts;
 mod designs;

@@ -6,12 +6,29 @@
 //!   x̂ and ŷ for f_x, f_xx, f_y, f_yy, along x̂ + ŷ for f_xy; the convective term's
 //!   Ẋᵀ H Ẋ as the second derivative of f along the velocity itself;
 //! - the principal curvature from the shape operator G⁻¹ II's mean and Gaussian curvatures
-//!   (the generator takes a Cholesky route).
+//!   (the generator takes a Cholesky route);
+//! - a barrel's f(x, y) = g(θ(x, y)) by the same jets, θ = atan2(y, x) evaluated in jet
+//!   arithmetic along the line (the generator takes the chain rule through θ_x, θ_y).
 
 use super::{CamFrame, ContactConst, Evaluated, Seen};
 use crate::jet::Jet2;
 use crate::motion::Vec3;
+use camchain_model::model::Profile;
 use camchain_runtime::{ContactGeometry, ContactKinematics};
+
+/// atan2(y, x) of two jets: atan(y/x) or ∓atan(x/y) (whichever quotient is at most 1 in
+/// magnitude) for the derivatives, the value from atan2.
+fn angle(x: Jet2, y: Jet2) -> Jet2 {
+    let value = y.v.atan2(x.v);
+    let (d1, d2) = if x.v.abs() >= y.v.abs() {
+        let a = (y / x).atan();
+        (a.d1, a.d2)
+    } else {
+        let a = (x / y).atan();
+        (-a.d1, -a.d2)
+    };
+    Jet2 { v: value, d1, d2 }
+}
 
 /// f, ∇f and the Hessian [f_xx, f_xy, f_yy] at a point.
 struct Local {
@@ -28,7 +45,14 @@ impl ContactConst {
             d1: d,
             d2: 0.0,
         };
-        self.tape.eval_jet_at(&[line(x, dx), line(y, dy)])[0]
+        let (x, y) = (line(x, dx), line(y, dy));
+        match &self.profile {
+            Profile::Barrel { .. } => self.tape.eval_jet(angle(x, y))[0],
+            Profile::Surface { .. }
+            | Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. } => self.tape.eval_jet_at(&[x, y])[0],
+        }
     }
 
     fn local(&self, p: [f64; 2]) -> Local {
@@ -75,18 +99,38 @@ impl ContactConst {
             .map(|k| (velocity[k] - along * unit[k]).powi(2))
             .sum::<f64>()
             .sqrt();
-        let position = frame.origin + frame.x * p[0] + frame.y * p[1] + frame.axis * f;
+        // A roller's centre is on a barrel's pitch surface, its contact point the radius
+        // below along the normal; a barrel's curvature is its developed pitch curve's at the
+        // point's radius r, (g″/r²)/(1 + (g′/r)²)^{3/2}, a surface's the larger principal one.
+        let rho = self.follower.radius().copied().unwrap_or(0.0);
+        let on_surface = [p[0], p[1], f];
+        let contact: [f64; 3] = std::array::from_fn(|k| on_surface[k] - rho * unit[k]);
+        let position =
+            frame.origin + frame.x * contact[0] + frame.y * contact[1] + frame.axis * contact[2];
+        let (parameter, curvature) = match &self.profile {
+            Profile::Barrel { .. } => {
+                let theta = p[1].atan2(p[0]);
+                let g = self.tape.eval_jet(Jet2::variable(theta))[0];
+                let r2 = p[0] * p[0] + p[1] * p[1];
+                let slope2 = g.d1 * g.d1 / r2;
+                (theta, g.d2 / r2 / (1.0 + slope2).powf(1.5))
+            }
+            Profile::Surface { .. }
+            | Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. } => (p[0], larger_principal_curvature([fx, fy], hessian)),
+        };
         let geometry = ContactGeometry {
             position: position.into(),
-            x: p[0],
-            y: p[1],
-            z: f,
+            x: contact[0],
+            y: contact[1],
+            z: contact[2],
             follower: point.into(),
             normal: normal.into(),
             axis: frame.axis.into(),
             force_scale: stretch,
-            parameter: p[0],
-            curvature: larger_principal_curvature([fx, fy], hessian),
+            parameter,
+            curvature,
             direction: direction.into(),
             sliding_speed: sliding,
         };

@@ -1065,6 +1065,23 @@ const CASES: &[Case] = &[
         "loops[0].b.body",
         "unknown body `rocket`",
     ),
+    // Cam surfaces and barrel cams.
+    // `"0.01*theta + base"`, the barrel's groove.
+    case(
+        "barrel_groove_open.ron",
+        51,
+        25,
+        "contacts[0].barrel.groove",
+        "must close round the cylinder",
+    ),
+    // `Roller(radius: 0.01)` on a cam surface.
+    case(
+        "surface_with_roller.ron",
+        43,
+        23,
+        "contacts[0].follower",
+        "a surface takes a point follower",
+    ),
 ];
 
 fn corpus() -> PathBuf {

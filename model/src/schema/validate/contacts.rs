@@ -196,6 +196,7 @@ fn profile(
         ("polar", c.polar.is_some()),
         ("parametric", c.parametric.is_some()),
         ("surface", c.surface.is_some()),
+        ("barrel", c.barrel.is_some()),
         ("table", c.table.is_some()),
         ("law", c.law.is_some()),
     ];
@@ -206,15 +207,15 @@ fn profile(
                 format!("{path}.marker"),
                 "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
                  `polar: \"r(theta)\"`, `parametric: (x: \"x(s)\", y: \"y(s)\")`, `surface: \
-                 \"f(x, y)\"` (a surface z = f(x, y)), `table: (…)` (through points) or `law: \
-                 (…)` (designed from the follower's motion)"
+                 \"f(x, y)\"` (a surface z = f(x, y)), `barrel: (…)` (a barrel cam), `table: \
+                 (…)` (through points) or `law: (…)` (designed from the follower's motion)"
                     .to_string(),
             ),
             [.., last] => (
                 format!("{path}.{last}"),
                 format!(
-                    "give only one of `profile`, `polar`, `parametric`, `surface`, `table` and \
-                     `law` (this contact gives {})",
+                    "give only one of `profile`, `polar`, `parametric`, `surface`, `barrel`, \
+                     `table` and `law` (this contact gives {})",
                     named
                         .iter()
                         .map(|n| format!("`{n}`"))
@@ -243,6 +244,10 @@ fn profile(
     }
     if let Some(source) = &c.surface {
         return surface(cx, path, source, i, follower).map(Shaped::from);
+    }
+    if let Some(barrel) = &c.barrel {
+        return super::barrels::barrel_profile(cx, path, barrel, i, name, follower)
+            .map(Shaped::from);
     }
     if let Some(source) = &c.profile {
         let f = expression(
@@ -362,7 +367,8 @@ fn contact_range(
     if c.range.is_some() && profile.is_surface() {
         return Err(at.error(
             &field,
-            "a surface has no `range`: the follower point may be anywhere over the cam plane",
+            "a surface has no `range`: the follower point may be anywhere over the cam plane \
+             (a barrel's round the cylinder)",
         ));
     }
     if let Some((a, b)) = c.range {
@@ -383,6 +389,8 @@ fn contact_range(
         (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
         (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
         (Profile::Explicit { .. } | Profile::Surface { .. }, Outline::Point) => None,
+        // A barrel's groove is a graph over the whole turn: no search, nothing to scan.
+        (Profile::Barrel { .. }, _) => None,
         (Profile::Explicit { .. } | Profile::Surface { .. }, Outline::Circle | Outline::Line) => {
             Some(format!(
                 "a {} on an explicit profile",
@@ -489,6 +497,7 @@ fn profile_field(contact: &Contact) -> &'static str {
         Profile::Polar { .. } => "polar",
         Profile::Parametric { .. } => "parametric",
         Profile::Surface { .. } => "surface",
+        Profile::Barrel { .. } => "barrel",
     }
 }
 

@@ -113,7 +113,7 @@ pub(super) fn law_profile(
 }
 
 /// +1 counterclockwise, −1 clockwise.
-fn sense(turning: Turning) -> f64 {
+pub(super) fn sense(turning: Turning) -> f64 {
     match turning {
         Turning::Counterclockwise => 1.0,
         Turning::Clockwise => -1.0,
@@ -135,7 +135,11 @@ fn law_of(name: LawName) -> Law {
 /// The segments as a motion program: angles in degrees (constant, positive), rises that go
 /// up and returns that come down, a turn in all, back to the base circle, no jump of the
 /// velocity where two segments join.
-fn program(cx: &Context, field: &str, segments: &[LawSegment]) -> Checked<MotionProgram> {
+pub(super) fn program(
+    cx: &Context,
+    field: &str,
+    segments: &[LawSegment],
+) -> Checked<MotionProgram> {
     let mut out = Vec::with_capacity(segments.len());
     let mut before = 0.0;
     for (k, segment) in segments.iter().enumerate() {
@@ -415,7 +419,7 @@ fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Chec
 
 impl Context<'_> {
     /// A design dimension: (its expression of the run-time parameters, its value), finite.
-    fn dimension(&self, field: &str, n: &raw::Number) -> Checked<(Scalar, f64)> {
+    pub(super) fn dimension(&self, field: &str, n: &raw::Number) -> Checked<(Scalar, f64)> {
         let (folded, value) = match n {
             raw::Number::Value(v) => (Scalar::Const(*v), *v),
             raw::Number::Expr(source) => {
@@ -427,12 +431,17 @@ impl Context<'_> {
     }
 
     /// A number that must not depend on run-time parameters.
-    fn constant(&self, field: &str, n: &raw::Number) -> Checked<f64> {
+    pub(super) fn constant(&self, field: &str, n: &raw::Number) -> Checked<f64> {
         self.number(field, n, None)
     }
 
     /// A positive number that must not depend on run-time parameters.
-    fn positive_constant(&self, field: &str, n: &raw::Number, what: &str) -> Checked<f64> {
+    pub(super) fn positive_constant(
+        &self,
+        field: &str,
+        n: &raw::Number,
+        what: &str,
+    ) -> Checked<f64> {
         let value = self.constant(field, n)?;
         positive(self.at, field, what, value)
     }

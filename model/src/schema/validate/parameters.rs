@@ -112,7 +112,8 @@ pub(super) fn parameters(
 }
 
 /// The parameters used by fields that must be constant (joint axes, cam plane axes, a motion
-/// law's segments): they stay folded in [`ParameterMode::AllAtRunTime`].
+/// law's segments, a planar cam's or a barrel's): they stay folded in
+/// [`ParameterMode::AllAtRunTime`].
 pub(super) fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usize> {
     let names: Vec<&str> = parameters.iter().map(|p| p.name.as_str()).collect();
     let axes =
@@ -131,8 +132,13 @@ pub(super) fn structural_parameters(file: &raw::Model, parameters: &[Parameter])
     let segments = file
         .contacts
         .iter()
-        .filter_map(|c| c.law.as_ref())
-        .flat_map(|law| law.segments.iter())
+        .flat_map(|c| {
+            let barrel = c.barrel.as_ref().and_then(|b| b.law.as_ref());
+            c.law
+                .iter()
+                .flat_map(|law| law.segments.iter())
+                .chain(barrel.into_iter().flat_map(|law| law.segments.iter()))
+        })
         .flat_map(|segment| match segment {
             raw::LawSegment::Dwell { degrees } => vec![degrees],
             raw::LawSegment::Rise { lift, degrees, .. }

@@ -1,0 +1,105 @@
+//! Barrel cams (`barrel:`): the pitch surface z = f(θ) on a cylinder about the cam's axis,
+//! given as an expression of `theta` or designed from the follower's motion law along the
+//! axis, each misuse located at its field (docs/model-format.md, "Barrel cams").
+
+use super::designs::{program, sense};
+use super::fields::positive;
+use super::parameters::expression;
+use super::{Checked, Context, Follower, Profile};
+use crate::model::Field;
+use crate::profile::{Scalar, Tabulated};
+use crate::schema::raw;
+use camchain_runtime::kinds::FollowerKind;
+use std::f64::consts::TAU;
+
+/// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`.
+pub(super) fn barrel_profile(
+    cx: &Context,
+    path: &str,
+    barrel: &raw::Barrel,
+    i: usize,
+    name: &str,
+    follower: &Follower,
+) -> Checked<Profile> {
+    let field = format!("{path}.barrel");
+    match follower.kind() {
+        FollowerKind::Knife | FollowerKind::Roller => {}
+        FollowerKind::Flat | FollowerKind::Mushroom => {
+            return Err(cx.at.error(
+                &format!("{path}.follower"),
+                format!(
+                    "a {} cannot run in a barrel cam's groove: give a roller (`follower: \
+                     Roller(radius: …)`, its centre the marker) or a knife edge",
+                    follower.kind().label()
+                ),
+            ));
+        }
+    }
+    // The radius places the drawings and the designer's outputs; the constraint reads the
+    // follower point's own distance from the axis, so it may be a run-time parameter.
+    let at = format!("{field}.radius");
+    let (_, radius) = cx.dimension(&at, &barrel.radius)?;
+    let radius = positive(cx.at, &at, "the barrel's pitch radius", radius)?;
+    let (source, f) = match (&barrel.groove, &barrel.law) {
+        (Some(source), None) => {
+            let at = format!("{field}.groove");
+            let f = expression(cx, &at, source, &["theta"], Field::Profile(i))?;
+            closes(cx, &at, &f)?;
+            (source.clone(), f)
+        }
+        (None, Some(law)) => {
+            let at = format!("{field}.law");
+            let program = program(cx, &at, &law.segments)?;
+            let (folded_base, base) = cx.dimension(&format!("{at}.base"), &law.base)?;
+            let tabulated = Tabulated::law(format!("{name}_law"), program);
+            // The follower sits at the cam frame's angle θ = −σφ when the cam has turned by
+            // φ (σ = +1 counterclockwise), so the law is read at φ = −σθ.
+            let theta = if sense(law.turning) < 0.0 {
+                Scalar::Var(0)
+            } else {
+                -Scalar::Var(0)
+            };
+            let s = theta.tabulated(&tabulated, 0);
+            cx.table.record(Field::Profile(i), folded_base + s.clone());
+            (format!("{base} + s(θ), the law"), Scalar::Const(base) + s)
+        }
+        (Some(_), Some(_)) => {
+            return Err(cx.at.error(
+                &format!("{field}.law"),
+                "give the groove's pitch surface either as `groove: \"f(theta)\"` or as a \
+                 `law`, not both",
+            ));
+        }
+        (None, None) => {
+            return Err(cx.at.error(
+                &field,
+                "a barrel cam needs its groove: `groove: \"f(theta)\"` (the pitch surface z = \
+                 f(θ)) or `law: (base: z0, segments: […])` (designed from the follower's \
+                 motion along the axis)",
+            ));
+        }
+    };
+    Ok(Profile::Barrel { source, f, radius })
+}
+
+/// A barrel's pitch surface closes on itself round the cylinder: f(θ + 2π) = f(θ), checked
+/// at 16 angles to 1e-9 of its height (or of 1 mm).
+fn closes(cx: &Context, field: &str, f: &Scalar) -> Checked<()> {
+    for k in 0..16 {
+        let theta = TAU * k as f64 / 16.0;
+        let (a, b) = (f.eval(theta), f.eval(theta + TAU));
+        if !(a.is_finite() && b.is_finite())
+            || (a - b).abs() > 1e-9 * a.abs().max(b.abs()).max(1e-3)
+        {
+            return Err(cx.at.error(
+                field,
+                format!(
+                    "a barrel cam's groove must close round the cylinder, f(theta + 2π) = \
+                     f(theta), but f({theta:.6}) = {a:e} m and f({:.6}) = {b:e} m",
+                    theta + TAU
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
