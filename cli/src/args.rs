@@ -253,6 +253,10 @@ pub enum BenchWhat {
     /// Closed loops alone: the loop models' right-hand sides, Andrews' squeezer's work
     /// against precision, the IFToMM benchmarks A02 and A04 (also part of `evaluations`).
     Loops,
+    /// Spatial cams alone: a saddle surface generated against numeric, a barrel cam against
+    /// the disc cam of the same program, the surface contact's operations against the
+    /// planar one's (also part of `evaluations`).
+    Surfaces,
     /// What finding events inside steps costs: right-hand sides per step of every built-in
     /// model with a contact, watched and not; one-sided runs near the jump speed and at high
     /// cam speeds.

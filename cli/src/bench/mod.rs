@@ -10,7 +10,10 @@
 //!   models; then (section `designs`) the reduced right-hand side of a cam given as a table of
 //!   points against the same cam given by its motion law, and revolutions of the designed cams;
 //!   then (section `loops`) the reduced right-hand side of loop models, Andrews' squeezer's
-//!   work against precision, and the IFToMM benchmarks A02 and A04;
+//!   work against precision, and the IFToMM benchmarks A02 and A04; then (section
+//!   `surfaces`, also alone as `surfaces`) the spatial cams: a saddle surface generated
+//!   against numeric, a barrel cam against the disc cam of the same program, the surface
+//!   contact's operations against the planar one's;
 //! - `events`: what finding events inside steps costs on the built-in models (right-hand
 //!   sides per step watched and not), and the one-sided runs where the scans find every
 //!   lift-off and impact;
@@ -29,6 +32,7 @@ mod events;
 mod loops;
 mod markdown;
 mod scaling;
+mod surfaces;
 mod sweep;
 mod timing;
 mod work_precision;
@@ -65,6 +69,14 @@ pub fn run(args: &BenchArgs) -> Result<(), CliError> {
         let section = loops::run(args.quick)?;
         markdown::replace_section(report, "loops", &section)?;
         println!("updated {} (section loops)", report.display());
+    }
+    if matches!(
+        args.what,
+        BenchWhat::Evaluations | BenchWhat::Surfaces | BenchWhat::All
+    ) {
+        let section = surfaces::run(args.quick)?;
+        markdown::replace_section(report, "surfaces", &section)?;
+        println!("updated {} (section surfaces)", report.display());
     }
     if let BenchWhat::ScalingFigure = args.what {
         let csv = args.scaling_csv.as_deref().ok_or_else(|| {

@@ -321,7 +321,20 @@ fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
             .contacts
             .get(event.contact)
             .map_or("?", |c| c.name.as_str());
+        // A barrel cam's groove holds its roller both ways: a sign change of the normal force
+        // is the roller changing flanks.
+        let groove = info
+            .contacts
+            .get(event.contact)
+            .is_some_and(|c| c.profile == ProfileKind::Barrel);
         let what = match event.kind {
+            EventKind::ForceBecameNegative if groove => format!(
+                "{name} changes flanks: the groove's upper flank takes over (a follower on the \
+                 lower flank alone would lift off here)"
+            ),
+            EventKind::ForceBecamePositive if groove => {
+                format!("{name} changes flanks: back on the groove's lower flank")
+            }
             EventKind::ForceBecameNegative => format!(
                 "warning: the normal force on {name} becomes negative: a one-sided follower \
                  would lift off the cam here"
