@@ -147,7 +147,9 @@ impl CamShape {
         let (outline, base_radius) = match &contact.profile {
             Profile::Explicit { f, .. } => (Outline::Explicit(f.resolve_all(values)), None),
             // A surface has no outline in a plane: the picture shows the follower on it.
-            Profile::Surface { .. } | Profile::Barrel { .. } => (Outline::Open(Vec::new()), None),
+            Profile::Surface { .. } | Profile::Barrel { .. } | Profile::Revolution { .. } => {
+                (Outline::Open(Vec::new()), None)
+            }
             Profile::Polar { r, .. } => {
                 let r = r.resolve_all(values);
                 let points: Vec<(f64, f64)> = (0..OUTLINE_POINTS)

@@ -157,6 +157,12 @@ fn largest(values: &[f64]) -> f64 {
 /// A message when a constraint value or derivative at the initial guess is not a number:
 /// the profile (or a loop's geometry) is not defined there.
 fn not_finite(model: &Model, values: &[f64], q: &[f64]) -> Option<String> {
+    not_finite_at(model, values, q, "at the initial guess")
+}
+
+/// [`not_finite`] at the configuration `at` describes (`at the initial guess`, `after 2
+/// Newton steps from the initial guess, at`).
+fn not_finite_at(model: &Model, values: &[f64], q: &[f64], at: &str) -> Option<String> {
     let bad = values.iter().find(|v| !v.is_finite())?;
     let profiles: Vec<String> = model
         .contacts
@@ -164,7 +170,7 @@ fn not_finite(model: &Model, values: &[f64], q: &[f64]) -> Option<String> {
         .map(|c| format!("contact `{}`", c.name))
         .collect();
     Some(format!(
-        "the constraints are {bad} at the initial guess q = {q:?}: a profile or a length is \
+        "the constraints are {bad} {at} q = {q:?}: a profile or a length is \
          not defined there (a division by zero, a logarithm or square root of a negative \
          number, a value beyond f64's range); check the profiles of {} and initial.q",
         if profiles.is_empty() {
@@ -210,10 +216,16 @@ fn assemble_contacts(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> 
         ));
     }
     let mut residual = f64::INFINITY;
-    for _ in 0..MAX_ITERATIONS {
+    for iteration in 0..MAX_ITERATIONS {
         let h = d.eval(&h_ids, 0.0, &q, &qd);
         let j = d.eval(&j_ids, 0.0, &q, &qd);
-        if let Some(error) = not_finite(model, &h, &q).or_else(|| not_finite(model, &j, &q)) {
+        let at = match iteration {
+            0 => "at the initial guess".to_string(),
+            k => format!("after {k} Newton steps from the initial guess, at"),
+        };
+        if let Some(error) =
+            not_finite_at(model, &h, &q, &at).or_else(|| not_finite_at(model, &j, &q, &at))
+        {
             return Err(error);
         }
         residual = largest(&h);
@@ -230,9 +242,24 @@ fn assemble_contacts(model: &Model, d: &Derivation) -> Result<Vec<f64>, String> 
             dependent_contacts(model, &j, &free, residual, &q)
                 .unwrap_or_else(|| no_free_column(model, &free, residual, &q))
         })?;
-        for (i, dq) in step {
-            q[i] -= dq;
-        }
+        // A full step may leave the region where the profiles are defined (a square root's
+        // argument turning negative past a sphere's pole): halve it until they are.
+        let mut fraction = 1.0;
+        let next = loop {
+            let mut next = q.clone();
+            for &(i, dq) in &step {
+                next[i] -= fraction * dq;
+            }
+            let defined = next.iter().all(|v| v.is_finite())
+                && d.eval(&h_ids, 0.0, &next, &qd)
+                    .iter()
+                    .all(|v| v.is_finite());
+            if defined || fraction < 1e-12 {
+                break next;
+            }
+            fraction *= 0.5;
+        };
+        q = next;
         if !q.iter().all(|v| v.is_finite()) {
             break;
         }

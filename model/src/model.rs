@@ -252,6 +252,15 @@ pub enum Profile {
         /// The pitch cylinder's radius R (m): where the roller's centre runs.
         radius: f64,
     },
+    /// A surface of revolution r = g(z) about the cam frame's axis x̂ × ŷ, r the distance
+    /// from that axis: the cam's material inside it (r < g(z)), the follower outside
+    /// (docs/method.md §13.5).
+    Revolution {
+        /// g as written (variable `z`).
+        source: String,
+        /// Parsed g.
+        g: Scalar,
+    },
 }
 
 impl Profile {
@@ -263,6 +272,7 @@ impl Profile {
             Profile::Parametric { .. } => "parametric",
             Profile::Surface { .. } => "surface",
             Profile::Barrel { .. } => "barrel",
+            Profile::Revolution { .. } => "revolution",
         }
     }
 
@@ -272,6 +282,7 @@ impl Profile {
         match self {
             Profile::Explicit { .. } | Profile::Surface { .. } => "x",
             Profile::Polar { .. } | Profile::Barrel { .. } => "theta",
+            Profile::Revolution { .. } => "z",
             Profile::Parametric { .. } => "s",
         }
     }
@@ -280,7 +291,7 @@ impl Profile {
     /// plane curve.
     pub fn is_surface(&self) -> bool {
         match self {
-            Profile::Surface { .. } | Profile::Barrel { .. } => true,
+            Profile::Surface { .. } | Profile::Barrel { .. } | Profile::Revolution { .. } => true,
             Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => false,
         }
     }
@@ -330,6 +341,7 @@ impl Contact {
             Profile::Explicit { f, .. }
             | Profile::Surface { f, .. }
             | Profile::Barrel { f, .. } => f,
+            Profile::Revolution { g, .. } => g,
             Profile::Polar { r, .. } => r,
             Profile::Parametric { x, .. } => x,
         }

@@ -17,13 +17,15 @@ use camchain_runtime::contact::ProfileSample;
 pub fn follower_side(profile: &Profile) -> f64 {
     match profile {
         Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
+        Profile::Revolution { .. } => -1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
     }
 }
 
 /// c, c′, c″ of `profile` at `s`, cam-frame components; for a surface z = f(x, y), its trace
 /// on the plane y = 0, (x, f(x, 0)) in that plane's (x, z) components; for a barrel cam, its
-/// pitch curve developed on the plane, (R θ, f(θ)).
+/// pitch curve developed on the plane, (R θ, f(θ)); for a surface of revolution its meridian
+/// (g(z), z).
 pub fn curve(profile: &Profile, s: f64) -> [[f64; 2]; 3] {
     let at = Jet2::variable(s);
     match profile {
@@ -34,6 +36,12 @@ pub fn curve(profile: &Profile, s: f64) -> [[f64; 2]; 3] {
         Profile::Barrel { f, radius, .. } => {
             let z = eval_on(f, at, &own_tables);
             [[radius * s, z.v], [*radius, z.d1], [0.0, z.d2]]
+        }
+        // A surface of revolution's meridian (g(z), z) in its (r, z) half-plane, the
+        // material on its left as z increases (towards the axis).
+        Profile::Revolution { g, .. } => {
+            let r = eval_on(g, at, &own_tables);
+            [[r.v, s], [r.d1, 1.0], [r.d2, 0.0]]
         }
         Profile::Explicit { f, .. } => {
             let y = eval_on(f, at, &own_tables);
@@ -73,7 +81,8 @@ pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> 
                 Profile::Explicit { .. }
                 | Profile::Parametric { .. }
                 | Profile::Surface { .. }
-                | Profile::Barrel { .. } => f64::NAN,
+                | Profile::Barrel { .. }
+                | Profile::Revolution { .. } => f64::NAN,
             };
             ProfileSample {
                 at: s,

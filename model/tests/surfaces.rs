@@ -189,3 +189,31 @@ fn a_barrel_needs_a_radius_a_groove_and_a_roller() {
         "cannot run in a barrel cam's groove",
     );
 }
+
+#[test]
+fn a_surface_of_revolution_is_a_function_of_z_followed_by_a_point() {
+    let source = edited(
+        "surface: \"c*(x*x + y*y) + 0.1*(x*y).sin()\",",
+        "revolution: \"(0.25 - z*z).sqrt()\",",
+    );
+    let model = parse_model(&source, Path::new("models/surface.ron")).expect("parses");
+    let Profile::Revolution { g, .. } = &model.contacts[0].profile else {
+        panic!("a surface of revolution: {:?}", model.contacts[0].profile)
+    };
+    assert!((g.eval(0.3) - 0.4).abs() < 1e-15);
+    rejected(
+        &source.replace("(0.25 - z*z).sqrt()", "(0.25 - x*x).sqrt()"),
+        "contacts[0].revolution",
+        16,
+        "the only variable allowed here is `z`",
+    );
+    rejected(
+        &source.replace(
+            "marker: \"tip\",\n",
+            "marker: \"tip\", follower: Roller(radius: 0.01),\n",
+        ),
+        "contacts[0].follower",
+        15,
+        "cannot follow a surface of revolution",
+    );
+}

@@ -13,8 +13,10 @@
 //! - A flat face's convective term from the general three-dimensional rotation of its
 //!   normal (the generator uses the planar form).
 //! - A cam surface z = f(x, y) ([`surface`]): its gradient and Hessian from jets along
-//!   lines, its curvature from the shape operator's invariants.
+//!   lines, its curvature from the shape operator's invariants; a surface of revolution
+//!   ([`revolution`]) likewise in three dimensions.
 
+mod revolution;
 mod surface;
 
 use crate::jet::Jet2;
@@ -147,6 +149,7 @@ impl ContactConst {
                 Profile::Explicit { f, .. }
                 | Profile::Surface { f, .. }
                 | Profile::Barrel { f, .. } => Tape::new(&[f]),
+                Profile::Revolution { g, .. } => Tape::new(&[g]),
                 Profile::Polar { r, .. } => Tape::new(&[r]),
                 Profile::Parametric { x, y, .. } => Tape::new(&[x, y]),
             },
@@ -240,6 +243,8 @@ impl ContactConst {
             Profile::Explicit { .. } => [at, values[0]],
             // A barrel's pitch curve developed at its radius, (R θ, g(θ)).
             Profile::Barrel { radius, .. } => [at * Jet2::constant(*radius), values[0]],
+            // A surface of revolution's meridian (g(z), z).
+            Profile::Revolution { .. } => [values[0], at],
             Profile::Surface { .. } => {
                 let on_trace = self.tape.eval_jet_at(&[at, Jet2::constant(0.0)]);
                 [at, on_trace[0]]
@@ -264,12 +269,14 @@ impl ContactConst {
             Profile::Explicit { .. }
             | Profile::Polar { .. }
             | Profile::Parametric { .. }
-            | Profile::Barrel { .. } => {}
+            | Profile::Barrel { .. }
+            | Profile::Revolution { .. } => {}
         }
         let values = self.tape.eval(s);
         match &self.profile {
             Profile::Explicit { .. } | Profile::Surface { .. } => [s, values[0]],
             Profile::Barrel { radius, .. } => [radius * s, values[0]],
+            Profile::Revolution { .. } => [values[0], s],
             Profile::Polar { .. } => [values[0] * s.cos(), values[0] * s.sin()],
             Profile::Parametric { .. } => [values[0], values[1]],
         }
@@ -279,7 +286,7 @@ impl ContactConst {
     fn side(&self) -> f64 {
         match self.profile {
             Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
-            Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
+            Profile::Polar { .. } | Profile::Parametric { .. } | Profile::Revolution { .. } => -1.0,
         }
     }
 
@@ -374,8 +381,14 @@ impl ContactConst {
             };
             d / d.norm()
         };
-        if self.profile.is_surface() {
-            return self.on_surface(&seen, &columns, &frame, point, direction);
+        match &self.profile {
+            Profile::Surface { .. } | Profile::Barrel { .. } => {
+                return self.on_surface(&seen, &columns, &frame, point, direction);
+            }
+            Profile::Revolution { .. } => {
+                return self.on_revolution(&seen, &columns, &frame, point, direction);
+            }
+            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => {}
         }
         let x = seen.p;
         // The contact point sits at the follower point's height along the cam's axis.

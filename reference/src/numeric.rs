@@ -86,6 +86,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
             Profile::Parametric { .. } => ProfileKind::Parametric,
             Profile::Surface { .. } => ProfileKind::Surface,
             Profile::Barrel { .. } => ProfileKind::Barrel,
+            Profile::Revolution { .. } => ProfileKind::Revolution,
         },
         cam_coordinate: c
             .cam_body

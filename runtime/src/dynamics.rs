@@ -68,13 +68,15 @@ pub enum ProfileKind {
     Surface,
     /// A barrel cam's pitch surface z = g(θ) on a cylinder about the cam's axis.
     Barrel,
+    /// A surface of revolution r = g(z) about the cam's axis.
+    Revolution,
 }
 
 impl ProfileKind {
     /// True for a surface over the cam plane, false for a plane curve.
     pub fn is_surface(self) -> bool {
         match self {
-            ProfileKind::Surface | ProfileKind::Barrel => true,
+            ProfileKind::Surface | ProfileKind::Barrel | ProfileKind::Revolution => true,
             ProfileKind::Explicit | ProfileKind::Polar | ProfileKind::Parametric => false,
         }
     }

@@ -231,7 +231,8 @@ pub fn geometry_values(
         }
         camchain::runtime::ProfileKind::Explicit
         | camchain::runtime::ProfileKind::Parametric
-        | camchain::runtime::ProfileKind::Surface => v.push(g.parameter),
+        | camchain::runtime::ProfileKind::Surface
+        | camchain::runtime::ProfileKind::Revolution => v.push(g.parameter),
     }
     v
 }

@@ -312,6 +312,48 @@ fn a_bilateral_barrel_run_reports_each_flank_change_where_the_law_says() {
 }
 
 #[test]
+fn a_particle_leaves_a_sphere_where_the_closed_form_says() {
+    // tests/contact_models/sphere_slide.ron: the sphere of radius a as the surface of
+    // revolution r = √(a² − z²), the particle started at rest θ₀ from the top. It leaves where
+    // m g cos θ = m v²/a with v² = 2 g a (cos θ₀ − cos θ): cos θ* = (2/3) cos θ₀, on the
+    // generated code and on the numeric reference alike.
+    let generated = &*contact_models::sphere_slide::DEFAULT;
+    let numeric = numeric("tests/contact_models/sphere_slide.ron");
+    let (a, theta0) = (0.5, 0.1);
+    let expected = 2.0 / 3.0 * f64::cos(theta0);
+    for (engine, model) in [
+        ("generated", generated as &dyn Dynamics),
+        ("numeric", &numeric as &dyn Dynamics),
+    ] {
+        let settings = model.info().defaults.clone();
+        let run = model
+            .simulate_unilateral(model.assemble(0.0).expect("assembles"), &settings, 0.0)
+            .unwrap_or_else(|f| panic!("{engine}: {f}"));
+        let lift_off = run
+            .events
+            .iter()
+            .find(|e| e.kind == EventKind::LiftOff)
+            .unwrap_or_else(|| panic!("{engine}: no lift-off in {:?}", run.events));
+        let (x, z) = (lift_off.q[0], lift_off.q[2]);
+        // The point is on the sphere there, and its height gives the angle: located to
+        // 1e-9 s at a speed of ~1.8 m/s (2e-9 m); the force's zero itself to rtol 1e-10.
+        let on_sphere = (x.hypot(z) - a).abs();
+        let cos = z / a;
+        println!(
+            "sphere_slide ({engine}): leaves at cos θ = {cos:.12}, closed form {expected:.12} \
+             ({:.1e}); t = {:.9} s",
+            cos - expected,
+            lift_off.t
+        );
+        assert!(on_sphere < 1e-12, "{engine}: {on_sphere:e} off the sphere");
+        assert!(
+            (cos - expected).abs() < 1e-8,
+            "{engine}: cos θ* = {cos}, closed form {expected}"
+        );
+    }
+}
+
+#[test]
 fn surface_models_run_alike_generated_and_numeric_and_keep_their_energy() {
     for (generated, path) in [
         (

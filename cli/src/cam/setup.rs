@@ -89,6 +89,7 @@ fn profile_kind(contact: &Contact) -> &'static str {
         Profile::Parametric { .. } => "parametric profile",
         Profile::Surface { .. } => "surface",
         Profile::Barrel { .. } => "barrel cam",
+        Profile::Revolution { .. } => "surface of revolution",
     }
 }
 

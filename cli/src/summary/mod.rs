@@ -110,6 +110,7 @@ pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
         ProfileKind::Parametric => "a parametric profile (x(s), y(s))",
         ProfileKind::Surface => "a surface z = f(x, y)",
         ProfileKind::Barrel => "a barrel cam's groove z = g(θ)",
+        ProfileKind::Revolution => "a surface of revolution r = g(z)",
     };
     let turned = contact
         .cam_coordinate
@@ -526,6 +527,9 @@ fn material_side(profile: ProfileKind) -> &'static str {
         ProfileKind::Barrel => {
             "the groove's lower flank pushes towards +z; its upper flank pulls (a groove holds \
              the follower both ways)"
+        }
+        ProfileKind::Revolution => {
+            "the cam is the region r < g(z) about its axis and pushes outwards"
         }
         ProfileKind::Parametric => {
             "the cam lies on the left of its curve as s increases (inside a curve traced \

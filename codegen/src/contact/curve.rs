@@ -72,6 +72,17 @@ pub fn curve(
                 d2: [zero, d2],
             }
         }
+        // A surface of revolution's meridian (g(z), z), as the model's samples give it.
+        Profile::Revolution { .. } => {
+            let placeholder = format!("__cam_{name}");
+            let [r, d1, d2] = value_and_derivatives(g, first, &placeholder, at, params);
+            let (zero, one) = (g.zero(), g.one());
+            CurvePoint {
+                point: [r, at],
+                d1: [d1, one],
+                d2: [d2, zero],
+            }
+        }
         // A barrel's pitch curve developed on the plane at its radius R, (R θ, g(θ)), as the
         // model's samples give it.
         Profile::Barrel { radius, .. } => {
@@ -142,6 +153,7 @@ fn combine(g: &mut Graph, a: Id, u: [Id; 2], b: Id, v: [Id; 2]) -> [Id; 2] {
 pub fn follower_side(profile: &Profile) -> f64 {
     match profile {
         Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
+        Profile::Revolution { .. } => -1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
     }
 }
@@ -314,6 +326,7 @@ mod tests {
                 Profile::Explicit { f, .. }
                 | Profile::Surface { f, .. }
                 | Profile::Barrel { f, .. } => (f, None),
+                Profile::Revolution { g, .. } => (g, None),
                 Profile::Polar { r, .. } => (r, None),
                 Profile::Parametric { x, y, .. } => (x, Some(y)),
             };

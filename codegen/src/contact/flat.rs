@@ -51,7 +51,8 @@ pub fn flat(
         Profile::Explicit { .. }
         | Profile::Parametric { .. }
         | Profile::Surface { .. }
-        | Profile::Barrel { .. } => Guess::Scan,
+        | Profile::Barrel { .. }
+        | Profile::Revolution { .. } => Guess::Scan,
     };
     let solution = g.implicit(
         &format!("{name}_parameter"),

@@ -7,7 +7,8 @@
 //! - the kinds: [`knife`] (a knife edge on y = f(x), the paper's eqs. 1–8, in closed form),
 //!   [`nearest`] (a roller, or a knife edge, on any profile: the profile point nearest the
 //!   follower point, found by Newton), [`flat`] (a flat face: the profile's extreme point
-//!   along the face's normal) and [`surface`] (a point on a cam surface z = f(x, y)).
+//!   along the face's normal), [`surface`] (a point on a cam surface z = f(x, y), or in a
+//!   barrel cam's groove) and [`revolution`] (a point outside a surface of revolution).
 //!
 //! A new kind is one more module here returning [`ContactTerms`] (with the [`Formulas`] the
 //! generated docs quote), and one more arm in [`contact_terms`]; the emitter, the runtime and
@@ -18,6 +19,7 @@ pub mod flat;
 pub mod knife;
 pub mod nearest;
 pub mod relative;
+pub mod revolution;
 pub mod surface;
 
 use crate::expr::{Graph, Id};
@@ -91,6 +93,9 @@ pub fn contact_terms(
             match (&contact.follower, &contact.profile) {
                 (Follower::Knife, Profile::Surface { .. } | Profile::Barrel { .. }) => {
                     surface::point(g, model, s, index, rel, None)
+                }
+                (Follower::Knife, Profile::Revolution { .. }) => {
+                    revolution::point(g, model, s, index, rel)
                 }
                 (Follower::Roller { radius }, Profile::Barrel { .. }) => {
                     surface::point(g, model, s, index, rel, Some(*radius))

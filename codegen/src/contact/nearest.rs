@@ -49,6 +49,7 @@ pub fn nearest(
     let guess = match contact.profile {
         Profile::Explicit { .. } | Profile::Surface { .. } => Guess::Input(0),
         Profile::Barrel { .. } => Guess::Angle { x: 0, y: 1 },
+        Profile::Revolution { .. } => Guess::Scan,
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
         Profile::Parametric { .. } => Guess::Scan,
     };

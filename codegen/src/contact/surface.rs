@@ -62,7 +62,8 @@ fn surface_at(
         Profile::Surface { .. }
         | Profile::Explicit { .. }
         | Profile::Polar { .. }
-        | Profile::Parametric { .. } => (derivatives(g, model, s, index, xy), None),
+        | Profile::Parametric { .. }
+        | Profile::Revolution { .. } => (derivatives(g, model, s, index, xy), None),
     }
 }
 
@@ -298,23 +299,7 @@ pub fn point(
         Some(b) => b.curvature,
         None => principal_curvature(g, &d, stretch, &name),
     };
-    let sliding = {
-        let v = [vx, vy, rel.height_rate];
-        let along = dot(g, v, unit);
-        g.label(along, format!("{name}_normal_speed"));
-        let tangential: Vec<Id> = (0..3)
-            .map(|k| {
-                let n = g.mul(along, unit[k]);
-                g.sub(v[k], n)
-            })
-            .collect();
-        for (&id, axis) in tangential.iter().zip(["x", "y", "z"]) {
-            g.label(id, format!("{name}_slip_{axis}"));
-        }
-        let squares: Vec<Id> = tangential.iter().map(|&t| g.mul(t, t)).collect();
-        let sum = g.sum(squares);
-        g.sqrt(sum)
-    };
+    let sliding = sliding_speed(g, [vx, vy, rel.height_rate], unit, &name);
     // The point on the surface over (X, Y); a roller's centre is on the pitch surface and
     // its contact point the radius below it along the normal, on the flank under it.
     let mut position = {
@@ -363,13 +348,32 @@ pub fn point(
     }
 }
 
+/// |v − (v·n) n|: the magnitude of the follower point's velocity `v` relative to the cam in
+/// the tangent plane of unit normal `unit` (cam-frame components), (S6).
+pub(super) fn sliding_speed(g: &mut Graph, v: [Id; 3], unit: [Id; 3], name: &str) -> Id {
+    let along = dot(g, v, unit);
+    g.label(along, format!("{name}_normal_speed"));
+    let tangential: Vec<Id> = (0..3)
+        .map(|k| {
+            let n = g.mul(along, unit[k]);
+            g.sub(v[k], n)
+        })
+        .collect();
+    for (&id, axis) in tangential.iter().zip(["x", "y", "z"]) {
+        g.label(id, format!("{name}_slip_{axis}"));
+    }
+    let squares: Vec<Id> = tangential.iter().map(|&t| g.mul(t, t)).collect();
+    let sum = g.sum(squares);
+    g.sqrt(sum)
+}
+
 fn dot(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> Id {
     let products: Vec<Id> = (0..3).map(|k| g.mul(a[k], b[k])).collect();
     g.sum(products)
 }
 
 /// The ground vector of cam-frame components (x, y, z).
-fn to_ground_vector(g: &mut Graph, rel: &Relative, [x, y, z]: [Id; 3]) -> V3 {
+pub(super) fn to_ground_vector(g: &mut Graph, rel: &Relative, [x, y, z]: [Id; 3]) -> V3 {
     let in_plane = rel.vector_to_ground(g, [x, y]);
     let up = vec3::scale(g, z, rel.axis);
     vec3::add(g, in_plane, up)

@@ -42,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 15] = [
+pub const KINDS: [Kind; 16] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -156,6 +156,16 @@ pub const KINDS: [Kind; 15] = [
         name: "knife on barrel",
         follower: "",
         profile: "barrel: (radius: 0.045, groove: \"0.002*theta.sin() + 0.001*(2.0*theta).cos()\"),",
+        offset: 0.0,
+        planar_only: false,
+        turn: 3.1,
+    },
+    // A surface of revolution about the cam frame's axis (a waisted drum), the follower
+    // point outside it at the polar profiles' distance.
+    Kind {
+        name: "knife on revolution",
+        follower: "",
+        profile: "revolution: \"0.045 + 3.0*z*z + 0.002*(40.0*z).sin()\",",
         offset: 0.0,
         planar_only: false,
         turn: 3.1,

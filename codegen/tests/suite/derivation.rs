@@ -306,3 +306,18 @@ fn an_unreachable_initial_state_fails_with_file_line_and_field() {
         "{text}"
     );
 }
+
+#[test]
+fn assembly_halves_a_newton_step_that_leaves_where_the_surface_is_defined() {
+    // The sphere r = √(a² − z²) (a = 0.5) with the particle at x = a sin 0.1 and the guess
+    // z = 0.45: Newton's full step lands at z = 0.53, above the sphere's pole, where √ of a
+    // negative number is NaN. Halving it stays on the sphere's side and converges to the root
+    // z = √(a² − x²).
+    let source = include_str!("../../../tests/contact_models/sphere_slide.ron");
+    let model = camchain_codegen::schema::parse_model(source, std::path::Path::new("sphere.ron"))
+        .expect("parses");
+    let d = Derivation::new(&model);
+    let q = camchain_codegen::assembly::assemble(&model, &d).expect("assembles");
+    let x = 0.5 * 0.1f64.sin();
+    assert!((q[2] - (0.25 - x * x).sqrt()).abs() < 1e-12, "z = {}", q[2]);
+}

@@ -242,6 +242,9 @@ pub(super) struct Contact {
     /// A barrel cam: the pitch surface z = f(θ) on a cylinder about the cam's axis.
     #[serde(default)]
     pub barrel: Option<Barrel>,
+    /// A surface of revolution r = g(z) about the cam's axis.
+    #[serde(default)]
+    pub revolution: Option<String>,
     /// A profile through a table of points.
     #[serde(default)]
     pub table: Option<Table>,

@@ -48,6 +48,8 @@ impl ContactConst {
         let (x, y) = (line(x, dx), line(y, dy));
         match &self.profile {
             Profile::Barrel { .. } => self.tape.eval_jet(angle(x, y))[0],
+            // Not a graph over the plane: its own route (`revolution.rs`).
+            Profile::Revolution { .. } => Jet2::constant(f64::NAN),
             Profile::Surface { .. }
             | Profile::Explicit { .. }
             | Profile::Polar { .. }
@@ -118,7 +120,8 @@ impl ContactConst {
             Profile::Surface { .. }
             | Profile::Explicit { .. }
             | Profile::Polar { .. }
-            | Profile::Parametric { .. } => (p[0], larger_principal_curvature([fx, fy], hessian)),
+            | Profile::Parametric { .. }
+            | Profile::Revolution { .. } => (p[0], larger_principal_curvature([fx, fy], hessian)),
         };
         let geometry = ContactGeometry {
             position: position.into(),

@@ -197,6 +197,7 @@ fn profile(
         ("parametric", c.parametric.is_some()),
         ("surface", c.surface.is_some()),
         ("barrel", c.barrel.is_some()),
+        ("revolution", c.revolution.is_some()),
         ("table", c.table.is_some()),
         ("law", c.law.is_some()),
     ];
@@ -207,15 +208,15 @@ fn profile(
                 format!("{path}.marker"),
                 "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
                  `polar: \"r(theta)\"`, `parametric: (x: \"x(s)\", y: \"y(s)\")`, `surface: \
-                 \"f(x, y)\"` (a surface z = f(x, y)), `barrel: (…)` (a barrel cam), `table: \
-                 (…)` (through points) or `law: (…)` (designed from the follower's motion)"
+                 \"f(x, y)\"` (a surface z = f(x, y)), `barrel: (…)` (a barrel cam), `revolution: \
+                 \"g(z)\"` (a surface of revolution r = g(z)), `table: (…)` (through points) or `law: (…)` (designed from the follower's motion)"
                     .to_string(),
             ),
             [.., last] => (
                 format!("{path}.{last}"),
                 format!(
                     "give only one of `profile`, `polar`, `parametric`, `surface`, `barrel`, \
-                     `table` and `law` (this contact gives {})",
+                     `revolution`, `table` and `law` (this contact gives {})",
                     named
                         .iter()
                         .map(|n| format!("`{n}`"))
@@ -244,6 +245,9 @@ fn profile(
     }
     if let Some(source) = &c.surface {
         return surface(cx, path, source, i, follower).map(Shaped::from);
+    }
+    if let Some(source) = &c.revolution {
+        return revolution(cx, path, source, i, follower).map(Shaped::from);
     }
     if let Some(barrel) = &c.barrel {
         return super::barrels::barrel_profile(cx, path, barrel, i, name, follower)
@@ -302,6 +306,38 @@ fn profile(
         y,
     }
     .into())
+}
+
+/// A surface of revolution r = g(z): an expression of `z` and the parameters, followed by a
+/// point (a knife edge) outside it.
+fn revolution(
+    cx: &Context,
+    path: &str,
+    source: &str,
+    i: usize,
+    follower: &Follower,
+) -> Checked<Profile> {
+    let g = expression(
+        cx,
+        &format!("{path}.revolution"),
+        source,
+        &["z"],
+        Field::Profile(i),
+    )?;
+    match follower.kind().outline() {
+        Outline::Point => Ok(Profile::Revolution {
+            source: source.to_string(),
+            g,
+        }),
+        Outline::Circle | Outline::Line => Err(cx.at.error(
+            &format!("{path}.follower"),
+            format!(
+                "a {} cannot follow a surface of revolution: it takes a point follower \
+                 (`follower: Knife`)",
+                follower.kind().label()
+            ),
+        )),
+    }
 }
 
 /// A surface z = f(x, y): an expression of `x`, `y` and the parameters, followed by a point
@@ -388,15 +424,19 @@ fn contact_range(
     let needs = match (profile, follower.kind().outline()) {
         (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
         (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
-        (Profile::Explicit { .. } | Profile::Surface { .. }, Outline::Point) => None,
+        (
+            Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Revolution { .. },
+            Outline::Point,
+        ) => None,
         // A barrel's groove is a graph over the whole turn: no search, nothing to scan.
         (Profile::Barrel { .. }, _) => None,
-        (Profile::Explicit { .. } | Profile::Surface { .. }, Outline::Circle | Outline::Line) => {
-            Some(format!(
-                "a {} on an explicit profile",
-                follower.kind().label()
-            ))
-        }
+        (
+            Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Revolution { .. },
+            Outline::Circle | Outline::Line,
+        ) => Some(format!(
+            "a {} on an explicit profile",
+            follower.kind().label()
+        )),
     };
     match needs {
         None => Ok(None),
@@ -498,6 +538,7 @@ fn profile_field(contact: &Contact) -> &'static str {
         Profile::Parametric { .. } => "parametric",
         Profile::Surface { .. } => "surface",
         Profile::Barrel { .. } => "barrel",
+        Profile::Revolution { .. } => "revolution",
     }
 }
 
