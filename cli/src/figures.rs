@@ -13,6 +13,10 @@
 //! - `comparison`: two runs side by side (the concave and the convex cam), on common
 //!   scales so that the difference between them shows at a glance.
 
+mod surface;
+
+pub use surface::surface;
+
 use super::kinematics::Geometry;
 use super::plots::{Figure, Frame, LinePanel, MechanismPanel, Panel, Row, Series, time_color};
 use super::summary::{LiftOff, unit};

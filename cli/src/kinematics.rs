@@ -76,6 +76,44 @@ pub struct Geometry {
     pub profile: Option<(Scalar, String)>,
     /// Every contact's cam and follower shape, in contact order.
     cams: Vec<CamShape>,
+    /// Every contact's cam surface (`None` for a plane profile), in contact order: what the
+    /// figure of its contact path draws (`figures::surface`).
+    pub surfaces: Vec<Option<SurfaceShape>>,
+}
+
+/// A contact's cam surface with every parameter at its value, for the figure of the contact
+/// path over it.
+#[derive(Debug, Clone)]
+pub enum SurfaceShape {
+    /// z = f(x, y) of the cam frame.
+    Graph(Scalar),
+    /// A barrel cam's pitch surface z = g(θ) on the radius R; the roller's radius ρ (0 for a
+    /// knife edge).
+    Barrel {
+        /// g(θ).
+        g: Scalar,
+        /// R (m).
+        radius: f64,
+        /// ρ (m).
+        roller: f64,
+    },
+    /// A surface of revolution r = g(z).
+    Revolution(Scalar),
+}
+
+impl SurfaceShape {
+    fn of(contact: &Contact, values: &[f64]) -> Option<Self> {
+        match &contact.profile {
+            Profile::Surface { f, .. } => Some(SurfaceShape::Graph(f.resolve_all(values))),
+            Profile::Barrel { f, radius, .. } => Some(SurfaceShape::Barrel {
+                g: f.resolve_all(values),
+                radius: *radius,
+                roller: contact.follower.radius().copied().unwrap_or(0.0),
+            }),
+            Profile::Revolution { g, .. } => Some(SurfaceShape::Revolution(g.resolve_all(values))),
+            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => None,
+        }
+    }
 }
 
 /// Points of a drawn closed profile, or of an open one along its range.
@@ -242,6 +280,11 @@ impl Geometry {
             .iter()
             .map(|c| CamShape::new(model, c, &values))
             .collect();
+        let surfaces = model
+            .contacts
+            .iter()
+            .map(|c| SurfaceShape::of(c, &values))
+            .collect();
         let profile = model.contacts.first().and_then(|c| match &c.profile {
             Profile::Explicit { f, source } if c.cam_body.is_none() => {
                 Some((f.resolve_all(&values), source.clone()))
@@ -256,6 +299,7 @@ impl Geometry {
             plane: Plane::ground(),
             profile,
             cams,
+            surfaces,
         };
         if !geometry.consistent() {
             return Err("the model's body or marker indices are out of order".into());

@@ -62,7 +62,14 @@ pub(super) fn draw_heat<DB: DrawingBackend>(
     let area = caption(area, &p.title)?;
     let (w, _) = area.dim_in_pixel();
     let (map, bar) = area.split_horizontally(w.saturating_sub(130));
-    let (xe, ye) = (cell_edges(&p.x), cell_edges(&p.y));
+    let edges = |v: &[f64]| {
+        if p.path.is_empty() {
+            cell_edges(v)
+        } else {
+            unclamped_edges(v)
+        }
+    };
+    let (xe, ye) = (edges(&p.x), edges(&p.y));
     let (x0, x1) = (xe[0], xe[xe.len() - 1]);
     let (y0, y1) = (ye[0], ye[ye.len() - 1]);
     let values: Vec<f64> = p.z.iter().flatten().flatten().copied().collect();
@@ -99,6 +106,12 @@ pub(super) fn draw_heat<DB: DrawingBackend>(
         }
     }
     chart.draw_series(cells)?;
+    if !p.path.is_empty() {
+        chart.draw_series(LineSeries::new(
+            p.path.iter().copied(),
+            WHITE.stroke_width(2),
+        ))?;
+    }
     let (power, z_label) = scaled_axis((lo, hi), &p.z_label);
     let scale = 10f64.powi(-power);
     let mut legend = ChartBuilder::on(&bar)

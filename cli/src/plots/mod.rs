@@ -113,6 +113,10 @@ pub struct HeatPanel {
     /// What the panel says, in place of a colour bar, when no cell has a value (`no lift-off
     /// in any run`).
     pub empty: String,
+    /// A path drawn over the cells (a contact's path over its cam surface), in the axes'
+    /// coordinates; empty for none. With a path the grid is a surface's, not swept
+    /// parameters': its cells are not clipped at zero.
+    pub path: Vec<(f64, f64)>,
 }
 
 /// Points on one pair of axes.

@@ -386,6 +386,9 @@ fn draw_run(
     if let Some(figure) = figures::follower(&run) {
         figures.push((figure, "follower"));
     }
+    if let Some(figure) = figures::surface(&run) {
+        figures.push((figure, "surface"));
+    }
     let mut paths = Vec::new();
     for (figure, stem) in &figures {
         paths.extend(figure.save(dir, stem).map_err(|e| e.to_string())?);

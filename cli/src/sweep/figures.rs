@@ -191,6 +191,7 @@ fn heat_maps(model: &str, runs: &Runs, plot: &PlotData, a: usize, b: usize) -> F
                 y: ys.clone(),
                 z,
                 empty: no_value(metric),
+                path: Vec::new(),
             })
         })
         .collect();
