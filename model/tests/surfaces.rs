@@ -217,3 +217,25 @@ fn a_surface_of_revolution_is_a_function_of_z_followed_by_a_point() {
         "cannot follow a surface of revolution",
     );
 }
+
+#[test]
+fn a_barrel_groove_must_lie_on_its_cylinder() {
+    let law = "law: (base: 0.02, segments: [Dwell(degrees: 60), Rise(law: Cycloidal, lift: 0.03, \
+               degrees: 120), Dwell(degrees: 60), Return(law: Cycloidal, degrees: 120)])";
+    let roller = |source: String| {
+        source.replace(
+            "marker: \"tip\",\n",
+            "marker: \"tip\", follower: Roller(radius: 0.01),\n",
+        )
+    };
+    // Flanks from z = 0.01 to 0.06: a 0.06 m cylinder holds them, a 0.055 m one does not.
+    let fits = roller(barrel(&format!("radius: 0.06, length: 0.06, {law}")));
+    parse_model(&fits, Path::new("models/surface.ron")).expect("the groove fits");
+    let e = rejected(
+        &roller(barrel(&format!("radius: 0.06, length: 0.055, {law}"))),
+        "contacts[0].barrel.length",
+        16,
+        "the groove leaves the cylinder: its upper flank reaches z = 0.06",
+    );
+    assert!(e.message.contains("0.055 m long"), "{e}");
+}

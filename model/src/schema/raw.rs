@@ -271,6 +271,10 @@ pub(super) struct Barrel {
     /// The pitch surface designed from the follower's motion law.
     #[serde(default)]
     pub law: Option<BarrelLaw>,
+    /// The cylinder's length along its axis from the cam frame's origin (m): the groove
+    /// must lie on it.
+    #[serde(default)]
+    pub length: Option<Number>,
 }
 
 /// `law: (base: z₀, turning: …, segments: […])` of a barrel cam: the follower's travel along

@@ -79,7 +79,55 @@ pub(super) fn barrel_profile(
             ));
         }
     };
+    if let Some(length) = &barrel.length {
+        let at = format!("{field}.length");
+        let (_, length) = cx.dimension(&at, length)?;
+        let length = positive(cx.at, &at, "the barrel's length", length)?;
+        let roller = follower.radius().copied().unwrap_or(0.0);
+        on_the_cylinder(cx, &at, &f, roller, length)?;
+    }
     Ok(Profile::Barrel { source, f, radius })
+}
+
+/// The groove's flanks, the roller's radius below and above its pitch surface, lie on the
+/// cylinder: 0 ≤ g(θ) − ρ and g(θ) + ρ ≤ length at 3600 angles of a turn (a law's
+/// extremes lie on its segments' joints, which are multiples of 0.1° in practice).
+fn on_the_cylinder(cx: &Context, at: &str, f: &Scalar, roller: f64, length: f64) -> Checked<()> {
+    let samples = 3600;
+    let heights = (0..samples).map(|k| {
+        let theta = TAU * k as f64 / samples as f64;
+        (theta, f.eval(theta))
+    });
+    let (mut lowest, mut highest) = ((0.0, f64::INFINITY), (0.0, f64::NEG_INFINITY));
+    for (theta, z) in heights {
+        if z - roller < lowest.1 {
+            lowest = (theta, z - roller);
+        }
+        if z + roller > highest.1 {
+            highest = (theta, z + roller);
+        }
+    }
+    // A flank exactly at an end is on the cylinder: rounding of a few ulps is let pass.
+    let slack = 1e-12 * length;
+    let beyond = if highest.1 > length + slack {
+        Some(("upper", highest, "its length"))
+    } else if lowest.1 < -slack {
+        Some(("lower", lowest, "its start (z = 0)"))
+    } else {
+        None
+    };
+    match beyond {
+        None => Ok(()),
+        Some((side, (theta, value), edge)) => Err(cx.at.error(
+            at,
+            format!(
+                "the groove leaves the cylinder: its {side} flank reaches z = {value:.6} m at θ \
+                 = {:.3}°, beyond {edge}; the cylinder is {length} m long (lengthen it, or \
+                 move the groove with `base`)",
+                theta.to_degrees()
+            ),
+        )),
+    }
 }
 
 /// A barrel's pitch surface closes on itself round the cylinder: f(θ + 2π) = f(θ), checked
