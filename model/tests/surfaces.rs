@@ -239,3 +239,46 @@ fn a_barrel_groove_must_lie_on_its_cylinder() {
     );
     assert!(e.message.contains("0.055 m long"), "{e}");
 }
+
+#[test]
+fn a_surface_is_checked_over_its_region_before_running() {
+    let with_region = |surface: &str, region: &str| {
+        edited(
+            "surface: \"c*(x*x + y*y) + 0.1*(x*y).sin()\",",
+            &format!("surface: \"{surface}\", region: {region},"),
+        )
+    };
+    let fine = with_region("c*(x*x + y*y)", "((-0.2, 0.2), (-0.3, 0.3))");
+    parse_model(&fine, Path::new("models/surface.ron")).expect("defined over its region");
+    // ln(1 − x) is −∞ at x = 1 (a grid point: 33 points over [0, 2]) and NaN beyond: refused
+    // at the surface, naming the first point.
+    let e = rejected(
+        &with_region("c*y*y + (1.0 - x).ln()", "((0.0, 2.0), (-0.1, 0.1))"),
+        "contacts[0].surface",
+        16,
+        "the surface is not defined over its region: f = -inf at (x, y) = (1, -0.1)",
+    );
+    assert!(e.message.contains("x ∈ [0, 2]"), "{e}");
+    // √ has an infinite slope where its argument vanishes: the derivatives are checked too.
+    rejected(
+        &with_region("(x + 0.5).sqrt()", "((-0.5, 0.5), (-0.1, 0.1))"),
+        "contacts[0].surface",
+        16,
+        "∂f/∂x = inf",
+    );
+    rejected(
+        &with_region("c*x*x", "((0.2, -0.2), (-0.1, 0.1))"),
+        "contacts[0].region",
+        16,
+        "must be increasing",
+    );
+    rejected(
+        &barrel("radius: 0.06, groove: \"0.01*theta.sin()\"").replace(
+            "marker: \"tip\",\n",
+            "marker: \"tip\", region: ((0.0, 1.0), (0.0, 1.0)),\n",
+        ),
+        "contacts[0].region",
+        15,
+        "only a surface",
+    );
+}

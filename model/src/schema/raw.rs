@@ -253,6 +253,9 @@ pub(super) struct Contact {
     pub law: Option<Law>,
     #[serde(default)]
     pub range: Option<(f64, f64)>,
+    /// Where a surface's follower goes: ((x₀, x₁), (y₀, y₁)) of the cam frame.
+    #[serde(default)]
+    pub region: Option<((f64, f64), (f64, f64))>,
     #[serde(default)]
     pub frame: Frame,
 }

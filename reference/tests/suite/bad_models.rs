@@ -1074,6 +1074,14 @@ const CASES: &[Case] = &[
         "contacts[0].barrel.groove",
         "must close round the cylinder",
     ),
+    // The surface's text: a logarithm undefined over part of the region.
+    case(
+        "surface_undefined_in_region.ron",
+        43,
+        22,
+        "contacts[0].surface",
+        "the surface is not defined over its region: f = NaN",
+    ),
     // `Roller(radius: 0.01)` on a cam surface.
     case(
         "surface_with_roller.ron",

@@ -8,6 +8,7 @@ use super::fields::{finite, identifier, lookup, unit_vector};
 use super::markers::cam_axes;
 use super::parameters::expression;
 use super::{Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile};
+use crate::jet::{Jet2, eval_on_all, own_tables};
 use crate::model::{Body, Contact, JointKind, RuntimeCheck};
 use crate::samples::profile_samples;
 use crate::schema::raw;
@@ -147,6 +148,9 @@ fn contact(
         design,
     } = profile(cx, &path, c, i, &name, &follower)?;
     let range = contact_range(at, &path, c, &profile, &follower, covers)?;
+    if let Some(region) = c.region {
+        surface_region(at, &path, &profile, region)?;
+    }
     Ok(Contact {
         name,
         marker,
@@ -306,6 +310,81 @@ fn profile(
         y,
     }
     .into())
+}
+
+/// Samples per side of a surface's region checked before running.
+const REGION_SAMPLES: usize = 33;
+
+/// A surface's `region`, ((x₀, x₁), (y₀, y₁)): finite and increasing, and the surface defined
+/// over it with the two derivatives the dynamics read. f, its gradient and its Hessian are
+/// evaluated by jets along x, y and x + y at 33 × 33 points; the first point where one is
+/// not a finite number is refused, with what failed and where.
+fn surface_region(
+    at: &Locator,
+    path: &str,
+    profile: &Profile,
+    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+) -> Checked<()> {
+    let field = format!("{path}.region");
+    let Profile::Surface { f, .. } = profile else {
+        return Err(at.error(
+            &field,
+            "only a surface (`surface: \"f(x, y)\"`) takes a `region`: the part of the cam \
+             plane its follower goes over",
+        ));
+    };
+    for (value, k) in [
+        (x0, "[0][0]"),
+        (x1, "[0][1]"),
+        (y0, "[1][0]"),
+        (y1, "[1][1]"),
+    ] {
+        finite(at, &format!("{field}{k}"), value)?;
+    }
+    if x0 >= x1 || y0 >= y1 {
+        return Err(at.error(
+            &field,
+            format!(
+                "the region's intervals must be increasing, got x in ({x0}, {x1}) and y in \
+                 ({y0}, {y1})"
+            ),
+        ));
+    }
+    let along = |x: f64, y: f64, dx: f64, dy: f64| {
+        let line = |v: f64, d: f64| Jet2 { v, d1: d, d2: 0.0 };
+        eval_on_all(f, &[line(x, dx), line(y, dy)], &own_tables)
+    };
+    let n = REGION_SAMPLES - 1;
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = x0 + (x1 - x0) * i as f64 / n as f64;
+            let y = y0 + (y1 - y0) * j as f64 / n as f64;
+            let (ex, ey, diagonal) = (
+                along(x, y, 1.0, 0.0),
+                along(x, y, 0.0, 1.0),
+                along(x, y, 1.0, 1.0),
+            );
+            let quantities = [
+                ("f", ex.v),
+                ("∂f/∂x", ex.d1),
+                ("∂f/∂y", ey.d1),
+                ("∂²f/∂x²", ex.d2),
+                ("∂²f/∂y²", ey.d2),
+                ("∂²f/∂x∂y", 0.5 * (diagonal.d2 - ex.d2 - ey.d2)),
+            ];
+            if let Some((what, value)) = quantities.iter().find(|q| !q.1.is_finite()) {
+                return Err(at.error(
+                    &format!("{path}.surface"),
+                    format!(
+                        "the surface is not defined over its region: {what} = {value} at (x, y) \
+                         = ({x}, {y}); the follower may go anywhere in x ∈ [{x0}, {x1}], y ∈ \
+                         [{y0}, {y1}] (narrow the region or change the surface)"
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A surface of revolution r = g(z): an expression of `z` and the parameters, followed by a
