@@ -188,14 +188,18 @@ fn the_barrel_cam_moves_its_follower_by_the_law() {
     // constraint to round-off each step), so the law holds to rounding, not to the tolerance.
     assert!(s_err < 1e-9 && v_err < 1e-9 && a_err < 1e-9);
     assert!(angle_err < 1e-12, "pressure angle {angle_err:e}");
-    // The largest pressure angle, at the rise's middle: atan(2h/(βR)), β = 120°.
+    // The largest pressure angle, at the rise's and the return's middles: atan(2h/(βR)),
+    // β = 120°. No sample exceeds it (beyond rounding), and the outputs, 0.01 rad of cam
+    // angle apart, come within half a spacing of the peak, where the angle's curvature is
+    // (dα/ds′)(2π)²h/β³ ≈ 13.6 · 0.129 ≈ 1.8 rad/rad²: 1.8/2 · 0.005² ≈ 2.2e-5 rad at most.
     let largest = run
         .samples
         .iter()
         .map(|s| s.contacts[0].pressure_angle())
         .fold(0.0, f64::max);
     let closed = (2.0 * lift / (TAU / 3.0) / radius).atan();
-    assert!((largest - closed).abs() < 1e-6, "{largest} vs {closed}");
+    assert!(largest <= closed + 1e-12, "{largest} above {closed}");
+    assert!(closed - largest < 2.3e-5, "{largest} vs {closed}");
 }
 
 #[test]
