@@ -5,10 +5,11 @@
 //! derivative along Ṗ itself; the principal curvatures are those of the level set F = 0, the
 //! eigenvalues of the Hessian restricted to the tangent plane over |∇F|.
 
+use super::surface::{spatial, tangential_speed};
 use super::{CamFrame, ContactConst, Evaluated, Seen};
 use crate::jet::Jet2;
 use crate::motion::Vec3;
-use camchain_runtime::{ContactGeometry, ContactKinematics};
+use camchain_runtime::ContactGeometry;
 
 impl ContactConst {
     /// F along the line P + t d: its value and first two derivatives in t.
@@ -58,11 +59,7 @@ impl ContactConst {
         let stretch = dot(gradient, gradient).sqrt();
         let unit: [f64; 3] = gradient.map(|g| g / stretch);
         let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
-        let along = dot(velocity, unit);
-        let sliding = (0..3)
-            .map(|k| (velocity[k] - along * unit[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let sliding = tangential_speed(velocity, unit);
         // The surface's point on the follower point's radius, at its height.
         let g = self.tape.eval(p[2])[0];
         let r = p[0].hypot(p[1]);
@@ -83,25 +80,7 @@ impl ContactConst {
             direction: direction.into(),
             sliding_speed: sliding,
         };
-        let kinematics = ContactKinematics {
-            geometry,
-            x: p[0],
-            y: p[1],
-            j1: columns.iter().map(|c| c.v[0]).collect(),
-            j2: columns.iter().map(|c| c.v[1]).collect(),
-            conv1: seen.a[0],
-            conv2: seen.a[1],
-            z: p[2],
-            j3: columns.iter().map(|c| c.height[1]).collect(),
-            conv3: seen.height[2],
-        };
-        Evaluated {
-            h,
-            jacobian,
-            bias,
-            geometry,
-            kinematics,
-        }
+        spatial(h, jacobian, bias, geometry, seen, columns)
     }
 }
 

@@ -96,11 +96,7 @@ impl ContactConst {
         let unit = [-fx / stretch, -fy / stretch, 1.0 / stretch];
         let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
         let velocity = [seen.v[0], seen.v[1], seen.height[1]];
-        let along: f64 = (0..3).map(|k| velocity[k] * unit[k]).sum();
-        let sliding = (0..3)
-            .map(|k| (velocity[k] - along * unit[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let sliding = tangential_speed(velocity, unit);
         // A roller's centre is on a barrel's pitch surface, its contact point the radius
         // below along the normal; a barrel's curvature is its developed pitch curve's at the
         // point's radius r, (g″/r²)/(1 + (g′/r)²)^{3/2}, a surface's the larger principal one.
@@ -137,25 +133,48 @@ impl ContactConst {
             direction: direction.into(),
             sliding_speed: sliding,
         };
-        let kinematics = ContactKinematics {
-            geometry,
-            x: p[0],
-            y: p[1],
-            j1: columns.iter().map(|c| c.v[0]).collect(),
-            j2: columns.iter().map(|c| c.v[1]).collect(),
-            conv1: seen.a[0],
-            conv2: seen.a[1],
-            z: seen.height[0],
-            j3: columns.iter().map(|c| c.height[1]).collect(),
-            conv3: seen.height[2],
-        };
-        Evaluated {
-            h,
-            jacobian,
-            bias,
-            geometry,
-            kinematics,
-        }
+        spatial(h, jacobian, bias, geometry, seen, columns)
+    }
+}
+
+/// |v − (v·n) n|: the speed of the follower point relative to the cam in the tangent plane of
+/// the unit normal n (cam-frame components).
+pub(super) fn tangential_speed(v: [f64; 3], n: [f64; 3]) -> f64 {
+    let along: f64 = (0..3).map(|k| v[k] * n[k]).sum();
+    (0..3)
+        .map(|k| (v[k] - along * n[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// A spatial cam's evaluation: h, J, c, the geometry, and the follower point's cam-frame
+/// kinematics with its height (Z, J3, c3) from `seen` and the Jacobian `columns`.
+pub(super) fn spatial(
+    h: f64,
+    jacobian: Vec<f64>,
+    bias: f64,
+    geometry: ContactGeometry,
+    seen: &Seen,
+    columns: &[Seen],
+) -> Evaluated {
+    let kinematics = ContactKinematics {
+        geometry,
+        x: seen.p[0],
+        y: seen.p[1],
+        j1: columns.iter().map(|c| c.v[0]).collect(),
+        j2: columns.iter().map(|c| c.v[1]).collect(),
+        conv1: seen.a[0],
+        conv2: seen.a[1],
+        z: seen.height[0],
+        j3: columns.iter().map(|c| c.height[1]).collect(),
+        conv3: seen.height[2],
+    };
+    Evaluated {
+        h,
+        jacobian,
+        bias,
+        geometry,
+        kinematics,
     }
 }
 

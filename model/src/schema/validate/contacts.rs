@@ -396,27 +396,19 @@ fn revolution(
     i: usize,
     follower: &Follower,
 ) -> Checked<Profile> {
-    let g = expression(
+    let what = "a surface of revolution: it takes";
+    let g = point_surface(
         cx,
-        &format!("{path}.revolution"),
+        path,
+        ("revolution", &["z"]),
         source,
-        &["z"],
-        Field::Profile(i),
+        i,
+        (follower, what),
     )?;
-    match follower.kind().outline() {
-        Outline::Point => Ok(Profile::Revolution {
-            source: source.to_string(),
-            g,
-        }),
-        Outline::Circle | Outline::Line => Err(cx.at.error(
-            &format!("{path}.follower"),
-            format!(
-                "a {} cannot follow a surface of revolution: it takes a point follower \
-                 (`follower: Knife`)",
-                follower.kind().label()
-            ),
-        )),
-    }
+    Ok(Profile::Revolution {
+        source: source.to_string(),
+        g,
+    })
 }
 
 /// A surface z = f(x, y): an expression of `x`, `y` and the parameters, followed by a point
@@ -428,23 +420,44 @@ fn surface(
     i: usize,
     follower: &Follower,
 ) -> Checked<Profile> {
+    let what = "a surface: a surface takes";
+    let f = point_surface(
+        cx,
+        path,
+        ("surface", &["x", "y"]),
+        source,
+        i,
+        (follower, what),
+    )?;
+    Ok(Profile::Surface {
+        source: source.to_string(),
+        f,
+    })
+}
+
+/// The expression of a surface followed by a point, parsed from `field` (of `variables`);
+/// any other follower is refused with "a roller cannot follow {what} a point follower".
+fn point_surface(
+    cx: &Context,
+    path: &str,
+    (field, variables): (&str, &[&str]),
+    source: &str,
+    i: usize,
+    (follower, what): (&Follower, &str),
+) -> Checked<crate::profile::Scalar> {
     let f = expression(
         cx,
-        &format!("{path}.surface"),
+        &format!("{path}.{field}"),
         source,
-        &["x", "y"],
+        variables,
         Field::Profile(i),
     )?;
     match follower.kind().outline() {
-        Outline::Point => Ok(Profile::Surface {
-            source: source.to_string(),
-            f,
-        }),
+        Outline::Point => Ok(f),
         Outline::Circle | Outline::Line => Err(cx.at.error(
             &format!("{path}.follower"),
             format!(
-                "a {} cannot follow a surface: a surface takes a point follower (`follower: \
-                 Knife`)",
+                "a {} cannot follow {what} a point follower (`follower: Knife`)",
                 follower.kind().label()
             ),
         )),
