@@ -497,6 +497,7 @@ fn frame_bounds(frames: &[Frame]) -> ((f64, f64), (f64, f64)) {
                 .chain(f.cams.iter().flat_map(|c| {
                     c.outline
                         .iter()
+                        .chain(&c.outer_flank)
                         .chain(&c.roller)
                         .chain(&c.face)
                         .chain(&c.base_circle)

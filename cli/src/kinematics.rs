@@ -111,7 +111,10 @@ impl SurfaceShape {
                 roller: contact.follower.radius().copied().unwrap_or(0.0),
             }),
             Profile::Revolution { g, .. } => Some(SurfaceShape::Revolution(g.resolve_all(values))),
-            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => None,
+            Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. }
+            | Profile::Face { .. } => None,
         }
     }
 }
@@ -150,6 +153,12 @@ enum Outline {
     Closed(Vec<(f64, f64)>),
     /// An open curve along its range.
     Open(Vec<(f64, f64)>),
+    /// A face cam's groove: its inner flank (closed, the material inside it drawn as a disc
+    /// cam's) and its outer flank.
+    Groove {
+        inner: Vec<(f64, f64)>,
+        outer: Vec<(f64, f64)>,
+    },
 }
 
 /// One contact's drawing at one instant, in plane coordinates.
@@ -170,6 +179,8 @@ pub struct CamPicture {
     pub roller: Vec<(f64, f64)>,
     /// The flat face.
     pub face: Vec<(f64, f64)>,
+    /// A face cam groove's outer flank (its inner flank is `outline`).
+    pub outer_flank: Vec<(f64, f64)>,
 }
 
 /// A circle of `radius` about `centre` in the plane spanned by `u`, `v`, as ground points.
@@ -200,6 +211,33 @@ impl CamShape {
                     .fold(f64::INFINITY, f64::min);
                 (Outline::Closed(points), least.is_finite().then_some(least))
             }
+            Profile::Face { centre } => {
+                let rho = contact.follower.radius().copied().unwrap_or(0.0);
+                let centre = centre.resolve_all(values);
+                let side = camchain_codegen::samples::follower_side(&centre);
+                // The flanks ρ either side of the centre line, along its normal n.
+                let flank = |offset: f64| -> Vec<(f64, f64)> {
+                    (0..OUTLINE_POINTS)
+                        .map(|i| std::f64::consts::TAU * i as f64 / OUTLINE_POINTS as f64)
+                        .map(|t| {
+                            let [c, d1, _] = camchain_codegen::samples::curve(&centre, t);
+                            let speed = d1[0].hypot(d1[1]);
+                            let n = [-side * d1[1] / speed, side * d1[0] / speed];
+                            (c[0] + offset * n[0], c[1] + offset * n[1])
+                        })
+                        .collect()
+                };
+                let inner = flank(-rho);
+                let least = inner
+                    .iter()
+                    .map(|(x, y)| x.hypot(*y))
+                    .fold(f64::INFINITY, f64::min);
+                let outer = flank(rho);
+                (
+                    Outline::Groove { inner, outer },
+                    least.is_finite().then_some(least),
+                )
+            }
             Profile::Parametric { x, y, .. } => {
                 let (x, y) = (x.resolve_all(values), y.resolve_all(values));
                 let (a, b) = contact.range.unwrap_or((0.0, 1.0));
@@ -217,7 +255,7 @@ impl CamShape {
             }
         };
         let size = match &outline {
-            Outline::Closed(p) | Outline::Open(p) => {
+            Outline::Closed(p) | Outline::Open(p) | Outline::Groove { outer: p, .. } => {
                 p.iter().map(|(x, y)| x.hypot(*y)).fold(0.0, f64::max)
             }
             Outline::Explicit(_) => 0.05,
@@ -383,6 +421,11 @@ impl Geometry {
             Outline::Closed(points) | Outline::Open(points) => {
                 picture.closed = matches!(cam.outline, Outline::Closed(_));
                 picture.outline = points.iter().copied().map(to_plane).collect();
+            }
+            Outline::Groove { inner, outer } => {
+                picture.closed = true;
+                picture.outline = inner.iter().copied().map(to_plane).collect();
+                picture.outer_flank = outer.iter().copied().map(to_plane).collect();
             }
         }
         if let Some(r) = cam.base_radius {

@@ -30,7 +30,7 @@ pub mod loops;
 
 // The model file and the validated model live in `camchain-model` (shared with the numeric
 // reference); their paths stay available here.
-pub use camchain_model::{design, error, model, profile, read_model_file, schema};
+pub use camchain_model::{design, error, model, profile, read_model_file, samples, schema};
 
 pub use derive::Derivation;
 pub use error::ModelError;

@@ -324,6 +324,22 @@ pub fn profile_expressions(
     turn(&placed.contact, &cos, &sin)
 }
 
+/// The pitch curve of a design (the follower point's path: a knife's edge, a roller's
+/// centre) as a parametric curve of the cam frame, parametrised as in
+/// [`profile_expressions`]: a face cam's groove centre line.
+pub fn pitch_expressions(
+    g: &Geometry<Scalar>,
+    senses: Senses,
+    law: &Arc<Tabulated>,
+) -> [Scalar; 2] {
+    let theta = signed(-senses.turning, Scalar::Var(0));
+    let s = theta.clone().tabulated(law, 0);
+    let ds = theta.tabulated(law, 1);
+    let placed = place(g, senses, &s, &ds);
+    let (cos, sin) = (Scalar::Var(0).cos(), Scalar::Var(0).sin());
+    turn(&placed.pitch, &cos, &sin)
+}
+
 /// A cam designed from a motion law, with its dimensions resolved to numbers: what the
 /// checks and the designer's outputs evaluate.
 #[derive(Debug, Clone, PartialEq)]

@@ -261,6 +261,16 @@ pub enum Profile {
         /// Parsed g.
         g: Scalar,
     },
+    /// A face (end) cam: a groove cut in the cam plane, its centre line `centre` (a
+    /// [`Profile::Polar`] r = g(θ), or the [`Profile::Parametric`] pitch curve of a law
+    /// design). A roller's centre (or a knife edge) stays on the centre line; the roller
+    /// touches the inner flank (the centre line moved towards the cam's material by the
+    /// roller's radius) when the normal force is positive, the outer one when it is negative
+    /// (docs/method.md §13.7).
+    Face {
+        /// The groove's centre line: polar or parametric, the follower on its right.
+        centre: Box<Profile>,
+    },
 }
 
 impl Profile {
@@ -273,6 +283,7 @@ impl Profile {
             Profile::Surface { .. } => "surface",
             Profile::Barrel { .. } => "barrel",
             Profile::Revolution { .. } => "revolution",
+            Profile::Face { .. } => "face",
         }
     }
 
@@ -284,6 +295,7 @@ impl Profile {
             Profile::Polar { .. } | Profile::Barrel { .. } => "theta",
             Profile::Revolution { .. } => "z",
             Profile::Parametric { .. } => "s",
+            Profile::Face { centre } => centre.variable(),
         }
     }
 
@@ -292,7 +304,84 @@ impl Profile {
     pub fn is_surface(&self) -> bool {
         match self {
             Profile::Surface { .. } | Profile::Barrel { .. } | Profile::Revolution { .. } => true,
-            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => false,
+            Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. }
+            | Profile::Face { .. } => false,
+        }
+    }
+
+    /// The expression of the field `Field::Profile(c)`: f, r, x(s), a surface's f(x, y), a
+    /// face cam's centre line's.
+    pub fn expression(&self) -> &Scalar {
+        match self {
+            Profile::Explicit { f, .. }
+            | Profile::Surface { f, .. }
+            | Profile::Barrel { f, .. } => f,
+            Profile::Revolution { g, .. } => g,
+            Profile::Polar { r, .. } => r,
+            Profile::Parametric { x, .. } => x,
+            Profile::Face { centre } => centre.expression(),
+        }
+    }
+
+    /// The same profile with every parameter replaced by its value in `values`.
+    pub fn resolve_all(&self, values: &[f64]) -> Profile {
+        let source = |s: &String| s.clone();
+        match self {
+            Profile::Explicit { source: s, f } => Profile::Explicit {
+                source: source(s),
+                f: f.resolve_all(values),
+            },
+            Profile::Polar { source: s, r } => Profile::Polar {
+                source: source(s),
+                r: r.resolve_all(values),
+            },
+            Profile::Parametric {
+                x_source,
+                y_source,
+                x,
+                y,
+            } => Profile::Parametric {
+                x_source: source(x_source),
+                y_source: source(y_source),
+                x: x.resolve_all(values),
+                y: y.resolve_all(values),
+            },
+            Profile::Surface { source: s, f } => Profile::Surface {
+                source: source(s),
+                f: f.resolve_all(values),
+            },
+            Profile::Barrel {
+                source: s,
+                f,
+                radius,
+            } => Profile::Barrel {
+                source: source(s),
+                f: f.resolve_all(values),
+                radius: *radius,
+            },
+            Profile::Revolution { source: s, g } => Profile::Revolution {
+                source: source(s),
+                g: g.resolve_all(values),
+            },
+            Profile::Face { centre } => Profile::Face {
+                centre: Box::new(centre.resolve_all(values)),
+            },
+        }
+    }
+
+    /// The plane curve the contact follows: a face cam's groove centre line, the profile
+    /// itself otherwise.
+    pub fn curve(&self) -> &Profile {
+        match self {
+            Profile::Face { centre } => centre,
+            Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. }
+            | Profile::Surface { .. }
+            | Profile::Barrel { .. }
+            | Profile::Revolution { .. } => self,
         }
     }
 }
@@ -337,14 +426,7 @@ impl Contact {
     /// The profile's expression of the field `Field::Profile(c)` (f, r, x(s), or a
     /// surface's f(x, y)).
     pub fn profile_expression(&self) -> &Scalar {
-        match &self.profile {
-            Profile::Explicit { f, .. }
-            | Profile::Surface { f, .. }
-            | Profile::Barrel { f, .. } => f,
-            Profile::Revolution { g, .. } => g,
-            Profile::Polar { r, .. } => r,
-            Profile::Parametric { x, .. } => x,
-        }
+        self.profile.expression()
     }
 
     /// The cam plane's normal x̂ × ŷ, cam body frame.

@@ -19,6 +19,7 @@ pub fn follower_side(profile: &Profile) -> f64 {
         Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
         Profile::Revolution { .. } => -1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
+        Profile::Face { centre } => follower_side(centre),
     }
 }
 
@@ -59,6 +60,8 @@ pub fn curve(profile: &Profile, s: f64) -> [[f64; 2]; 3] {
             let (x, y) = (eval_on(x, at, &own_tables), eval_on(y, at, &own_tables));
             [[x.v, y.v], [x.d1, y.d1], [x.d2, y.d2]]
         }
+        // A face cam's groove: its centre line.
+        Profile::Face { centre } => curve(centre, s),
     }
 }
 
@@ -76,13 +79,14 @@ pub fn profile_samples(profile: &Profile, range: (f64, f64), samples: usize) -> 
     (0..=samples)
         .map(|k| {
             let s = range.0 + (range.1 - range.0) * k as f64 / samples.max(1) as f64;
-            let radius = match profile {
+            let radius = match profile.curve() {
                 Profile::Polar { r, .. } => r.eval(s),
                 Profile::Explicit { .. }
                 | Profile::Parametric { .. }
                 | Profile::Surface { .. }
                 | Profile::Barrel { .. }
-                | Profile::Revolution { .. } => f64::NAN,
+                | Profile::Revolution { .. }
+                | Profile::Face { .. } => f64::NAN,
             };
             ProfileSample {
                 at: s,

@@ -57,7 +57,11 @@ pub(crate) struct ContactConst {
     x_axis: Vec3,
     y_axis: Vec3,
     follower: Follower,
+    /// The profile; a face cam's groove centre line.
     profile: Profile,
+    /// In a face cam's groove, the roller's radius (0 for a knife edge): its centre is on
+    /// `profile`, it touches the inner flank that far in.
+    groove: Option<f64>,
     /// The profile's expressions (f, r, or x and y) as one tape, for the many evaluations of
     /// the search.
     tape: Tape,
@@ -144,14 +148,20 @@ impl ContactConst {
             x_axis: vec3(&contact.x_axis),
             y_axis: vec3(&contact.y_axis),
             follower: contact.follower,
-            profile: contact.profile.clone(),
-            tape: match &contact.profile {
+            profile: contact.profile.curve().clone(),
+            groove: match contact.profile {
+                Profile::Face { .. } => Some(contact.follower.radius().copied().unwrap_or(0.0)),
+                _ => None,
+            },
+            tape: match contact.profile.curve() {
                 Profile::Explicit { f, .. }
                 | Profile::Surface { f, .. }
                 | Profile::Barrel { f, .. } => Tape::new(&[f]),
                 Profile::Revolution { g, .. } => Tape::new(&[g]),
                 Profile::Polar { r, .. } => Tape::new(&[r]),
                 Profile::Parametric { x, y, .. } => Tape::new(&[x, y]),
+                // `curve()` is never a face.
+                Profile::Face { .. } => Tape::new(&[]),
             },
             range: contact.range.unwrap_or((0.0, std::f64::consts::TAU)),
         }
@@ -253,7 +263,8 @@ impl ContactConst {
                 let r = values[0];
                 [r * at.cos(), r * at.sin()]
             }
-            Profile::Parametric { .. } => [values[0], values[1]],
+            // (`profile` is a face cam's centre line, never the face itself.)
+            Profile::Parametric { .. } | Profile::Face { .. } => [values[0], values[1]],
         };
         CurvePoint {
             c: [x.v, y.v],
@@ -270,7 +281,8 @@ impl ContactConst {
             | Profile::Polar { .. }
             | Profile::Parametric { .. }
             | Profile::Barrel { .. }
-            | Profile::Revolution { .. } => {}
+            | Profile::Revolution { .. }
+            | Profile::Face { .. } => {}
         }
         let values = self.tape.eval(s);
         match &self.profile {
@@ -278,7 +290,7 @@ impl ContactConst {
             Profile::Barrel { radius, .. } => [radius * s, values[0]],
             Profile::Revolution { .. } => [values[0], s],
             Profile::Polar { .. } => [values[0] * s.cos(), values[0] * s.sin()],
-            Profile::Parametric { .. } => [values[0], values[1]],
+            Profile::Parametric { .. } | Profile::Face { .. } => [values[0], values[1]],
         }
     }
 
@@ -286,7 +298,10 @@ impl ContactConst {
     fn side(&self) -> f64 {
         match self.profile {
             Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
-            Profile::Polar { .. } | Profile::Parametric { .. } | Profile::Revolution { .. } => -1.0,
+            Profile::Polar { .. }
+            | Profile::Parametric { .. }
+            | Profile::Revolution { .. }
+            | Profile::Face { .. } => -1.0,
         }
     }
 
@@ -388,7 +403,10 @@ impl ContactConst {
             Profile::Revolution { .. } => {
                 return self.on_revolution(&seen, &columns, &frame, point, direction);
             }
-            Profile::Explicit { .. } | Profile::Polar { .. } | Profile::Parametric { .. } => {}
+            Profile::Explicit { .. }
+            | Profile::Polar { .. }
+            | Profile::Parametric { .. }
+            | Profile::Face { .. } => {}
         }
         let x = seen.p;
         // The contact point sits at the follower point's height along the cam's axis.
@@ -429,7 +447,16 @@ impl ContactConst {
                     let jac = columns.iter().map(|col| dot(n, col.v)).collect();
                     let along = dot(t, seen.v);
                     let bias = dot(n, seen.a) - kappa * along * along / (1.0 - kappa * distance);
-                    (distance - rho, jac, bias, c.c, n, 1.0, s, kappa, t)
+                    match self.groove {
+                        None => (distance - rho, jac, bias, c.c, n, 1.0, s, kappa, t),
+                        // In a face cam's groove the centre is on the centre line; the inner
+                        // flank, ρ in, has the signed radius of curvature 1/κ + ρ.
+                        Some(rho) => {
+                            let flank = [c.c[0] - rho * n[0], c.c[1] - rho * n[1]];
+                            let flank_kappa = 1.0 / (1.0 / kappa + rho);
+                            (distance, jac, bias, flank, n, 1.0, s, flank_kappa, t)
+                        }
+                    }
                 }
                 (Follower::Flat { .. }, _) => {
                     let m = seen.m;

@@ -87,6 +87,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
             Profile::Surface { .. } => ProfileKind::Surface,
             Profile::Barrel { .. } => ProfileKind::Barrel,
             Profile::Revolution { .. } => ProfileKind::Revolution,
+            Profile::Face { .. } => ProfileKind::Face,
         },
         cam_coordinate: c
             .cam_body

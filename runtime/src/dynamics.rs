@@ -70,6 +70,8 @@ pub enum ProfileKind {
     Barrel,
     /// A surface of revolution r = g(z) about the cam's axis.
     Revolution,
+    /// A face cam's groove in the cam plane: the follower point on its centre line.
+    Face,
 }
 
 impl ProfileKind {
@@ -77,7 +79,10 @@ impl ProfileKind {
     pub fn is_surface(self) -> bool {
         match self {
             ProfileKind::Surface | ProfileKind::Barrel | ProfileKind::Revolution => true,
-            ProfileKind::Explicit | ProfileKind::Polar | ProfileKind::Parametric => false,
+            ProfileKind::Explicit
+            | ProfileKind::Polar
+            | ProfileKind::Parametric
+            | ProfileKind::Face => false,
         }
     }
 }

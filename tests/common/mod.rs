@@ -225,10 +225,11 @@ pub fn geometry_values(
     }
     v.extend([g.x, g.y, g.z, g.force_scale, g.curvature, g.sliding_speed]);
     match profile {
-        // An angle: modulo 2π.
-        camchain::runtime::ProfileKind::Polar | camchain::runtime::ProfileKind::Barrel => {
-            v.extend([g.parameter.cos(), g.parameter.sin()])
-        }
+        // An angle: modulo 2π (a face cam's centre line, polar or a design's, runs round
+        // the turn).
+        camchain::runtime::ProfileKind::Polar
+        | camchain::runtime::ProfileKind::Barrel
+        | camchain::runtime::ProfileKind::Face => v.extend([g.parameter.cos(), g.parameter.sin()]),
         camchain::runtime::ProfileKind::Explicit
         | camchain::runtime::ProfileKind::Parametric
         | camchain::runtime::ProfileKind::Surface

@@ -13,6 +13,7 @@ mod cycloidal;
 mod designs;
 #[path = "../support/eccentric.rs"]
 mod eccentric;
+mod faces;
 mod generated_vs_numeric;
 mod integrators;
 mod loops;

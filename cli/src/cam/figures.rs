@@ -286,6 +286,7 @@ fn line(points: Vec<(f64, f64)>) -> CamPicture {
         centre: (f64::NAN, f64::NAN),
         roller: points,
         face: Vec::new(),
+        outer_flank: Vec::new(),
     }
 }
 
@@ -329,6 +330,7 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
             centre: (0.0, 0.0),
             roller: Vec::new(),
             face: Vec::new(),
+            outer_flank: Vec::new(),
         }],
     )];
     let mut visible: Vec<(f64, f64)> = outline.iter().chain(&base).copied().collect();

@@ -80,8 +80,10 @@ pub fn load(arg: &str) -> Result<Subject, CliError> {
 
 /// What a contact's profile is, in a list of contacts.
 fn profile_kind(contact: &Contact) -> &'static str {
-    if contact.design.is_some() {
-        return "designed from a law";
+    match (&contact.profile, &contact.design) {
+        (Profile::Face { .. }, Some(_)) => return "face cam's groove designed from a law",
+        (_, Some(_)) => return "designed from a law",
+        (_, None) => {}
     }
     match &contact.profile {
         Profile::Explicit { .. } => "explicit profile",
@@ -90,6 +92,7 @@ fn profile_kind(contact: &Contact) -> &'static str {
         Profile::Surface { .. } => "surface",
         Profile::Barrel { .. } => "barrel cam",
         Profile::Revolution { .. } => "surface of revolution",
+        Profile::Face { .. } => "face cam's groove",
     }
 }
 

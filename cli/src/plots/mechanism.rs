@@ -85,6 +85,11 @@ pub(super) fn draw_cam<DB: DrawingBackend>(
         }
         chart.draw_series(LineSeries::new(edge, CAM_EDGE.stroke_width(2)))?;
     }
+    if !cam.outer_flank.is_empty() {
+        let mut edge = cam.outer_flank.clone();
+        edge.push(cam.outer_flank[0]);
+        chart.draw_series(LineSeries::new(edge, CAM_EDGE.stroke_width(2)))?;
+    }
     if !cam.base_circle.is_empty() {
         chart.draw_series(LineSeries::new(
             cam.base_circle.clone(),

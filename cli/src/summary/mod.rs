@@ -111,12 +111,22 @@ pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
         ProfileKind::Surface => "a surface z = f(x, y)",
         ProfileKind::Barrel => "a barrel cam's groove z = g(θ)",
         ProfileKind::Revolution => "a surface of revolution r = g(z)",
+        ProfileKind::Face => "a face cam's groove",
     };
     let turned = contact
         .cam_coordinate
         .and_then(|i| info.coordinates.get(i))
         .map_or_else(String::new, |c| format!(" turned by {}", c.name));
-    format!("{follower} on {profile}{turned}")
+    let on = match contact.profile {
+        ProfileKind::Face => "in",
+        ProfileKind::Explicit
+        | ProfileKind::Polar
+        | ProfileKind::Parametric
+        | ProfileKind::Surface
+        | ProfileKind::Barrel
+        | ProfileKind::Revolution => "on",
+    };
+    format!("{follower} {on} {profile}{turned}")
 }
 
 /// One line per contact: its kind and where its pressure angle is largest (degrees, the
@@ -322,34 +332,45 @@ fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
             .contacts
             .get(event.contact)
             .map_or("?", |c| c.name.as_str());
-        // A barrel cam's groove holds its roller both ways: a sign change of the normal force
-        // is the roller changing flanks.
+        // A barrel or face cam's groove holds its roller both ways: a sign change of the
+        // normal force is the roller changing flanks.
         let groove = info
             .contacts
             .get(event.contact)
-            .is_some_and(|c| c.profile == ProfileKind::Barrel);
-        let what = match event.kind {
-            EventKind::ForceBecameNegative if groove => format!(
-                "{name} changes flanks: the groove's upper flank takes over (a follower on the \
-                 lower flank alone would lift off here)"
+            .and_then(|c| match c.profile {
+                ProfileKind::Barrel => Some(("upper", "lower")),
+                ProfileKind::Face => Some(("outer", "inner")),
+                ProfileKind::Explicit
+                | ProfileKind::Polar
+                | ProfileKind::Parametric
+                | ProfileKind::Surface
+                | ProfileKind::Revolution => None,
+            });
+        let what = match (event.kind, groove) {
+            (EventKind::ForceBecameNegative, Some((other, own))) => format!(
+                "{name} changes flanks: the groove's {other} flank takes over (a follower on the \
+                 {own} flank alone would lift off here)"
             ),
-            EventKind::ForceBecamePositive if groove => {
-                format!("{name} changes flanks: back on the groove's lower flank")
+            (EventKind::ForceBecamePositive, Some((_, own))) => {
+                format!("{name} changes flanks: back on the groove's {own} flank")
             }
-            EventKind::ForceBecameNegative => format!(
+            (EventKind::ForceBecameNegative, None) => format!(
                 "warning: the normal force on {name} becomes negative: a one-sided follower \
                  would lift off the cam here"
             ),
-            EventKind::ForceBecamePositive => {
+            (EventKind::ForceBecamePositive, None) => {
                 format!("the normal force on {name} becomes positive again")
             }
-            EventKind::LiftOff => format!("{name} lifts off the cam"),
-            EventKind::Impact {
-                normal_velocity,
-                rebound,
-                stays,
-                loss,
-            } => format!(
+            (EventKind::LiftOff, _) => format!("{name} lifts off the cam"),
+            (
+                EventKind::Impact {
+                    normal_velocity,
+                    rebound,
+                    stays,
+                    loss,
+                },
+                _,
+            ) => format!(
                 "{name} lands at {:.3e} m/s, {}; impact loss {loss:.2e} J",
                 -normal_velocity,
                 if stays {
@@ -530,6 +551,10 @@ fn material_side(profile: ProfileKind) -> &'static str {
         }
         ProfileKind::Revolution => {
             "the cam is the region r < g(z) about its axis and pushes outwards"
+        }
+        ProfileKind::Face => {
+            "the groove's inner flank pushes outwards; its outer flank pulls (a groove holds \
+             the follower both ways)"
         }
         ProfileKind::Parametric => {
             "the cam lies on the left of its curve as s increases (inside a curve traced \

@@ -28,7 +28,7 @@ pub struct CurvePoint {
 pub fn curve_at(g: &mut Graph, model: &Model, s: &Symbols, index: usize, at: Id) -> CurvePoint {
     let contact = &model.contacts[index];
     let first = s.expression(model, Field::Profile(index), contact.profile_expression());
-    let second = match &contact.profile {
+    let second = match contact.profile.curve() {
         Profile::Parametric { y, .. } => Some(s.expression(model, Field::ProfileY(index), y)),
         _ => None,
     };
@@ -136,6 +136,9 @@ pub fn curve(
                 d2: [x2, y2],
             }
         }
+        // A face cam's groove: its centre line (polar or parametric), whose expressions
+        // `first` and `second` are.
+        Profile::Face { centre } => curve(g, centre, first, second, name, at, params),
     }
 }
 
@@ -155,6 +158,7 @@ pub fn follower_side(profile: &Profile) -> f64 {
         Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Barrel { .. } => 1.0,
         Profile::Revolution { .. } => -1.0,
         Profile::Polar { .. } | Profile::Parametric { .. } => -1.0,
+        Profile::Face { centre } => follower_side(centre),
     }
 }
 
@@ -329,6 +333,7 @@ mod tests {
                 Profile::Revolution { g, .. } => (g, None),
                 Profile::Polar { r, .. } => (r, None),
                 Profile::Parametric { x, y, .. } => (x, Some(y)),
+                Profile::Face { .. } => continue,
             };
             let c = curve(&mut g, profile, first, second, "check", at, &[]);
             let f = frame(&mut g, &c, follower_side(profile));

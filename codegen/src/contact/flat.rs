@@ -52,7 +52,8 @@ pub fn flat(
         | Profile::Parametric { .. }
         | Profile::Surface { .. }
         | Profile::Barrel { .. }
-        | Profile::Revolution { .. } => Guess::Scan,
+        | Profile::Revolution { .. }
+        | Profile::Face { .. } => Guess::Scan,
     };
     let solution = g.implicit(
         &format!("{name}_parameter"),

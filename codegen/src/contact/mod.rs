@@ -25,6 +25,7 @@ pub mod surface;
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3};
 use crate::model::{Follower, Model, Profile};
+use nearest::Rim;
 use relative::Relative;
 
 /// Symbolic terms of one contact: what every kind supplies.
@@ -103,13 +104,19 @@ pub fn contact_terms(
                 (Follower::Knife, Profile::Explicit { .. }) => {
                     knife::explicit(g, model, s, index, rel)
                 }
-                (Follower::Knife, _) => nearest::nearest(g, model, s, index, rel, None),
+                (Follower::Knife, Profile::Face { .. }) => {
+                    nearest::nearest(g, model, s, index, rel, Rim::Groove(0.0))
+                }
+                (Follower::Roller { radius }, Profile::Face { .. }) => {
+                    nearest::nearest(g, model, s, index, rel, Rim::Groove(*radius))
+                }
+                (Follower::Knife, _) => nearest::nearest(g, model, s, index, rel, Rim::Knife),
                 (Follower::Roller { radius }, _) => {
-                    nearest::nearest(g, model, s, index, rel, Some(*radius))
+                    nearest::nearest(g, model, s, index, rel, Rim::Roller(*radius))
                 }
                 (Follower::Flat { normal }, _) => flat::flat(g, model, kin, s, index, rel, *normal),
                 (Follower::Mushroom { radius, .. }, _) => {
-                    nearest::nearest(g, model, s, index, rel, Some(*radius))
+                    nearest::nearest(g, model, s, index, rel, Rim::Roller(*radius))
                 }
             }
         })

@@ -12,6 +12,10 @@
 //! ```
 //!
 //! (κ D < 1 wherever the roller does not undercut the profile.)
+//!
+//! In a face cam's groove ([`Rim::Groove`]) the profile is the groove's centre line and the
+//! roller's centre stays on it: h = D, with J and c as above; the roller touches the inner
+//! flank c(s*) − ρ n, whose curvature is κ/(1 + κρ) (docs/method.md §13.7).
 
 use super::curve::{
     self, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
@@ -22,15 +26,31 @@ use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{Symbols, vec3};
 use crate::model::{Field, Model, Profile};
 
-/// The terms of contact `index`: a roller of radius `radius`, or a knife edge (`None`).
+/// What follows the profile.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Rim {
+    /// A knife edge: the follower point on the profile.
+    Knife,
+    /// A roller (or a curved face) of this radius, its centre the radius off the profile.
+    Roller(f64),
+    /// A roller of this radius (0 for a knife edge) in a face cam's groove, its centre on
+    /// the groove's centre line (the profile).
+    Groove(f64),
+}
+
+/// The terms of contact `index` followed as `rim` says.
 pub fn nearest(
     g: &mut Graph,
     model: &Model,
     s: &Symbols,
     index: usize,
     rel: Relative,
-    radius: Option<f64>,
+    rim: Rim,
 ) -> ContactTerms {
+    let radius = match rim {
+        Rim::Roller(r) => Some(r),
+        Rim::Knife | Rim::Groove(_) => None,
+    };
     let contact = &model.contacts[index];
     let name = &contact.name;
     let side = follower_side(&contact.profile);
@@ -46,19 +66,23 @@ pub fn nearest(
         g.sub(bend, speed2)
     };
     let objective = dot2(g, d, d);
-    let guess = match contact.profile {
+    let guess = match contact.profile.curve() {
         Profile::Explicit { .. } | Profile::Surface { .. } => Guess::Input(0),
         Profile::Barrel { .. } => Guess::Angle { x: 0, y: 1 },
         Profile::Revolution { .. } => Guess::Scan,
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
-        Profile::Parametric { .. } => Guess::Scan,
+        Profile::Parametric { .. } | Profile::Face { .. } => Guess::Scan,
     };
-    let what = match radius {
-        Some(_) => format!(
+    let what = match rim {
+        Rim::Roller(_) => format!(
             "the profile point nearest the {}'s centre",
             contact.follower.kind().label()
         ),
-        None => "the profile point under the knife edge".to_string(),
+        Rim::Knife => "the profile point under the knife edge".to_string(),
+        Rim::Groove(_) => format!(
+            "the groove's centre-line point nearest the {}'s centre",
+            contact.follower.kind().label()
+        ),
     };
     let solution = g.implicit(
         &format!("{name}_parameter"),
@@ -79,9 +103,9 @@ pub fn nearest(
     let f = labelled_frame(g, &at, side, name);
     let distance = dot2(g, f.normal, offset);
     g.label(distance, format!("{name}_distance"));
-    let rho = match radius {
-        Some(r) => s.field(g, model, Field::Radius(index), r),
-        None => g.zero(),
+    let rho = match rim {
+        Rim::Roller(r) => s.field(g, model, Field::Radius(index), r),
+        Rim::Knife | Rim::Groove(_) => g.zero(),
     };
     let h = g.sub(distance, rho);
     let jacobian = rel
@@ -102,13 +126,29 @@ pub fn nearest(
         g.sub(normal_part, turn)
     };
     g.label(f.curvature, format!("{name}_kappa"));
+    // Where the follower touches: the profile point, or in a groove the inner flank ρ in
+    // from the centre line, curved by κ/(1 + κρ).
+    let (touched, curvature) = match rim {
+        Rim::Knife | Rim::Roller(_) => (at.point, f.curvature),
+        Rim::Groove(r) => {
+            let rho = s.field(g, model, Field::Radius(index), r);
+            let inward = f.normal.map(|n| g.mul(rho, n));
+            let flank = sub2(g, at.point, inward);
+            let one = g.one();
+            let k_rho = g.mul(f.curvature, rho);
+            let stretch = g.add(one, k_rho);
+            let k = g.div(f.curvature, stretch);
+            g.label(k, format!("{name}_flank_kappa"));
+            (flank, k)
+        }
+    };
     // The follower's material at the contact point moves relative to the cam at
     // Ṗ + ω_r rot90(c − P).
-    let to_contact = sub2(g, at.point, rel.xy);
+    let to_contact = sub2(g, touched, rel.xy);
     let swing = perp(g, to_contact);
     let material = curve::add_scaled(g, rel.velocity, rel.spin, swing);
     let sliding = dot2(g, f.tangent, material);
-    let position = rel.to_ground(g, at.point);
+    let position = rel.to_ground(g, touched);
     let normal = rel.vector_to_ground(g, f.normal);
     vec3::label(g, position, &format!("{name}_contact"));
     ContactTerms {
@@ -116,15 +156,25 @@ pub fn nearest(
         jacobian,
         bias,
         position,
-        cam_point: at.point,
+        cam_point: touched,
         cam_height: None,
         normal,
         force_scale: g.one(),
         parameter: solution,
-        curvature: f.curvature,
+        curvature,
         sliding,
         relative: rel,
-        formulas: if radius.is_some() {
+        formulas: if let Rim::Groove(_) = rim {
+            Formulas {
+                kind: format!(
+                    "a {} in a face cam's groove, its centre on the centre line",
+                    contact.follower.kind().label()
+                ),
+                h: "h = D, eq. (C7) on the centre line",
+                jacobian: "J = n·∂P/∂q, eq. (C8)",
+                bias: "eq. (C9)",
+            }
+        } else if radius.is_some() {
             Formulas {
                 kind: format!(
                     "a {} on the profile's nearest point",

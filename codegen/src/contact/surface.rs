@@ -63,7 +63,8 @@ fn surface_at(
         | Profile::Explicit { .. }
         | Profile::Polar { .. }
         | Profile::Parametric { .. }
-        | Profile::Revolution { .. } => (derivatives(g, model, s, index, xy), None),
+        | Profile::Revolution { .. }
+        | Profile::Face { .. } => (derivatives(g, model, s, index, xy), None),
     }
 }
 

@@ -29,6 +29,7 @@ pub(super) fn info_static(model: &Model) -> String {
                 crate::model::Profile::Surface { .. } => "Surface",
                 crate::model::Profile::Barrel { .. } => "Barrel",
                 crate::model::Profile::Revolution { .. } => "Revolution",
+                crate::model::Profile::Face { .. } => "Face",
             };
             let cam_coordinate = match c.cam_body {
                 Some(b) if model.bodies[b].joint.kind == JointKind::Revolute => {

@@ -42,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 16] = [
+pub const KINDS: [Kind; 17] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -174,6 +174,16 @@ pub const KINDS: [Kind; 16] = [
         name: "roller on barrel",
         follower: "follower: Roller(radius: 0.01),",
         profile: "barrel: (radius: 0.045, groove: \"0.002*theta.sin() + 0.001*(2.0*theta).cos()\"),",
+        offset: 0.0,
+        planar_only: false,
+        turn: 3.1,
+    },
+    // A face cam's groove whose centre line is the polar profiles' curve: the roller's
+    // centre on it, the inner flank the radius in.
+    Kind {
+        name: "roller in face groove",
+        follower: "follower: Roller(radius: 0.006),",
+        profile: "face: (groove: \"0.01*theta.cos() + (0.0016 - 0.0001*theta.sin().powi(2)).sqrt()\"),",
         offset: 0.0,
         planar_only: false,
         turn: 3.1,

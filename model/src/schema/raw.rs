@@ -245,6 +245,9 @@ pub(super) struct Contact {
     /// A surface of revolution r = g(z) about the cam's axis.
     #[serde(default)]
     pub revolution: Option<String>,
+    /// A face cam: a groove in the cam plane, its centre line r = g(θ) or designed.
+    #[serde(default)]
+    pub face: Option<Face>,
     /// A profile through a table of points.
     #[serde(default)]
     pub table: Option<Table>,
@@ -278,6 +281,18 @@ pub(super) struct Barrel {
     /// must lie on it.
     #[serde(default)]
     pub length: Option<Number>,
+}
+
+/// `face: (groove: "g(theta)")` or `face: (law: (…))`: a face cam's groove.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Face {
+    /// The groove's centre line r = g(θ) as an expression of `theta`.
+    #[serde(default)]
+    pub groove: Option<String>,
+    /// The centre line designed from the follower's motion law (a disc cam's `law`).
+    #[serde(default)]
+    pub law: Option<Law>,
 }
 
 /// `law: (base: z₀, turning: …, segments: […])` of a barrel cam: the follower's travel along

@@ -15,6 +15,7 @@ mod barrels;
 mod bodies;
 mod contacts;
 mod designs;
+mod faces;
 mod fields;
 mod initial;
 mod loops;

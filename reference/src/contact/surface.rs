@@ -53,7 +53,8 @@ impl ContactConst {
             Profile::Surface { .. }
             | Profile::Explicit { .. }
             | Profile::Polar { .. }
-            | Profile::Parametric { .. } => self.tape.eval_jet_at(&[x, y])[0],
+            | Profile::Parametric { .. }
+            | Profile::Face { .. } => self.tape.eval_jet_at(&[x, y])[0],
         }
     }
 
@@ -117,7 +118,8 @@ impl ContactConst {
             | Profile::Explicit { .. }
             | Profile::Polar { .. }
             | Profile::Parametric { .. }
-            | Profile::Revolution { .. } => (p[0], larger_principal_curvature([fx, fy], hessian)),
+            | Profile::Revolution { .. }
+            | Profile::Face { .. } => (p[0], larger_principal_curvature([fx, fy], hessian)),
         };
         let geometry = ContactGeometry {
             position: position.into(),

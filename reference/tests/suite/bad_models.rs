@@ -1090,6 +1090,30 @@ const CASES: &[Case] = &[
         "contacts[0].follower",
         "a surface takes a point follower",
     ),
+    // Face cams. `Flat(normal: …)` in a groove.
+    case(
+        "face_flat_follower.ron",
+        31,
+        23,
+        "contacts[0].follower",
+        "a flat face cannot run in a face cam's groove",
+    ),
+    // The `law` given beside the `groove`.
+    case(
+        "face_groove_and_law.ron",
+        34,
+        22,
+        "contacts[0].face.law",
+        "either as `groove: \"g(theta)\"` or as a `law`, not both",
+    ),
+    // `Roller(radius: 0.03)`: the lobes' 24 mm radius of curvature.
+    case(
+        "face_groove_undercut.ron",
+        32,
+        38,
+        "contacts[0].follower.radius",
+        "undercuts the groove's inner flank: at θ = 0.0000 rad the centre line is convex",
+    ),
 ];
 
 fn corpus() -> PathBuf {

@@ -4,7 +4,7 @@
 //! polar radius that stays positive), each located at the field it concerns.
 
 use super::bodies::BodyTree;
-use super::fields::{finite, identifier, lookup, unit_vector};
+use super::fields::{closes, finite, identifier, lookup, unit_vector};
 use super::markers::cam_axes;
 use super::parameters::expression;
 use super::{Checked, Context, Field, Follower, GROUND, Locator, Marker, Profile};
@@ -202,6 +202,7 @@ fn profile(
         ("surface", c.surface.is_some()),
         ("barrel", c.barrel.is_some()),
         ("revolution", c.revolution.is_some()),
+        ("face", c.face.is_some()),
         ("table", c.table.is_some()),
         ("law", c.law.is_some()),
     ];
@@ -213,14 +214,14 @@ fn profile(
                 "a contact needs a cam profile: `profile: \"f(x)\"` (explicit y = f(x)), \
                  `polar: \"r(theta)\"`, `parametric: (x: \"x(s)\", y: \"y(s)\")`, `surface: \
                  \"f(x, y)\"` (a surface z = f(x, y)), `barrel: (…)` (a barrel cam), `revolution: \
-                 \"g(z)\"` (a surface of revolution r = g(z)), `table: (…)` (through points) or `law: (…)` (designed from the follower's motion)"
+                 \"g(z)\"` (a surface of revolution r = g(z)), `face: (…)` (a face cam's groove), `table: (…)` (through points) or `law: (…)` (designed from the follower's motion)"
                     .to_string(),
             ),
             [.., last] => (
                 format!("{path}.{last}"),
                 format!(
                     "give only one of `profile`, `polar`, `parametric`, `surface`, `barrel`, \
-                     `revolution`, `table` and `law` (this contact gives {})",
+                     `revolution`, `face`, `table` and `law` (this contact gives {})",
                     named
                         .iter()
                         .map(|n| format!("`{n}`"))
@@ -240,7 +241,15 @@ fn profile(
         });
     }
     if let Some(law) = &c.law {
-        let (profile, design) = super::designs::law_profile(cx, path, law, i, name, follower)?;
+        let field = format!("{path}.law");
+        let (profile, design) = super::designs::law_profile(
+            cx,
+            (path, &field),
+            law,
+            (i, name),
+            follower,
+            super::designs::Traced::Profile,
+        )?;
         return Ok(Shaped {
             profile,
             covers: Some((0.0, std::f64::consts::TAU)),
@@ -252,6 +261,14 @@ fn profile(
     }
     if let Some(source) = &c.revolution {
         return revolution(cx, path, source, i, follower).map(Shaped::from);
+    }
+    if let Some(face) = &c.face {
+        let (profile, design) = super::faces::face_profile(cx, path, face, (i, name), follower)?;
+        return Ok(Shaped {
+            profile,
+            covers: Some((0.0, std::f64::consts::TAU)),
+            design,
+        });
     }
     if let Some(barrel) = &c.barrel {
         return super::barrels::barrel_profile(cx, path, barrel, i, name, follower)
@@ -515,6 +532,8 @@ fn contact_range(
     }
     let needs = match (profile, follower.kind().outline()) {
         (Profile::Polar { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
+        // A face cam's groove given as r = g(θ) runs round the turn (a law's covers it).
+        (Profile::Face { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
         (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
         (
             Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Revolution { .. },
@@ -551,6 +570,9 @@ fn followable(at: &Locator, i: usize, contact: &Contact) -> Checked<()> {
         return Ok(());
     };
     let path = format!("contacts[{i}]");
+    if let Profile::Face { .. } = contact.profile {
+        return super::faces::groove_fits(at, &path, contact);
+    }
     let samples = profile_samples(&contact.profile, range, PROFILE_CHECK_SAMPLES);
     let shape = Shape {
         kind: contact.follower.kind(),
@@ -579,7 +601,9 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
     let runtime_radius = table.is_runtime(Field::Radius(i));
     let runtime_profile =
         table.is_runtime(Field::Profile(i)) || table.is_runtime(Field::ProfileY(i));
+    // A face cam's groove is checked for the file's values only (`faces::groove_fits`).
     let matters = match contact.follower.kind().outline() {
+        _ if matches!(contact.profile, Profile::Face { .. }) => false,
         Outline::Point => matches!(contact.profile, Profile::Polar { .. }),
         Outline::Circle | Outline::Line => true,
     };
@@ -596,30 +620,13 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
     }
 }
 
-/// A polar profile is periodic: r(θ + 2π) = r(θ) (a disc cam closes on itself), checked at
-/// 16 angles to 1e-9 of the radius.
-fn closes(at: &Locator, field: &str, r: &crate::profile::Scalar) -> Checked<()> {
-    for k in 0..16 {
-        let theta = std::f64::consts::TAU * k as f64 / 16.0;
-        let (a, b) = (r.eval(theta), r.eval(theta + std::f64::consts::TAU));
-        if (a - b).abs() > 1e-9 * a.abs().max(b.abs()).max(1e-3) {
-            return Err(at.error(
-                field,
-                format!(
-                    "a polar profile must close on itself, r(theta + 2π) = r(theta), but \
-                     r({theta:.6}) = {a:e} m and r({:.6}) = {b:e} m",
-                    theta + std::f64::consts::TAU
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
 /// The field that holds a contact's profile.
 fn profile_field(contact: &Contact) -> &'static str {
-    if contact.design.is_some() {
-        return "law";
+    match (&contact.profile, &contact.design) {
+        (Profile::Face { .. }, Some(_)) => return "face.law",
+        (Profile::Face { .. }, None) => return "face.groove",
+        (_, Some(_)) => return "law",
+        (_, None) => {}
     }
     match &contact.profile {
         Profile::Explicit { f, .. } if is_table(f) => "table",
@@ -631,6 +638,7 @@ fn profile_field(contact: &Contact) -> &'static str {
         Profile::Surface { .. } => "surface",
         Profile::Barrel { .. } => "barrel",
         Profile::Revolution { .. } => "revolution",
+        Profile::Face { .. } => "face",
     }
 }
 

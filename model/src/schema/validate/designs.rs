@@ -21,17 +21,25 @@ fn default_pressure_limit(motion: &raw::Motion) -> f64 {
     }
 }
 
-/// The profile of contact `index` (named `name`, path `path`) designed from `law` for
-/// `follower`, and the design.
+/// What a design's parametric curve is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Traced {
+    /// The cam's profile (a disc cam's `law`): the pitch curve moved in by the roller.
+    Profile,
+    /// The pitch curve itself (a face cam's groove centre line, `face: (law: …)`).
+    Pitch,
+}
+
+/// The profile of contact `index` (named `name`, path `path`) designed from `law` (at the
+/// field `field`) for `follower`, and the design.
 pub(super) fn law_profile(
     cx: &Context,
-    path: &str,
+    (path, field): (&str, &str),
     law: &raw::Law,
-    index: usize,
-    name: &str,
+    (index, name): (usize, &str),
     follower: &Follower,
+    traced: Traced,
 ) -> Checked<(Profile, CamDesign)> {
-    let field = format!("{path}.law");
     if follower.centre_direction().is_some() {
         // A design places the follower point (the marker) on its pitch curve: a circle
         // centred off the marker (a curved face's apex is the marker) has no such point.
@@ -44,7 +52,7 @@ pub(super) fn law_profile(
             ),
         ));
     }
-    let program = program(cx, &field, &law.segments)?;
+    let program = program(cx, field, &law.segments)?;
     let senses = Senses {
         turning: sense(law.turning),
         swing: match &law.motion {
@@ -53,8 +61,8 @@ pub(super) fn law_profile(
         },
         shape: follower.kind(),
     };
-    let (folded, resolved) = geometry(cx, &field, law, index, follower)?;
-    reachable(cx, path, &resolved, senses)?;
+    let (folded, resolved) = geometry(cx, field, law, index, follower)?;
+    reachable(cx, field, &resolved, senses)?;
     let max_pressure_angle = match law.max_pressure_angle {
         Some(limit) if limit > 0.0 && limit < 90.0 => limit,
         Some(limit) => {
@@ -89,14 +97,21 @@ pub(super) fn law_profile(
         speed: speed.as_ref().map(|s| s.0),
         speed_expression: speed.map(|s| s.1),
     };
-    can_be_made(cx, path, name, &design)?;
-    let [x, y] = design::profile_expressions(&folded, senses, &tabulated);
+    can_be_made(cx, (path, field), name, &design)?;
+    let [x, y] = match traced {
+        Traced::Profile => design::profile_expressions(&folded, senses, &tabulated),
+        Traced::Pitch => design::pitch_expressions(&folded, senses, &tabulated),
+    };
     let values = &cx.table.values;
     let (x_resolved, y_resolved) = (x.resolve_all(values), y.resolve_all(values));
     cx.table.record(Field::Profile(index), x);
     cx.table.record(Field::ProfileY(index), y);
     let source = format!(
-        "the cam designed for a {} {} follower from the motion law of `law`",
+        "the {} designed for a {} {} follower from the motion law of `law`",
+        match traced {
+            Traced::Profile => "cam",
+            Traced::Pitch => "groove's centre line",
+        },
         match &law.motion {
             raw::Motion::Translating { .. } => "translating",
             raw::Motion::Oscillating { .. } => "oscillating",
@@ -294,9 +309,9 @@ fn geometry(
 /// The follower can sit on the base circle: a translating guide's offset within the prime
 /// circle (base radius plus roller), an arm that reaches it from its pivot, a flat face's
 /// line that touches the base circle.
-fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Checked<()> {
+fn reachable(cx: &Context, law: &str, g: &Geometry<f64>, senses: Senses) -> Checked<()> {
     let prime = g.base_radius + g.roller;
-    let field = format!("{path}.law.motion");
+    let field = format!("{law}.motion");
     match (&g.motion, senses.shape.outline()) {
         (Motion::Translating { offset }, Outline::Point | Outline::Circle)
             if offset.abs() >= prime =>
@@ -351,7 +366,12 @@ fn reachable(cx: &Context, path: &str, g: &Geometry<f64>, senses: Senses) -> Che
 /// The designed cam can be made and followed: a roller smaller than the pitch curve's
 /// convex radii (no undercutting), a flat face on a profile without cusps, an oscillating
 /// face that never turns with the cam.
-fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Checked<()> {
+fn can_be_made(
+    cx: &Context,
+    (path, law): (&str, &str),
+    name: &str,
+    design: &CamDesign,
+) -> Checked<()> {
     let g = &design.geometry;
     let mm = |x: f64| format!("{:.3} mm", x * 1e3);
     let label = design.senses.shape.label();
@@ -388,7 +408,7 @@ fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Chec
                 });
                 if rate < 1e-9 {
                     return Err(cx.at.error(
-                        &format!("{path}.law"),
+                        law,
                         format!(
                             "contact `{name}`: at cam angle {:.3}° the flat face turns with the \
                              cam (the arm's rate equals the cam's): no profile touches it",
@@ -400,7 +420,7 @@ fn can_be_made(cx: &Context, path: &str, name: &str, design: &CamDesign) -> Chec
             let (theta, radius) = design.least(DESIGN_SAMPLES, |p| p.radius_of_curvature);
             if radius <= 0.0 {
                 return Err(cx.at.error(
-                    &format!("{path}.law.base_radius"),
+                    &format!("{law}.base_radius"),
                     format!(
                         "contact `{name}`: the flat face's cam would have a cusp: its radius of \
                          curvature reaches {} at cam angle {:.3}°; the base circle must be at \

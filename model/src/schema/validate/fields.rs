@@ -105,6 +105,26 @@ pub(super) fn unique_names<'n>(
     Ok(index)
 }
 
+/// A polar profile is periodic: r(θ + 2π) = r(θ) (a disc cam closes on itself), checked at
+/// 16 angles to 1e-9 of the radius.
+pub(super) fn closes(at: &Locator, field: &str, r: &crate::profile::Scalar) -> Checked<()> {
+    for k in 0..16 {
+        let theta = std::f64::consts::TAU * k as f64 / 16.0;
+        let (a, b) = (r.eval(theta), r.eval(theta + std::f64::consts::TAU));
+        if (a - b).abs() > 1e-9 * a.abs().max(b.abs()).max(1e-3) {
+            return Err(at.error(
+                field,
+                format!(
+                    "a polar profile must close on itself, r(theta + 2π) = r(theta), but \
+                     r({theta:.6}) = {a:e} m and r({:.6}) = {b:e} m",
+                    theta + std::f64::consts::TAU
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -112,7 +112,7 @@ pub(super) fn parameters(
 }
 
 /// The parameters used by fields that must be constant (joint axes, cam plane axes, a motion
-/// law's segments, a planar cam's or a barrel's): they stay folded in
+/// law's segments, a disc cam's, a face cam's or a barrel's): they stay folded in
 /// [`ParameterMode::AllAtRunTime`].
 pub(super) fn structural_parameters(file: &raw::Model, parameters: &[Parameter]) -> Vec<usize> {
     let names: Vec<&str> = parameters.iter().map(|p| p.name.as_str()).collect();
@@ -134,8 +134,10 @@ pub(super) fn structural_parameters(file: &raw::Model, parameters: &[Parameter])
         .iter()
         .flat_map(|c| {
             let barrel = c.barrel.as_ref().and_then(|b| b.law.as_ref());
+            let face = c.face.as_ref().and_then(|f| f.law.as_ref());
             c.law
                 .iter()
+                .chain(face)
                 .flat_map(|law| law.segments.iter())
                 .chain(barrel.into_iter().flat_map(|law| law.segments.iter()))
         })
