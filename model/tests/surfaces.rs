@@ -73,9 +73,8 @@ fn a_surface_expression_names_only_x_y_and_parameters() {
 }
 
 #[test]
-fn a_surface_takes_a_point_follower_only() {
+fn a_surface_takes_a_point_or_a_ball_only() {
     for follower in [
-        "Roller(radius: 0.01)",
         "Flat(normal: (0.0, 0.0, 1.0))",
         "Mushroom(radius: 0.05, normal: (0.0, 0.0, -1.0))",
     ] {
@@ -86,7 +85,7 @@ fn a_surface_takes_a_point_follower_only() {
             ),
             "contacts[0].follower",
             15,
-            "a surface takes a point follower",
+            "a surface takes a point (`follower: Knife`) or a ball",
         );
     }
 }

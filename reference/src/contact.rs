@@ -16,6 +16,7 @@
 //!   lines, its curvature from the shape operator's invariants; a surface of revolution
 //!   ([`revolution`]) likewise in three dimensions.
 
+mod ball;
 mod revolution;
 mod surface;
 
@@ -396,6 +397,10 @@ impl ContactConst {
             };
             d / d.norm()
         };
+        if let (Profile::Surface { .. }, Follower::Roller { .. }) = (&self.profile, &self.follower)
+        {
+            return self.on_ball(&seen, &columns, &frame, point, direction);
+        }
         match &self.profile {
             Profile::Surface { .. } | Profile::Barrel { .. } => {
                 return self.on_surface(&seen, &columns, &frame, point, direction);

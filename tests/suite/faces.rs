@@ -274,13 +274,13 @@ fn generated_and_numeric_face_cams_run_alike() {
 
 #[test]
 fn a_radial_follower_in_a_polar_groove_moves_by_the_centre_line() {
-    // tests/face_models/radial_groove.ron (the numeric reference: no compilation): the
+    // tests/numeric_models/radial_groove.ron (the numeric reference: no compilation): the
     // roller's centre on the ground's x axis, in the groove whose centre line is r(φ) = 0.05
     // + 0.01 cos 3φ, the cam turned by ωt. The follower sits at the cam-frame angle φ = −ωt:
     // x(t) = r(−ωt), and the groove's force along its normal n, whose x component is
     // r/√(r² + r′²), accelerates the follower's 0.2 kg: N = m ẍ √(r² + r′²)/r.
     let path = format!(
-        "{}/tests/face_models/radial_groove.ron",
+        "{}/tests/numeric_models/radial_groove.ron",
         env!("CARGO_MANIFEST_DIR")
     );
     let model = camchain_reference::NumericModel::load(std::path::Path::new(&path))

@@ -103,7 +103,11 @@ fn settings_text(settings: &SimSettings) -> String {
 
 /// What a contact is, in words: `roller on a polar profile turned by cam_angle`.
 pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
-    let follower = contact.follower.label();
+    // A roller on a surface is a ball.
+    let follower = match (contact.follower, contact.profile) {
+        (camchain_runtime::kinds::FollowerKind::Roller, ProfileKind::Surface) => "ball",
+        _ => contact.follower.label(),
+    };
     let profile = match contact.profile {
         ProfileKind::Explicit => "an explicit profile y = f(x)",
         ProfileKind::Polar => "a polar profile r(θ)",

@@ -14,6 +14,7 @@
 //! generated docs quote), and one more arm in [`contact_terms`]; the emitter, the runtime and
 //! the outputs take it from there.
 
+pub mod ball;
 pub mod curve;
 pub mod flat;
 pub mod knife;
@@ -97,6 +98,9 @@ pub fn contact_terms(
                 }
                 (Follower::Knife, Profile::Revolution { .. }) => {
                     revolution::point(g, model, s, index, rel)
+                }
+                (Follower::Roller { radius }, Profile::Surface { .. }) => {
+                    ball::ball(g, model, s, index, rel, *radius)
                 }
                 (Follower::Roller { radius }, Profile::Barrel { .. }) => {
                     surface::point(g, model, s, index, rel, Some(*radius))

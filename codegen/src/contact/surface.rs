@@ -26,14 +26,14 @@ use crate::expr::{Graph, Guess, Id, Implicit};
 use crate::kinematics::{Symbols, V3, vec3};
 use crate::model::{Field, Model, Profile};
 
-/// f and its derivatives at the follower point's (X, Y).
-struct Derivatives {
-    f: Id,
-    fx: Id,
-    fy: Id,
-    fxx: Id,
-    fxy: Id,
-    fyy: Id,
+/// f and its derivatives at a point (x, y) of the cam plane.
+pub(super) struct Derivatives {
+    pub f: Id,
+    pub fx: Id,
+    pub fy: Id,
+    pub fxx: Id,
+    pub fxy: Id,
+    pub fyy: Id,
 }
 
 /// A barrel's pitch surface at the follower point: the derivatives of f(x, y) = g(θ), and
@@ -191,7 +191,7 @@ fn barrel(
 }
 
 /// f, ∇f and the Hessian of contact `index`'s surface z = f(x, y) at (x, y), symbolic.
-fn derivatives(
+pub(super) fn derivatives(
     g: &mut Graph,
     model: &Model,
     s: &Symbols,
@@ -368,7 +368,7 @@ pub(super) fn sliding_speed(g: &mut Graph, v: [Id; 3], unit: [Id; 3], name: &str
     g.sqrt(sum)
 }
 
-fn dot(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> Id {
+pub(super) fn dot(g: &mut Graph, a: [Id; 3], b: [Id; 3]) -> Id {
     let products: Vec<Id> = (0..3).map(|k| g.mul(a[k], b[k])).collect();
     g.sum(products)
 }
@@ -385,7 +385,7 @@ pub(super) fn to_ground_vector(g: &mut Graph, rel: &Relative, [x, y, z]: [Id; 3]
 /// form G = I + ∇f ∇fᵀ and the second II = Hess f / W. With G = L Lᵀ (Cholesky) the
 /// eigenvalues are those of the symmetric A = L⁻¹ II L⁻ᵀ, whose discriminant
 /// ((A11 − A22)/2)² + A12² is a sum of squares: never negative by round-off.
-fn principal_curvature(g: &mut Graph, d: &Derivatives, stretch: Id, name: &str) -> Id {
+pub(super) fn principal_curvature(g: &mut Graph, d: &Derivatives, stretch: Id, name: &str) -> Id {
     let one = g.one();
     // L = [[l11, 0], [l21, l22]]: l11 = √(1 + f_x²), l21 = f_x f_y / l11, l22 = W / l11.
     let fx2 = g.mul(d.fx, d.fx);

@@ -42,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 17] = [
+pub const KINDS: [Kind; 18] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -145,6 +145,16 @@ pub const KINDS: [Kind; 17] = [
     Kind {
         name: "knife on surface",
         follower: "",
+        profile: "surface: \"0.001 + 0.3*x*y - 0.5*x*x + 0.002*(30.0*y).sin() + 0.4*y*y*x\",",
+        offset: 0.0,
+        planar_only: false,
+        turn: 0.4,
+    },
+    // A ball on the same surface: its centre (the marker) a few millimetres above it, the
+    // foot point found in two dimensions.
+    Kind {
+        name: "ball on surface",
+        follower: "follower: Roller(radius: 0.004),",
         profile: "surface: \"0.001 + 0.3*x*y - 0.5*x*x + 0.002*(30.0*y).sin() + 0.4*y*y*x\",",
         offset: 0.0,
         planar_only: false,

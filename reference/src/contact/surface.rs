@@ -31,10 +31,10 @@ fn angle(x: Jet2, y: Jet2) -> Jet2 {
 }
 
 /// f, ∇f and the Hessian [f_xx, f_xy, f_yy] at a point.
-struct Local {
-    f: f64,
-    gradient: [f64; 2],
-    hessian: [f64; 3],
+pub(super) struct Local {
+    pub f: f64,
+    pub gradient: [f64; 2],
+    pub hessian: [f64; 3],
 }
 
 impl ContactConst {
@@ -58,7 +58,7 @@ impl ContactConst {
         }
     }
 
-    fn local(&self, p: [f64; 2]) -> Local {
+    pub(super) fn local(&self, p: [f64; 2]) -> Local {
         let (ex, ey, diagonal) = (
             self.along(p, [1.0, 0.0]),
             self.along(p, [0.0, 1.0]),
@@ -182,7 +182,7 @@ pub(super) fn spatial(
 
 /// The larger eigenvalue of the shape operator G⁻¹ II of z = f(x, y) with the upward normal:
 /// mean curvature H = tr/2 and Gaussian curvature K = det, κ = H + √(H² − K).
-fn larger_principal_curvature([fx, fy]: [f64; 2], [a, b, c]: [f64; 3]) -> f64 {
+pub(super) fn larger_principal_curvature([fx, fy]: [f64; 2], [a, b, c]: [f64; 3]) -> f64 {
     let w2 = 1.0 + fx * fx + fy * fy;
     let w = w2.sqrt();
     // G = [[1 + fx², fx fy], [fx fy, 1 + fy²]], det G = w²; II = [[a, b], [b, c]] / w.

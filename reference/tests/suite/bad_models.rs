@@ -1082,13 +1082,13 @@ const CASES: &[Case] = &[
         "contacts[0].surface",
         "the surface is not defined over its region: f = NaN",
     ),
-    // `Roller(radius: 0.01)` on a cam surface.
+    // `Flat(normal: …)` on a cam surface.
     case(
-        "surface_with_roller.ron",
-        43,
+        "surface_with_flat.ron",
+        44,
         23,
         "contacts[0].follower",
-        "a surface takes a point follower",
+        "a surface takes a point (`follower: Knife`) or a ball",
     ),
     // Face cams. `Flat(normal: …)` in a groove.
     case(

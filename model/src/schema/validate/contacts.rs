@@ -413,14 +413,14 @@ fn revolution(
     i: usize,
     follower: &Follower,
 ) -> Checked<Profile> {
-    let what = "a surface of revolution: it takes";
+    let what = "a surface of revolution: it takes a point follower (`follower: Knife`)";
     let g = point_surface(
         cx,
         path,
         ("revolution", &["z"]),
         source,
         i,
-        (follower, what),
+        (follower, what, false),
     )?;
     Ok(Profile::Revolution {
         source: source.to_string(),
@@ -429,7 +429,7 @@ fn revolution(
 }
 
 /// A surface z = f(x, y): an expression of `x`, `y` and the parameters, followed by a point
-/// (a knife edge).
+/// (a knife edge) or a ball (a `Roller`, its centre on the offset surface).
 fn surface(
     cx: &Context,
     path: &str,
@@ -437,14 +437,15 @@ fn surface(
     i: usize,
     follower: &Follower,
 ) -> Checked<Profile> {
-    let what = "a surface: a surface takes";
+    let what = "a surface: a surface takes a point (`follower: Knife`) or a ball (`follower: \
+                Roller(radius: …)`, its centre the marker)";
     let f = point_surface(
         cx,
         path,
         ("surface", &["x", "y"]),
         source,
         i,
-        (follower, what),
+        (follower, what, true),
     )?;
     Ok(Profile::Surface {
         source: source.to_string(),
@@ -452,15 +453,16 @@ fn surface(
     })
 }
 
-/// The expression of a surface followed by a point, parsed from `field` (of `variables`);
-/// any other follower is refused with "a roller cannot follow {what} a point follower".
+/// The expression of a surface followed by a point (or by a ball where `balls`), parsed
+/// from `field` (of `variables`); any other follower is refused with "a flat face cannot
+/// follow {what}".
 fn point_surface(
     cx: &Context,
     path: &str,
     (field, variables): (&str, &[&str]),
     source: &str,
     i: usize,
-    (follower, what): (&Follower, &str),
+    (follower, what, balls): (&Follower, &str, bool),
 ) -> Checked<crate::profile::Scalar> {
     let f = expression(
         cx,
@@ -469,15 +471,15 @@ fn point_surface(
         variables,
         Field::Profile(i),
     )?;
-    match follower.kind().outline() {
-        Outline::Point => Ok(f),
-        Outline::Circle | Outline::Line => Err(cx.at.error(
-            &format!("{path}.follower"),
-            format!(
-                "a {} cannot follow {what} a point follower (`follower: Knife`)",
-                follower.kind().label()
-            ),
-        )),
+    match follower {
+        Follower::Knife => Ok(f),
+        Follower::Roller { .. } if balls => Ok(f),
+        Follower::Roller { .. } | Follower::Flat { .. } | Follower::Mushroom { .. } => {
+            Err(cx.at.error(
+                &format!("{path}.follower"),
+                format!("a {} cannot follow {what}", follower.kind().label()),
+            ))
+        }
     }
 }
 
@@ -535,14 +537,12 @@ fn contact_range(
         // A face cam's groove given as r = g(θ) runs round the turn (a law's covers it).
         (Profile::Face { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
         (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
+        (Profile::Explicit { .. } | Profile::Revolution { .. }, Outline::Point) => None,
+        // A barrel's groove is a graph over the whole turn, a surface over the whole plane
+        // (a ball's foot point is searched from the centre's own x, y): no range.
+        (Profile::Barrel { .. } | Profile::Surface { .. }, _) => None,
         (
-            Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Revolution { .. },
-            Outline::Point,
-        ) => None,
-        // A barrel's groove is a graph over the whole turn: no search, nothing to scan.
-        (Profile::Barrel { .. }, _) => None,
-        (
-            Profile::Explicit { .. } | Profile::Surface { .. } | Profile::Revolution { .. },
+            Profile::Explicit { .. } | Profile::Revolution { .. },
             Outline::Circle | Outline::Line,
         ) => Some(format!(
             "a {} on an explicit profile",

@@ -1,0 +1,133 @@
+//! A ball (a `Roller` on a surface) on a cam surface z = f(x, y), by the reference's own
+//! routes (docs/method.md §13.8): the foot point S nearest the ball's centre C by a damped
+//! two-dimensional Newton descent of |C − S|²/2 from (X, Y), its gradient and Hessian from
+//! the surface's jets ([`ContactConst::local`]); the foot point's rate ṡ from the
+//! implicit-function theorem on that gradient, and the convective term as N·C̈° + Ṅ·Ċ with
+//! Ṅ differentiated from N = (−∇f, 1)/W along ṡ (the generator takes the Weingarten form
+//! −aᵀ L ṡ).
+
+use super::surface::{larger_principal_curvature, spatial, tangential_speed};
+use super::{CamFrame, ContactConst, Evaluated, Seen};
+use crate::motion::Vec3;
+use camchain_runtime::ContactGeometry;
+
+/// Newton steps allowed for the foot point.
+const STEPS: usize = 100;
+
+impl ContactConst {
+    /// The foot point (u, v) of C = (X, Y, Z) on the surface: a stationary point of
+    /// φ = |C − S|²/2 reached by Newton steps halved until φ decreases.
+    fn foot(&self, c: [f64; 3]) -> [f64; 2] {
+        let phi = |s: [f64; 2]| {
+            let f = self.local(s).f;
+            0.5 * ((c[0] - s[0]).powi(2) + (c[1] - s[1]).powi(2) + (c[2] - f).powi(2))
+        };
+        let mut s = [c[0], c[1]];
+        let scale = c[0].abs().max(c[1].abs()).max(1e-3);
+        for _ in 0..STEPS {
+            let l = self.local(s);
+            let [fu, fv] = l.gradient;
+            let [fuu, fuv, fvv] = l.hessian;
+            let gap = c[2] - l.f;
+            let grad = [-(c[0] - s[0]) - gap * fu, -(c[1] - s[1]) - gap * fv];
+            let h = [
+                1.0 + fu * fu - gap * fuu,
+                fu * fv - gap * fuv,
+                1.0 + fv * fv - gap * fvv,
+            ];
+            let det = h[0] * h[2] - h[1] * h[1];
+            let step = [
+                -(h[2] * grad[0] - h[1] * grad[1]) / det,
+                -(h[0] * grad[1] - h[1] * grad[0]) / det,
+            ];
+            if !(step[0].is_finite() && step[1].is_finite()) {
+                return [f64::NAN; 2];
+            }
+            let before = phi(s);
+            let mut t = 1.0;
+            let mut next = [s[0] + step[0], s[1] + step[1]];
+            while phi(next) > before && t > 1e-6 {
+                t *= 0.5;
+                next = [s[0] + t * step[0], s[1] + t * step[1]];
+            }
+            s = next;
+            if step[0].hypot(step[1]) * t <= 1e-15 * scale {
+                break;
+            }
+        }
+        s
+    }
+
+    /// h, J, c and the outputs of a ball of radius ρ on this contact's surface.
+    pub(super) fn on_ball(
+        &self,
+        seen: &Seen,
+        columns: &[Seen],
+        frame: &CamFrame,
+        point: Vec3,
+        direction: Vec3,
+    ) -> Evaluated {
+        let rho = self.follower.radius().copied().unwrap_or(0.0);
+        let c = [seen.p[0], seen.p[1], seen.height[0]];
+        let s = self.foot(c);
+        let l = self.local(s);
+        let [fu, fv] = l.gradient;
+        let [fuu, fuv, fvv] = l.hessian;
+        let w = (1.0 + fu * fu + fv * fv).sqrt();
+        let unit = [-fu / w, -fv / w, 1.0 / w];
+        let foot = [s[0], s[1], l.f];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let gap: [f64; 3] = std::array::from_fn(|k| c[k] - foot[k]);
+        let h = dot(unit, gap) - rho;
+        let jacobian: Vec<f64> = columns
+            .iter()
+            .map(|col| dot(unit, [col.v[0], col.v[1], col.height[1]]))
+            .collect();
+        let velocity = [seen.v[0], seen.v[1], seen.height[1]];
+        // The gradient of φ vanishes at the foot: its derivative along the motion gives the
+        // foot's rate, (G − (Z − f) Hess f) ṡ = (Ẋ + f_u Ż, Ẏ + f_v Ż).
+        let above = c[2] - l.f;
+        let m = [
+            1.0 + fu * fu - above * fuu,
+            fu * fv - above * fuv,
+            1.0 + fv * fv - above * fvv,
+        ];
+        let b = [
+            velocity[0] + fu * velocity[2],
+            velocity[1] + fv * velocity[2],
+        ];
+        let det = m[0] * m[2] - m[1] * m[1];
+        let rate = [
+            (m[2] * b[0] - m[1] * b[1]) / det,
+            (m[0] * b[1] - m[1] * b[0]) / det,
+        ];
+        // Ṅ from N = (−f_u, −f_v, 1)/W with (ḟ_u, ḟ_v) = Hess f · ṡ.
+        let gu = fuu * rate[0] + fuv * rate[1];
+        let gv = fuv * rate[0] + fvv * rate[1];
+        let w_dot = (fu * gu + fv * gv) / w;
+        let unit_dot = [
+            -gu / w + fu * w_dot / (w * w),
+            -gv / w + fv * w_dot / (w * w),
+            -w_dot / (w * w),
+        ];
+        let convective = [seen.a[0], seen.a[1], seen.height[2]];
+        let bias = dot(unit, convective) + dot(unit_dot, velocity);
+        let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
+        let position = frame.origin + frame.x * foot[0] + frame.y * foot[1] + frame.axis * foot[2];
+        let geometry = ContactGeometry {
+            position: position.into(),
+            x: foot[0],
+            y: foot[1],
+            z: foot[2],
+            follower: point.into(),
+            normal: normal.into(),
+            axis: frame.axis.into(),
+            force_scale: 1.0,
+            parameter: foot[0],
+            curvature: larger_principal_curvature([fu, fv], l.hessian),
+            direction: direction.into(),
+            sliding_speed: tangential_speed(velocity, unit),
+        };
+        spatial(h, jacobian, bias, geometry, seen, columns)
+    }
+}

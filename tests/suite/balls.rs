@@ -1,0 +1,139 @@
+//! A ball (a `Roller` on a cam surface, docs/method.md §13.8) against closed forms.
+//!
+//! `tests/contact_models/ball_on_plane.ron`: a ball of radius ρ on the inclined plane
+//! z = a x + b y under gravity, its centre carried by three perpendicular slides. Its centre
+//! stays on the parallel plane ρ W above (W = √(1 + a² + b²)) and moves there as a point
+//! does, uniformly accelerated by gravity's tangential part, pressed on by N = m g/W; the
+//! point on that parallel plane (`tests/numeric_models/point_on_offset_plane.ron`, read by
+//! the numeric reference) runs alike.
+
+use camchain::runtime::{Dynamics, Simulate, Trajectory};
+use camchain_models::contact_models;
+use camchain_reference::NumericModel;
+
+const A: f64 = 0.3;
+const B: f64 = -0.2;
+const RHO: f64 = 0.02;
+const M: f64 = 0.5;
+const G: f64 = 9.81;
+
+fn run(model: &dyn Dynamics) -> Trajectory {
+    let settings = model.info().defaults.clone();
+    model
+        .simulate(model.assemble(0.0).expect("assembles"), &settings)
+        .unwrap_or_else(|f| panic!("{}", f.error))
+}
+
+#[test]
+fn a_ball_on_a_plane_moves_like_a_point_on_the_parallel_plane() {
+    let w = (1.0 + A * A + B * B).sqrt();
+    let normal = [-A / w, -B / w, 1.0 / w];
+    // Gravity less its normal part: g_t = (0, 0, −g) + (g/W) n.
+    let accel = [G / w * normal[0], G / w * normal[1], -G + G / w * normal[2]];
+    let (x0, v0) = ([0.0, 0.0, RHO * w], [0.5, 0.3, 0.5 * A + 0.3 * B]);
+    let ball = run(&*contact_models::ball_on_plane::DEFAULT);
+    let path = format!(
+        "{}/tests/numeric_models/point_on_offset_plane.ron",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let point = NumericModel::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let point = run(&point);
+    assert_eq!(ball.samples.len(), 201, "2 s at dt_out 0.01");
+    assert_eq!(point.samples.len(), ball.samples.len());
+    let [mut closed, mut twin, mut force, mut contact] = [0.0f64; 4];
+    for (s, p) in ball.samples.iter().zip(&point.samples) {
+        let t = s.t;
+        for k in 0..3 {
+            let expected = x0[k] + v0[k] * t + 0.5 * accel[k] * t * t;
+            closed = closed.max((s.q[k] - expected).abs());
+            twin = twin.max((s.q[k] - p.q[k]).abs());
+            twin = twin.max((s.qd[k] - p.qd[k]).abs());
+        }
+        force = force.max((s.normal_force[0] - M * G / w).abs());
+        // The contact point is the centre moved ρ against the normal.
+        let c = &s.contacts[0];
+        for (k, n) in normal.iter().enumerate() {
+            contact = contact.max((c.position[k] - (s.q[k] - RHO * n)).abs());
+        }
+    }
+    println!(
+        "ball on a plane over 2 s: centre against the closed form {closed:.1e} m, against the \
+         point on the parallel plane {twin:.1e}, normal force {force:.1e} N, contact point \
+         {contact:.1e} m"
+    );
+    // The issue's demand: 1e-12. The motion is quadratic in t, which Dormand–Prince 8(5,3)
+    // integrates exactly: what remains is rounding over 4 m of travel (~1e-15 relative),
+    // and the carriages' 1e-15 of the ball's mass.
+    assert!(closed < 1e-12, "closed form {closed:e} m");
+    assert!(twin < 1e-12, "point on the parallel plane {twin:e}");
+    assert!(force < 1e-12, "normal force {force:e} N");
+    assert!(contact < 1e-12, "contact point {contact:e} m");
+}
+
+#[test]
+fn a_ball_in_a_bowl_keeps_its_circular_orbit_generated_and_numeric() {
+    // tests/contact_models/ball_in_bowl.ron: the ball touches z = c (x² + y²) at the foot
+    // radius rf, the normal leaning by α (tan α = 2 c rf); the centre circles at R = rf − ρ
+    // sin α, height c rf² + ρ cos α, at ω² = g tan α / R, pressed by N = m g / cos α.
+    let (c, rf, rho, m, g): (f64, f64, f64, f64, f64) = (2.0, 0.1, 0.02, 0.5, 9.81);
+    let alpha = (2.0 * c * rf).atan();
+    let radius = rf - rho * alpha.sin();
+    let height = c * rf * rf + rho * alpha.cos();
+    let omega = (g * alpha.tan() / radius).sqrt();
+    let force = m * g / alpha.cos();
+    let path = format!(
+        "{}/tests/contact_models/ball_in_bowl.ron",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let numeric = NumericModel::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let generated = run(&*contact_models::ball_in_bowl::DEFAULT);
+    let numeric = run(&numeric);
+    assert_eq!(generated.samples.len(), 901, "9 s at dt_out 0.01");
+    assert_eq!(numeric.samples.len(), generated.samples.len());
+    for (engine, trajectory) in [("generated", &generated), ("numeric", &numeric)] {
+        let [mut r_err, mut z_err, mut phase, mut n_err] = [0.0f64; 4];
+        for s in &trajectory.samples {
+            let (x, y, z) = (s.q[0], s.q[1], s.q[2]);
+            r_err = r_err.max((x.hypot(y) - radius).abs() / radius);
+            z_err = z_err.max((z - height).abs());
+            let turned = y.atan2(x);
+            let expected = (omega * s.t + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            let d = (turned - expected + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            phase = phase.max(d.abs());
+            n_err = n_err.max((s.normal_force[0] - force).abs() / force);
+        }
+        println!(
+            "ball in a bowl, {engine}, {:.1} revolutions: radius {r_err:.1e} of R, height \
+             {z_err:.1e} m, phase {phase:.1e} rad, normal force {n_err:.1e}",
+            omega * 9.0 / std::f64::consts::TAU
+        );
+        // As the particle on the paraboloid (surfaces.rs): circular to 1e-9; the phase
+        // drifts with the integration (rtol 1e-10) over 58 rad, to 1e-8.
+        assert!(
+            r_err < 1e-9 && z_err < 1e-9,
+            "{engine}: {r_err:e} {z_err:e}"
+        );
+        assert!(phase < 1e-8, "{engine}: phase {phase:e} rad");
+        assert!(n_err < 1e-9, "{engine}: normal force {n_err:e}");
+    }
+    // The generated code's nested Newton solves (warm-started from the last foot point)
+    // against the reference's two-dimensional descent, over the whole run.
+    let mut worst = 0.0f64;
+    for (a, b) in generated.samples.iter().zip(&numeric.samples) {
+        for k in 0..3 {
+            worst = worst
+                .max((a.q[k] - b.q[k]).abs())
+                .max((a.qd[k] - b.qd[k]).abs());
+        }
+        let (pa, pb) = (a.contacts[0].position, b.contacts[0].position);
+        for k in 0..3 {
+            worst = worst.max((pa[k] - pb[k]).abs());
+        }
+    }
+    println!("ball in a bowl: generated against numeric {worst:.1e}");
+    // Two routes to the same dynamics, the integrators' step choices amplifying rounding
+    // over 9 s: 1e-9 (measured ~1e-12).
+    assert!(worst < 1e-9, "{worst:e}");
+}
