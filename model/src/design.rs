@@ -148,6 +148,14 @@ pub enum Motion<N> {
         /// A flat face's distance from the pivot's line, towards the cam (m).
         face_offset: N,
     },
+    /// Along the cam's axis, beside a barrel cam: the design frame D is then the groove
+    /// developed at the pitch radius, D's x the arc length round the cylinder (the
+    /// follower at x = 0), its y the height along the axis; the follower point at height
+    /// `base_radius` + s (the design's base is the groove's height at the program's start).
+    Axial {
+        /// The pitch radius R (m): where the roller's centre runs.
+        radius: N,
+    },
 }
 
 /// The dimensions of a design: numbers, or expressions of the run-time parameters.
@@ -226,6 +234,25 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
     let one = N::constant(1.0);
     let zero = N::constant(0.0);
     match (senses.shape.outline(), &g.motion) {
+        // A barrel's groove developed at R: the cam moves past the follower at −σR per
+        // radian, so the pitch curve's tangent is (−σR, s′) and its upward normal
+        // (σ s′, R)/|·|; the roller touches the lower flank.
+        (_, Motion::Axial { radius }) => {
+            let p = [zero.clone(), g.base_radius.clone() + s.clone()];
+            let tangent = [signed(-sigma, radius.clone()), ds.clone()];
+            let length = dot(&tangent, &tangent).sqrt();
+            let normal = [
+                signed(sigma, ds.clone()) / length.clone(),
+                radius.clone() / length,
+            ];
+            let contact = sub(&p, &scale(&g.roller, &normal));
+            Placed {
+                pitch: p,
+                contact,
+                normal,
+                motion: [zero, one],
+            }
+        }
         (Outline::Point | Outline::Circle, _) => {
             let (p, dp, motion) = match &g.motion {
                 Motion::Translating { offset } => {
@@ -244,6 +271,12 @@ pub fn place<N: Number>(g: &Geometry<N>, senses: Senses, s: &N, ds: &N) -> Place
                     let dp = scale(&signed(kappa, arm.clone() * ds.clone()), &ju);
                     (p, dp, scale(&signed(kappa, one), &ju))
                 }
+                // Handled above.
+                Motion::Axial { .. } => (
+                    [zero.clone(), zero.clone()],
+                    [zero.clone(), zero.clone()],
+                    [zero, one],
+                ),
             };
             let tangent = sub(&dp, &scale(&N::constant(sigma), &perp(&p)));
             let length = dot(&tangent, &tangent).sqrt();
@@ -396,11 +429,17 @@ impl CamDesign {
         let pressure =
             cross(&placed.motion, &placed.normal).atan2(dot(&placed.motion, &placed.normal));
         let (radius, pitch_radius) = self.radii(&lift);
+        // The cam frame: turned back by the cam's angle, or for a barrel's development
+        // shifted back by its arc, x = −σRθ.
+        let to_frame = |x: &V<f64>| match &g.motion {
+            Motion::Axial { radius } => [x[0] - senses.turning * radius * theta, x[1]],
+            Motion::Translating { .. } | Motion::Oscillating { .. } => to_cam(x, &cos, &sin),
+        };
         DesignPoint {
             theta,
             lift,
-            pitch: to_cam(&placed.pitch, &cos, &sin),
-            contact: to_cam(&placed.contact, &cos, &sin),
+            pitch: to_frame(&placed.pitch),
+            contact: to_frame(&placed.contact),
             pressure_angle: pressure,
             radius_of_curvature: radius,
             pitch_radius,
@@ -412,6 +451,13 @@ impl CamDesign {
     fn radii(&self, l: &[f64; 4]) -> (f64, f64) {
         let (g, sigma, kappa) = (&self.geometry, self.senses.turning, self.senses.swing);
         match (self.senses.shape.outline(), &g.motion) {
+            // The developed pitch curve (−σRθ, z₀ + s): its radius of curvature
+            // −(R² + s′²)^{3/2}/(R s″), positive at a crest (convex seen from the follower
+            // above it); the lower flank's is that less ρ.
+            (_, Motion::Axial { radius }) => {
+                let pitch = -(radius * radius + l[1] * l[1]).powf(1.5) / (radius * l[2]);
+                (pitch - g.roller, pitch)
+            }
             (Outline::Point | Outline::Circle, motion) => {
                 let (p, dp, ddp) = match motion {
                     Motion::Translating { offset } => {
@@ -419,6 +465,7 @@ impl CamDesign {
                         let y0 = (rp * rp - offset * offset).sqrt();
                         ([*offset, y0 + l[0]], [0.0, l[1]], [0.0, l[2]])
                     }
+                    Motion::Axial { .. } => ([0.0; 2], [0.0; 2], [0.0; 2]),
                     Motion::Oscillating { pivot, arm, .. } => {
                         let u = arm_direction(g, self.senses, &l[0]);
                         let ju = perp(&u);
@@ -465,8 +512,26 @@ impl CamDesign {
     /// machine: a CSV text with a header `x,y` (m, cam frame), `points` points at evenly
     /// spaced cam angles and the first repeated at the end (a closed curve), each number in
     /// Rust's shortest form that reads back to the same `f64`; `#` lines say what it is.
+    ///
+    /// A barrel cam's table is its groove's pitch surface instead: `theta,z`, the cam-frame
+    /// angle θ (rad, k·2π/points) and the height g(θ) of the roller centre's path there (m).
     pub fn profile_table(&self, points: usize, what: &str) -> String {
         let points = points.max(3);
+        if let Motion::Axial { .. } = self.geometry.motion {
+            let mut out = format!(
+                "# {what}\n# the groove's pitch surface z = g(θ) (m) at the cam-frame angles θ = \
+                 k·2π/{points} (rad) and 2π again (a closed groove)\ntheta,z\n"
+            );
+            let tau = std::f64::consts::TAU;
+            for k in 0..=points {
+                let theta = tau * k as f64 / points as f64;
+                // The follower sits at the cam-frame angle −σφ at the cam angle φ.
+                let phi = (-self.senses.turning * theta).rem_euclid(tau);
+                let z = self.geometry.base_radius + self.program.eval(phi)[0];
+                out.push_str(&format!("{theta:?},{z:?}\n"));
+            }
+            return out;
+        }
         let mut out = format!(
             "# {what}\n# the cam profile in the cam frame (m), {points} points at cam angles \
              k·360°/{points} and the first again at 360° (a closed curve)\nx,y\n"
@@ -664,6 +729,9 @@ mod tests {
                         pivot: pivot.map(Scalar::Const),
                         arm: Scalar::Const(*arm),
                         face_offset: Scalar::Const(*face_offset),
+                    },
+                    Motion::Axial { radius } => Motion::Axial {
+                        radius: Scalar::Const(*radius),
                     },
                 },
             };

@@ -162,6 +162,7 @@ pub fn face_offset(design: &CamDesign, p: &DesignPoint) -> f64 {
     let reference = match &g.motion {
         Motion::Translating { offset } => [*offset, 0.0],
         Motion::Oscillating { pivot, .. } => *pivot,
+        Motion::Axial { .. } => [0.0, 0.0],
     };
     // Along J n, n the face's normal.
     let along = [-placed.normal[1], placed.normal[0]];

@@ -307,6 +307,9 @@ fn frame(label: String, color: RGBColor, cams: Vec<CamPicture>) -> Frame {
 /// The cam in its frame: profile (filled), pitch curve, base and prime circles, the follower
 /// at cam angle 0; equal scales.
 pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
+    if let design::Motion::Axial { radius } = design.geometry.motion {
+        return groove(name, design, analysis, radius);
+    }
     let g = &design.geometry;
     let outline: Vec<(f64, f64)> = analysis
         .points
@@ -415,6 +418,61 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
                 title: format!("{circles}; the cam turns {turning} (shown at θ = 0)"),
                 x_label: "x [m]".into(),
                 y_label: "y [m]".into(),
+                bounds: ((x0, x1), (y0, y1)),
+                cam: None,
+                frames,
+                legend: true,
+            }),
+        )],
+    )
+}
+
+/// A barrel cam's groove developed at its pitch radius R: the pitch curve (the roller
+/// centre's path), the lower flank the roller rides on and the upper one, ρ either side along
+/// the developed curve's normal, with the roller where it sits at θ = 0.
+fn groove(name: &str, design: &CamDesign, analysis: &Analysis, radius: f64) -> Figure {
+    let rho = design.geometry.roller;
+    let at = |f: &dyn Fn(&design::DesignPoint) -> [f64; 2]| -> Vec<(f64, f64)> {
+        analysis.points.iter().map(f).map(|[x, y]| (x, y)).collect()
+    };
+    let pitch = at(&|p| p.pitch);
+    let lower = at(&|p| p.contact);
+    // The upper flank: the pitch point moved ρ the other way (the lower flank's offset
+    // mirrored through the pitch curve).
+    let upper = at(&|p| {
+        [
+            2.0 * p.pitch[0] - p.contact[0],
+            2.0 * p.pitch[1] - p.contact[1],
+        ]
+    });
+    let (cx, cy) = pitch.first().copied().unwrap_or((0.0, 0.0));
+    let rim: Vec<(f64, f64)> = circle(rho)
+        .into_iter()
+        .map(|(x, y)| (cx + x, cy + y))
+        .collect();
+    let visible: Vec<(f64, f64)> = lower.iter().chain(&upper).chain(&rim).copied().collect();
+    let (x0, x1) = data_range(visible.iter().map(|p| p.0));
+    let (y0, y1) = data_range(visible.iter().map(|p| p.1));
+    let frames = vec![
+        frame("lower flank".into(), GREY, vec![line(lower)]),
+        frame("upper flank".into(), GREY, vec![line(upper)]),
+        frame("pitch curve".into(), BLUE, vec![line(pitch)]),
+        frame(
+            format!("{} at θ = 0", design.senses.shape.label()),
+            RED,
+            vec![line(rim)],
+        ),
+    ];
+    column(
+        format!("{name}: barrel cam's groove developed at the pitch radius {radius:.6} m"),
+        vec![(
+            PROFILE_ROW,
+            Panel::Mechanism(MechanismPanel {
+                title: format!(
+                    "one turn of the cam, arc length −σRθ; the roller's radius {rho:.6} m"
+                ),
+                x_label: "arc length round the pitch cylinder [m]".into(),
+                y_label: "height along the cam's axis [m]".into(),
                 bounds: ((x0, x1), (y0, y1)),
                 cam: None,
                 frames,

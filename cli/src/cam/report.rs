@@ -14,7 +14,7 @@ use std::io::{self, Write};
 /// The units of the follower's displacement and its first three time derivatives.
 pub fn units(design: &CamDesign) -> [&'static str; 4] {
     match design.geometry.motion {
-        Motion::Translating { .. } => ["m", "m/s", "m/s²", "m/s³"],
+        Motion::Translating { .. } | Motion::Axial { .. } => ["m", "m/s", "m/s²", "m/s³"],
         Motion::Oscillating { .. } => ["rad", "rad/s", "rad/s²", "rad/s³"],
     }
 }
@@ -81,6 +81,11 @@ pub fn design_summary(
                 metres(*offset)
             )
         }
+        Motion::Axial { radius } => format!(
+            "translating along the cam's axis in a barrel cam's groove, its centre at the pitch \
+             radius {}",
+            metres(*radius)
+        ),
         Motion::Oscillating {
             pivot,
             arm,
@@ -114,12 +119,27 @@ pub fn design_summary(
         Outline::Point | Outline::Circle => g.base_radius + g.roller,
         Outline::Line => g.base_radius,
     };
-    let _ = writeln!(
-        text,
-        "  cam: turns {turning}; base circle radius {}, prime circle radius {}",
-        metres(g.base_radius),
-        metres(prime)
-    );
+    match g.motion {
+        Motion::Axial { radius } => {
+            let _ = writeln!(
+                text,
+                "  cam: a barrel turning {turning}; the groove's centre {} along the axis at \
+                 the program's start, its flanks {} to either side; developed at the pitch \
+                 radius {} for the pressure angle and the radii of curvature",
+                metres(g.base_radius),
+                metres(g.roller),
+                metres(radius)
+            );
+        }
+        Motion::Translating { .. } | Motion::Oscillating { .. } => {
+            let _ = writeln!(
+                text,
+                "  cam: turns {turning}; base circle radius {}, prime circle radius {}",
+                metres(g.base_radius),
+                metres(prime)
+            );
+        }
+    }
     let _ = writeln!(text, "  segments (cam angle in degrees, lift in {}):", u[0]);
     let _ = writeln!(
         text,
@@ -194,7 +214,13 @@ pub fn design_summary(
         ),
         None => "concave nowhere".to_string(),
     };
-    let _ = writeln!(text, "  profile's radius of curvature: {convex}; {concave}");
+    let groove = matches!(g.motion, Motion::Axial { .. });
+    let curve = if groove {
+        "the groove's lower flank's radius of curvature (developed)"
+    } else {
+        "profile's radius of curvature"
+    };
+    let _ = writeln!(text, "  {curve}: {convex}; {concave}");
     if let Some(undercut) = &analysis.undercut {
         let _ = writeln!(
             text,
@@ -205,6 +231,27 @@ pub fn design_summary(
             degrees(undercut.pitch.theta, 3),
             metres(g.roller)
         );
+    }
+    if groove {
+        // The upper flank is convex where the pitch curve is hollow seen from below it.
+        let (theta, pitch) = design.least(camchain_codegen::design::DESIGN_SAMPLES, |p| {
+            if p.pitch_radius < 0.0 {
+                -p.pitch_radius
+            } else {
+                f64::INFINITY
+            }
+        });
+        if pitch.is_finite() {
+            let _ = writeln!(
+                text,
+                "  the groove's upper flank: undercut margin {} (the pitch curve's smallest \
+                 concave radius {} at {}° less the roller's {})",
+                metres(pitch - g.roller),
+                metres(pitch),
+                degrees(theta, 3),
+                metres(g.roller)
+            );
+        }
     }
     if let Some(face) = &analysis.face {
         let Range { max, min } = face.offset;
@@ -218,7 +265,7 @@ pub fn design_summary(
             number(max.value),
             degrees(max.theta, 3),
             match g.motion {
-                Motion::Translating { .. } => "the guide's line",
+                Motion::Translating { .. } | Motion::Axial { .. } => "the guide's line",
                 Motion::Oscillating { .. } => "the foot of the pivot",
             }
         );

@@ -412,3 +412,116 @@ fn bad_input_gives_one_line_and_its_exit_code() {
     assert!(!dir.join("out").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_barrel_cam_design_reports_its_law_groove_and_jump_speed() {
+    // models/barrel_indexer.ron: a groove designed from cycloidal rise and return of h = 30 mm
+    // over β = 120° each (dwells of 60°), pitch radius R = 60 mm, roller ρ = 10 mm, at 10 rad/s.
+    let dir = scratch("cam-barrel");
+    let table = dir.join("groove.csv");
+    let table_arg = table.to_string_lossy().into_owned();
+    let stdout = cam(&dir, &["barrel_indexer", "--table", &table_arg]);
+    let (h, beta, w, radius, rho, base) = (0.03, 120f64.to_radians(), 10.0, 0.06, 0.01, 0.02);
+    let (v_max, _) = peak(&stdout, "velocity [m/s]");
+    let (a_max, _) = peak(&stdout, "acceleration [m/s²]");
+    // The textbook peaks 2hω/β and 2πhω²/β², as for the disc cam (printed to 12 digits).
+    assert!(
+        relative(v_max, 2.0 * h * w / beta) < 1e-9,
+        "{v_max}\n{stdout}"
+    );
+    assert!(
+        relative(a_max, 2.0 * PI * h * w * w / (beta * beta)) < 1e-9,
+        "{a_max}"
+    );
+    // The pressure angle of a follower translating along the axis, atan(s′/R), largest at the
+    // rise's middle: atan(2h/(βR)), printed in degrees to 3 decimals.
+    let line = stdout
+        .lines()
+        .map(str::trim)
+        .find(|l| l.starts_with("pressure angle:"))
+        .expect("a pressure angle line");
+    let largest: f64 = line
+        .split_once("max ")
+        .and_then(|(_, rest)| rest.split('°').next())
+        .and_then(|word| word.parse().ok())
+        .unwrap_or_else(|| panic!("no largest pressure angle in `{line}`"));
+    let closed = (2.0 * h / (beta * radius)).atan().to_degrees();
+    assert!(
+        (largest - closed).abs() < 6e-4,
+        "{largest}° against {closed}°"
+    );
+    // The developed pitch curve's radius of curvature (R² + s′²)^{3/2}/(R |s″|) from the
+    // cycloidal law's closed form, at its least over a rise (sampled every 1e-6 of β; the
+    // report refines by golden-section search), less ρ: both flanks' undercut margins,
+    // printed to the micrometre.
+    let least = (1..1_000_000)
+        .map(|k| {
+            let x = k as f64 / 1e6;
+            let s1 = h / beta * (1.0 - (2.0 * PI * x).cos());
+            let s2 = 2.0 * PI * h / (beta * beta) * (2.0 * PI * x).sin();
+            (radius * radius + s1 * s1).powf(1.5) / (radius * s2.abs())
+        })
+        .fold(f64::INFINITY, f64::min);
+    let lower = value_after(&stdout, "undercut margin:", "margin: ");
+    let upper = value_after(&stdout, "the groove's upper flank:", "margin ");
+    for margin in [lower, upper] {
+        assert!(
+            (margin - (least - rho)).abs() < 1e-6,
+            "{margin} against {}",
+            least - rho
+        );
+    }
+    // The jump speed predicted from bilateral runs against the closed form (the spring
+    // holds the follower on the lower flank; surfaces.rs checks lift-off there).
+    let predicted = value_after(&stdout, "predicted jump speed", "speed ");
+    let parameters = parse_model_from(
+        camchain_models::source("barrel_indexer").expect("built in"),
+        Path::new("models/barrel_indexer.ron"),
+        &[],
+        ParameterMode::AsDeclared,
+        Files::Embedded(camchain_models::files("barrel_indexer")),
+    )
+    .expect("valid")
+    .parameters;
+    let p = |name: &str| {
+        parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.default)
+            .unwrap_or_else(|| panic!("no parameter {name}"))
+    };
+    let law = cycloidal::Cycloidal {
+        m: p("m"),
+        g: p("g"),
+        k: p("k"),
+        c: p("c"),
+        free: p("free"),
+        base: p("base"),
+        lift: p("h"),
+    };
+    let closed = law.jump_speed().0;
+    assert!(
+        relative(predicted, closed) < 1e-8,
+        "predicted {predicted}, closed form {closed}"
+    );
+    // The groove table: z = base + s(φ) at the cam-frame angle θ, φ = −θ for a cam turning
+    // counterclockwise.
+    let text = std::fs::read_to_string(&table).expect("the table");
+    let rows: Vec<(f64, f64)> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && *l != "theta,z")
+        .map(|l| {
+            let (t, z) = l.split_once(',').expect("two columns");
+            (t.parse().expect("θ"), z.parse().expect("z"))
+        })
+        .collect();
+    assert_eq!(rows.len(), 721, "720 points and the first again");
+    for (theta, z) in rows {
+        let expected = base + law.law((-theta).rem_euclid(TAU)).0;
+        assert!(
+            (z - expected).abs() < 1e-15,
+            "θ = {theta}: {z} against {expected}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

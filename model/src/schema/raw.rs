@@ -305,6 +305,12 @@ pub(super) struct BarrelLaw {
     #[serde(default)]
     pub turning: Turning,
     pub segments: Vec<LawSegment>,
+    /// The cam's nominal speed (rad/s), for `camchain cam`.
+    #[serde(default)]
+    pub speed: Option<Number>,
+    /// The largest pressure angle accepted without a warning (degrees).
+    #[serde(default)]
+    pub max_pressure_angle: Option<f64>,
 }
 
 /// `parametric: (x: "…", y: "…")`.

@@ -1074,6 +1074,14 @@ const CASES: &[Case] = &[
         "contacts[0].barrel.groove",
         "must close round the cylinder",
     ),
+    // `Roller(radius: "rho")`: 10 mm against the groove's 5 mm crests.
+    case(
+        "barrel_groove_undercut.ron",
+        48,
+        38,
+        "contacts[0].follower.radius",
+        "undercuts the groove's lower flank: at θ = 11.500°",
+    ),
     // The surface's text: a logarithm undefined over part of the region.
     case(
         "surface_undefined_in_region.ron",

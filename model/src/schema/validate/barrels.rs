@@ -2,17 +2,21 @@
 //! given as an expression of `theta` or designed from the follower's motion law along the
 //! axis, each misuse located at its field (docs/model-format.md, "Barrel cams").
 
-use super::designs::{program, sense};
+use super::designs::{can_be_made, nominal_speed, pressure_limit, program, sense};
 use super::fields::positive;
 use super::parameters::expression;
 use super::{Checked, Context, Follower, Profile};
+use crate::design::{CamDesign, Geometry, Motion, Senses};
+use crate::jet::{Jet2, eval_on, own_tables};
 use crate::model::Field;
 use crate::profile::{Scalar, Tabulated};
 use crate::schema::raw;
 use camchain_runtime::kinds::FollowerKind;
 use std::f64::consts::TAU;
 
-/// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`.
+/// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`, with its
+/// design when the groove is designed from a law (what `camchain cam` reports: the groove
+/// developed at its pitch radius).
 pub(super) fn barrel_profile(
     cx: &Context,
     path: &str,
@@ -20,7 +24,7 @@ pub(super) fn barrel_profile(
     i: usize,
     name: &str,
     follower: &Follower,
-) -> Checked<Profile> {
+) -> Checked<(Profile, Option<CamDesign>)> {
     let field = format!("{path}.barrel");
     match follower.kind() {
         FollowerKind::Knife | FollowerKind::Roller => {}
@@ -40,18 +44,20 @@ pub(super) fn barrel_profile(
     let at = format!("{field}.radius");
     let (_, radius) = cx.dimension(&at, &barrel.radius)?;
     let radius = positive(cx.at, &at, "the barrel's pitch radius", radius)?;
-    let (source, f) = match (&barrel.groove, &barrel.law) {
+    let (source, f, design) = match (&barrel.groove, &barrel.law) {
         (Some(source), None) => {
             let at = format!("{field}.groove");
             let f = expression(cx, &at, source, &["theta"], Field::Profile(i))?;
             closes(cx, &at, &f)?;
-            (source.clone(), f)
+            let roller = follower.radius().copied().unwrap_or(0.0);
+            groove_fits(cx, path, (name, &f), radius, roller)?;
+            (source.clone(), f, None)
         }
         (None, Some(law)) => {
             let at = format!("{field}.law");
             let program = program(cx, &at, &law.segments)?;
             let (folded_base, base) = cx.dimension(&format!("{at}.base"), &law.base)?;
-            let tabulated = Tabulated::law(format!("{name}_law"), program);
+            let tabulated = Tabulated::law(format!("{name}_law"), program.clone());
             // The follower sits at the cam frame's angle θ = −σφ when the cam has turned by
             // φ (σ = +1 counterclockwise), so the law is read at φ = −σθ.
             let theta = if sense(law.turning) < 0.0 {
@@ -61,7 +67,31 @@ pub(super) fn barrel_profile(
             };
             let s = theta.tabulated(&tabulated, 0);
             cx.table.record(Field::Profile(i), folded_base + s.clone());
-            (format!("{base} + s(θ), the law"), Scalar::Const(base) + s)
+            let speed = nominal_speed(cx, &at, law.speed.as_ref())?;
+            let design = CamDesign {
+                program,
+                law: tabulated,
+                geometry: Geometry {
+                    base_radius: base,
+                    roller: follower.radius().copied().unwrap_or(0.0),
+                    motion: Motion::Axial { radius },
+                },
+                senses: Senses {
+                    turning: sense(law.turning),
+                    swing: 1.0,
+                    shape: follower.kind(),
+                },
+                // A translating follower's usual limit (Norton, ch. 7), as for disc cams.
+                max_pressure_angle: pressure_limit(cx, &at, law.max_pressure_angle, 30.0)?,
+                speed: speed.as_ref().map(|s| s.0),
+                speed_expression: speed.map(|s| s.1),
+            };
+            can_be_made(cx, (path, &at), name, &design)?;
+            (
+                format!("{base} + s(θ), the law"),
+                Scalar::Const(base) + s,
+                Some(design),
+            )
         }
         (Some(_), Some(_)) => {
             return Err(cx.at.error(
@@ -86,7 +116,7 @@ pub(super) fn barrel_profile(
         let roller = follower.radius().copied().unwrap_or(0.0);
         on_the_cylinder(cx, &at, &f, roller, length)?;
     }
-    Ok(Profile::Barrel { source, f, radius })
+    Ok((Profile::Barrel { source, f, radius }, design))
 }
 
 /// The groove's flanks, the roller's radius below and above its pitch surface, lie on the
@@ -128,6 +158,40 @@ fn on_the_cylinder(cx: &Context, at: &str, f: &Scalar, roller: f64, length: f64)
             ),
         )),
     }
+}
+
+/// A roller fits a groove given as an expression: the pitch curve developed at the pitch
+/// radius R, (Rθ, g(θ)), bends with the radius (R² + g′²)^{3/2}/(R |g″|), which must exceed
+/// the roller's on both sides (at 3600 angles; a law's design is checked by
+/// `designs::can_be_made` the same way).
+fn groove_fits(
+    cx: &Context,
+    path: &str,
+    (name, f): (&str, &Scalar),
+    radius: f64,
+    roller: f64,
+) -> Checked<()> {
+    if roller <= 0.0 {
+        return Ok(());
+    }
+    for k in 0..3600 {
+        let theta = TAU * k as f64 / 3600.0;
+        let g = eval_on(f, Jet2::variable(theta), &own_tables);
+        let bend = (radius * radius + g.d1 * g.d1).powf(1.5) / (radius * g.d2.abs());
+        if bend <= roller {
+            let flank = if g.d2 < 0.0 { "lower" } else { "upper" };
+            return Err(cx.at.error(
+                &format!("{path}.follower.radius"),
+                format!(
+                    "contact `{name}`: the roller ({roller} m) undercuts the groove's {flank} \
+                     flank: at θ = {:.3}° the groove's pitch curve, developed at the pitch \
+                     radius, bends with a radius of {bend:.6} m, smaller than the roller's",
+                    theta.to_degrees()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A barrel's pitch surface closes on itself round the cylinder: f(θ + 2π) = f(θ), checked

@@ -271,8 +271,13 @@ fn profile(
         });
     }
     if let Some(barrel) = &c.barrel {
-        return super::barrels::barrel_profile(cx, path, barrel, i, name, follower)
-            .map(Shaped::from);
+        let (profile, design) =
+            super::barrels::barrel_profile(cx, path, barrel, i, name, follower)?;
+        return Ok(Shaped {
+            profile,
+            covers: None,
+            design,
+        });
     }
     if let Some(source) = &c.profile {
         let f = expression(
@@ -625,6 +630,7 @@ fn profile_field(contact: &Contact) -> &'static str {
     match (&contact.profile, &contact.design) {
         (Profile::Face { .. }, Some(_)) => return "face.law",
         (Profile::Face { .. }, None) => return "face.groove",
+        (Profile::Barrel { .. }, Some(_)) => return "barrel.law",
         (_, Some(_)) => return "law",
         (_, None) => {}
     }

@@ -63,30 +63,13 @@ pub(super) fn law_profile(
     };
     let (folded, resolved) = geometry(cx, field, law, index, follower)?;
     reachable(cx, field, &resolved, senses)?;
-    let max_pressure_angle = match law.max_pressure_angle {
-        Some(limit) if limit > 0.0 && limit < 90.0 => limit,
-        Some(limit) => {
-            return Err(cx.at.error(
-                &format!("{field}.max_pressure_angle"),
-                format!("the pressure angle's limit is in degrees, between 0 and 90, not {limit}"),
-            ));
-        }
-        None => default_pressure_limit(&law.motion),
-    }
-    .to_radians();
-    let speed = match &law.speed {
-        Some(n) => {
-            let at = format!("{field}.speed");
-            let (_, value) = cx.dimension(&at, n)?;
-            positive(cx.at, &at, "the cam's nominal speed", value)?;
-            let expression = match n {
-                raw::Number::Value(v) => Scalar::Const(*v),
-                raw::Number::Expr(source) => cx.table.parsed(&at, source)?,
-            };
-            Some((value, expression))
-        }
-        None => None,
-    };
+    let max_pressure_angle = pressure_limit(
+        cx,
+        field,
+        law.max_pressure_angle,
+        default_pressure_limit(&law.motion),
+    )?;
+    let speed = nominal_speed(cx, field, law.speed.as_ref())?;
     let tabulated = Tabulated::law(format!("{name}_law"), program.clone());
     let design = CamDesign {
         program,
@@ -125,6 +108,42 @@ pub(super) fn law_profile(
         y: y_resolved,
     };
     Ok((profile, design))
+}
+
+/// A design's `max_pressure_angle` (degrees in the file, `default` when absent), in rad.
+pub(super) fn pressure_limit(
+    cx: &Context,
+    field: &str,
+    given: Option<f64>,
+    default: f64,
+) -> Checked<f64> {
+    match given {
+        Some(limit) if limit > 0.0 && limit < 90.0 => Ok(limit.to_radians()),
+        Some(limit) => Err(cx.at.error(
+            &format!("{field}.max_pressure_angle"),
+            format!("the pressure angle's limit is in degrees, between 0 and 90, not {limit}"),
+        )),
+        None => Ok(default.to_radians()),
+    }
+}
+
+/// A design's nominal `speed` (rad/s): its value and its expression of the parameters.
+pub(super) fn nominal_speed(
+    cx: &Context,
+    field: &str,
+    given: Option<&raw::Number>,
+) -> Checked<Option<(f64, Scalar)>> {
+    let Some(n) = given else {
+        return Ok(None);
+    };
+    let at = format!("{field}.speed");
+    let (_, value) = cx.dimension(&at, n)?;
+    positive(cx.at, &at, "the cam's nominal speed", value)?;
+    let expression = match n {
+        raw::Number::Value(v) => Scalar::Const(*v),
+        raw::Number::Expr(source) => cx.table.parsed(&at, source)?,
+    };
+    Ok(Some((value, expression)))
 }
 
 /// +1 counterclockwise, −1 clockwise.
@@ -360,13 +379,15 @@ fn reachable(cx: &Context, law: &str, g: &Geometry<f64>, senses: Senses) -> Chec
             Ok(())
         }
         (Motion::Translating { .. }, Outline::Point | Outline::Circle | Outline::Line) => Ok(()),
+        // A barrel's follower always meets its groove.
+        (Motion::Axial { .. }, _) => Ok(()),
     }
 }
 
 /// The designed cam can be made and followed: a roller smaller than the pitch curve's
 /// convex radii (no undercutting), a flat face on a profile without cusps, an oscillating
 /// face that never turns with the cam.
-fn can_be_made(
+pub(super) fn can_be_made(
     cx: &Context,
     (path, law): (&str, &str),
     name: &str,
@@ -375,6 +396,33 @@ fn can_be_made(
     let g = &design.geometry;
     let mm = |x: f64| format!("{:.3} mm", x * 1e3);
     let label = design.senses.shape.label();
+    if let Motion::Axial { .. } = g.motion {
+        // A barrel's groove, developed at its pitch radius: the roller must bend less
+        // sharply than the pitch curve on both sides (its crests for the lower flank, its
+        // troughs for the upper one).
+        let (theta, margin) = design.least(DESIGN_SAMPLES, |p| p.pitch_radius.abs() - g.roller);
+        if margin <= 0.0 {
+            let p = design.at(theta);
+            let flank = if p.pitch_radius > 0.0 {
+                "lower"
+            } else {
+                "upper"
+            };
+            return Err(cx.at.error(
+                &format!("{path}.follower.radius"),
+                format!(
+                    "contact `{name}`: the {label} ({}) undercuts the groove's {flank} flank: at \
+                     cam angle {:.3}° the groove's pitch curve, developed at its pitch radius, \
+                     bends with a radius of {}, smaller than the {label}'s; take a larger pitch \
+                     radius, a gentler law or a smaller {label}",
+                    mm(g.roller),
+                    theta.to_degrees(),
+                    mm(p.pitch_radius.abs())
+                ),
+            ));
+        }
+        return Ok(());
+    }
     match design.senses.shape.outline() {
         Outline::Circle if g.roller > 0.0 => {
             let (theta, radius) = design.least(DESIGN_SAMPLES, |p| {
