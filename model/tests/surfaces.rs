@@ -190,7 +190,7 @@ fn a_barrel_needs_a_radius_a_groove_and_a_roller() {
 }
 
 #[test]
-fn a_surface_of_revolution_is_a_function_of_z_followed_by_a_point() {
+fn a_surface_of_revolution_is_a_function_of_z_followed_by_a_point_or_a_ball() {
     let source = edited(
         "surface: \"c*(x*x + y*y) + 0.1*(x*y).sin()\",",
         "revolution: \"(0.25 - z*z).sqrt()\",",
@@ -206,14 +206,30 @@ fn a_surface_of_revolution_is_a_function_of_z_followed_by_a_point() {
         16,
         "the only variable allowed here is `z`",
     );
+    // A ball needs the heights its contact point may take; a flat face is refused.
     rejected(
         &source.replace(
             "marker: \"tip\",\n",
             "marker: \"tip\", follower: Roller(radius: 0.01),\n",
         ),
+        "contacts[0].marker",
+        15,
+        "a roller on a surface of revolution (the heights z its contact point may take) needs \
+         `range: (from, to)`",
+    );
+    let ball = source.replace(
+        "marker: \"tip\",\n",
+        "marker: \"tip\", follower: Roller(radius: 0.01), range: (-0.4, 0.4),\n",
+    );
+    parse_model(&ball, Path::new("models/surface.ron")).expect("a ball with its range");
+    rejected(
+        &source.replace(
+            "marker: \"tip\",\n",
+            "marker: \"tip\", follower: Flat(normal: (1.0, 0.0, 0.0)),\n",
+        ),
         "contacts[0].follower",
         15,
-        "cannot follow a surface of revolution",
+        "a flat face cannot follow a surface of revolution",
     );
 }
 

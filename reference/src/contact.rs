@@ -397,9 +397,14 @@ impl ContactConst {
             };
             d / d.norm()
         };
-        if let (Profile::Surface { .. }, Follower::Roller { .. }) = (&self.profile, &self.follower)
-        {
-            return self.on_ball(&seen, &columns, &frame, point, direction);
+        match (&self.profile, &self.follower) {
+            (Profile::Surface { .. }, Follower::Roller { .. }) => {
+                return self.on_ball(&seen, &columns, &frame, point, direction);
+            }
+            (Profile::Revolution { .. }, Follower::Roller { .. }) => {
+                return self.on_ball_revolution(&seen, &columns, &frame, point, direction);
+            }
+            _ => {}
         }
         match &self.profile {
             Profile::Surface { .. } | Profile::Barrel { .. } => {

@@ -137,3 +137,51 @@ fn a_ball_in_a_bowl_keeps_its_circular_orbit_generated_and_numeric() {
     // over 9 s: 1e-9 (measured ~1e-12).
     assert!(worst < 1e-9, "{worst:e}");
 }
+
+#[test]
+fn a_ball_leaves_a_sphere_where_its_centre_would_as_a_particle() {
+    // tests/contact_models/ball_slide.ron: a ball of radius ρ on the sphere r = √(a² − z²)
+    // (a surface of revolution), started at rest with its centre θ₀ from the top: the centre
+    // moves on the sphere of radius a + ρ and leaves it at cos θ* = (2/3) cos θ₀.
+    let path = format!(
+        "{}/tests/contact_models/ball_slide.ron",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let numeric = NumericModel::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let generated = &*contact_models::ball_slide::DEFAULT;
+    let (a, rho, theta0) = (0.4, 0.1, 0.5f64);
+    let expected = 2.0 / 3.0 * theta0.cos();
+    for (engine, model) in [
+        ("generated", generated as &dyn Dynamics),
+        ("numeric", &numeric as &dyn Dynamics),
+    ] {
+        let settings = model.info().defaults.clone();
+        let run = model
+            .simulate_unilateral(model.assemble(0.0).expect("assembles"), &settings, 0.0)
+            .unwrap_or_else(|f| panic!("{engine}: {f}"));
+        let lift_off = run
+            .events
+            .iter()
+            .find(|e| e.kind == camchain::runtime::events::EventKind::LiftOff)
+            .unwrap_or_else(|| panic!("{engine}: no lift-off in {:?}", run.events));
+        let (x, z) = (lift_off.q[0], lift_off.q[2]);
+        let on_sphere = (x.hypot(z) - (a + rho)).abs();
+        let cos = z / (a + rho);
+        println!(
+            "ball_slide ({engine}): the centre leaves at cos θ = {cos:.12}, closed form \
+             {expected:.12} ({:.1e}); t = {:.9} s",
+            cos - expected,
+            lift_off.t
+        );
+        // As the particle on a sphere (surfaces.rs): the event located to 1e-9 s at ~2 m/s,
+        // the force's zero to the integration's rtol 1e-10.
+        assert!(
+            on_sphere < 1e-12,
+            "{engine}: {on_sphere:e} off the centre's sphere"
+        );
+        assert!(
+            (cos - expected).abs() < 1e-8,
+            "{engine}: cos θ* = {cos}, closed form {expected}"
+        );
+    }
+}

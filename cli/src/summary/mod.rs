@@ -105,7 +105,10 @@ fn settings_text(settings: &SimSettings) -> String {
 pub fn contact_kind(info: &ModelInfo, contact: &ContactInfo) -> String {
     // A roller on a surface is a ball.
     let follower = match (contact.follower, contact.profile) {
-        (camchain_runtime::kinds::FollowerKind::Roller, ProfileKind::Surface) => "ball",
+        (
+            camchain_runtime::kinds::FollowerKind::Roller,
+            ProfileKind::Surface | ProfileKind::Revolution,
+        ) => "ball",
         _ => contact.follower.label(),
     };
     let profile = match contact.profile {

@@ -22,6 +22,10 @@
 //!
 //! ṡ = (u̇, v̇) is the foot point's rate; Ṅ·Ċ = −aᵀ L ṡ. At D = 0 (a point) c is (S3)
 //! divided by W.
+//!
+//! On a surface of revolution r = g(z) ([`on_revolution`]) the foot point lies in the
+//! centre's meridian half-plane: the ball is the planar roller (C7)–(C9) on the meridian
+//! curve (g(t), t), seen in the coordinates (r, Z) ([`Relative::meridian`]), §13.8.
 
 use super::relative::Relative;
 use super::surface::{
@@ -129,6 +133,93 @@ pub fn ball(
     let foot_y = inner(g, "y", [foot_x, centre[0], centre[1], centre[2]]);
     let d = derivatives(g, model, s, index, [foot_x, foot_y]);
     terms(g, model, s, index, rel, radius, [foot_x, foot_y], &d)
+}
+
+/// The terms of contact `index`: a ball of radius `radius` outside its surface of revolution:
+/// the nearest-point roller on the meridian curve in the (r, Z) half-plane, its outputs
+/// taken back to space (the contact point, the normal, the larger principal curvature, the
+/// centre's sliding speed along the tangent plane).
+pub fn on_revolution(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    index: usize,
+    rel: Relative,
+    radius: f64,
+) -> ContactTerms {
+    let name = model.contacts[index].name.clone();
+    let (meridian, u) = rel.meridian(g);
+    let mut terms = super::nearest::nearest(
+        g,
+        model,
+        s,
+        index,
+        meridian.clone(),
+        super::nearest::Rim::Roller(radius),
+    );
+    // The foot point (g(t*), t*) on the centre's radius, in the cam frame.
+    let expression = s.expression(
+        model,
+        Field::Profile(index),
+        model.contacts[index].profile_expression(),
+    );
+    let [foot_r, g1, g2] = crate::expr::scalar::value_and_derivatives(
+        g,
+        expression,
+        &format!("__ball_{name}_meridian"),
+        terms.parameter,
+        &s.params,
+    );
+    let one = g.one();
+    let stretch = {
+        let sq = g.mul(g1, g1);
+        let w2 = g.add(one, sq);
+        g.sqrt(w2)
+    };
+    let unit = {
+        let radial = g.div(one, stretch);
+        let up = {
+            let n = g.neg(g1);
+            g.div(n, stretch)
+        };
+        [g.mul(u[0], radial), g.mul(u[1], radial), up]
+    };
+    for (&id, axis) in unit.iter().zip(["x", "y", "z"]) {
+        g.label(id, format!("{name}_cam_normal_{axis}"));
+    }
+    terms.cam_point = [g.mul(u[0], foot_r), g.mul(u[1], foot_r)];
+    terms.cam_height = Some(terms.parameter);
+    // The larger principal curvature, positive where hollow seen from outside: the
+    // meridian's g″/W³ and the parallel circle's −1/(g W), as (a + b + |a − b|)/2.
+    terms.curvature = {
+        let w3 = {
+            let p = g.mul(stretch, stretch);
+            g.mul(p, stretch)
+        };
+        let along = g.div(g2, w3);
+        let across = {
+            let p = g.mul(foot_r, stretch);
+            let q = g.div(one, p);
+            g.neg(q)
+        };
+        let sum = g.add(along, across);
+        let gap = g.sub(along, across);
+        let gap2 = g.mul(gap, gap);
+        let spread = g.sqrt(gap2);
+        let total = g.add(sum, spread);
+        g.scale(0.5, total)
+    };
+    let velocity = [rel.velocity[0], rel.velocity[1], rel.height_rate];
+    terms.sliding = sliding_speed(g, velocity, unit, &name);
+    terms.relative = rel;
+    terms.formulas = Formulas {
+        kind: "a ball outside a surface of revolution r = g(z), its centre on the offset"
+            .to_string(),
+        h: "h = D − ρ in the meridian half-plane, eq. (C7)",
+        jacobian: "J = n·∂(r, Z)/∂q, eq. (C8)",
+        bias: "eq. (C9) with r̈ = u·P̈ + (|Ṗ_xy|² − ṙ²)/r",
+    };
+    terms
 }
 
 /// ∂F/∂w of F = (c − w) + (Z − f) f_w: −1 − f_w² + (Z − f) f_ww.

@@ -102,6 +102,9 @@ pub fn contact_terms(
                 (Follower::Roller { radius }, Profile::Surface { .. }) => {
                     ball::ball(g, model, s, index, rel, *radius)
                 }
+                (Follower::Roller { radius }, Profile::Revolution { .. }) => {
+                    ball::on_revolution(g, model, s, index, rel, *radius)
+                }
                 (Follower::Roller { radius }, Profile::Barrel { .. }) => {
                     surface::point(g, model, s, index, rel, Some(*radius))
                 }

@@ -69,7 +69,8 @@ pub fn nearest(
     let guess = match contact.profile.curve() {
         Profile::Explicit { .. } | Profile::Surface { .. } => Guess::Input(0),
         Profile::Barrel { .. } => Guess::Angle { x: 0, y: 1 },
-        Profile::Revolution { .. } => Guess::Scan,
+        // A ball on a surface of revolution, in its meridian half-plane (r, Z): from Z.
+        Profile::Revolution { .. } => Guess::Input(1),
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
         Profile::Parametric { .. } | Profile::Face { .. } => Guess::Scan,
     };

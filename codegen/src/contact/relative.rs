@@ -93,6 +93,78 @@ impl Relative {
         let y = vec3::scale(g, xy[1], self.y_axis);
         vec3::add(g, x, y)
     }
+
+    /// The follower point seen in its meridian half-plane, for a cam symmetric about the
+    /// cam's axis (a surface of revolution): the plane coordinates (r, Z), r = √(X² + Y²) the
+    /// distance from the axis, with their Jacobian columns, rates and convective parts
+    /// (r̈ has the turning meridian's (|Ṗ_xy|² − ṙ²)/r besides u·P̈_xy, u = (X, Y)/r), its
+    /// axes the radial direction and the cam's axis in ground coordinates (so that
+    /// `to_ground` of a meridian point is the point of space). The follower's spin about the
+    /// cam's axis moves no point of the half-plane: it is zero there. Also returns u.
+    pub fn meridian(&self, g: &mut Graph) -> (Relative, [Id; 2]) {
+        let [x, y] = self.xy;
+        let r = {
+            let xx = g.mul(x, x);
+            let yy = g.mul(y, y);
+            let s = g.add(xx, yy);
+            g.sqrt(s)
+        };
+        let u = [g.div(x, r), g.div(y, r)];
+        let along = |g: &mut Graph, v: [Id; 2]| {
+            let a = g.mul(u[0], v[0]);
+            let b = g.mul(u[1], v[1]);
+            g.add(a, b)
+        };
+        let columns = self
+            .columns
+            .iter()
+            .zip(&self.height_columns)
+            .map(|(&c, &j3)| [along(g, c), j3])
+            .collect();
+        let rate = along(g, self.velocity);
+        let bend = {
+            let [vx, vy] = self.velocity;
+            let speed2 = {
+                let a = g.mul(vx, vx);
+                let b = g.mul(vy, vy);
+                g.add(a, b)
+            };
+            let rate2 = g.mul(rate, rate);
+            let across = g.sub(speed2, rate2);
+            g.div(across, r)
+        };
+        let radial_convective = {
+            let a = along(g, self.convective);
+            g.add(a, bend)
+        };
+        let radial = {
+            let a = vec3::scale(g, u[0], self.x_axis);
+            let b = vec3::scale(g, u[1], self.y_axis);
+            vec3::add(g, a, b)
+        };
+        let zero = g.zero();
+        let n = self.columns.len();
+        let meridian = Relative {
+            point: self.point,
+            xy: [r, self.height],
+            columns,
+            convective: [radial_convective, self.height_convective],
+            velocity: [rate, self.height_rate],
+            origin: self.origin,
+            x_axis: radial,
+            y_axis: self.axis,
+            axis: vec3::zero(g),
+            height: zero,
+            height_columns: vec![zero; n],
+            height_convective: zero,
+            height_rate: zero,
+            spin_columns: vec![zero; n],
+            spin: zero,
+            direction: self.direction,
+            follower_body: self.follower_body,
+        };
+        (meridian, u)
+    }
 }
 
 /// The bodies whose joints move `body`, tip first (empty for the ground).

@@ -42,7 +42,7 @@ pub struct Kind {
 }
 
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 18] = [
+pub const KINDS: [Kind; 19] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -177,6 +177,15 @@ pub const KINDS: [Kind; 18] = [
         follower: "",
         profile: "revolution: \"0.045 + 3.0*z*z + 0.002*(40.0*z).sin()\",",
         offset: 0.0,
+        planar_only: false,
+        turn: 3.1,
+    },
+    // A ball outside the same drum, its centre a few millimetres farther out.
+    Kind {
+        name: "ball on revolution",
+        follower: "follower: Roller(radius: 0.004),",
+        profile: "revolution: \"0.045 + 3.0*z*z + 0.002*(40.0*z).sin()\", range: (-0.05, 0.05),",
+        offset: 0.004,
         planar_only: false,
         turn: 3.1,
     },

@@ -4,7 +4,9 @@
 //! the surface's jets ([`ContactConst::local`]); the foot point's rate ṡ from the
 //! implicit-function theorem on that gradient, and the convective term as N·C̈° + Ṅ·Ċ with
 //! Ṅ differentiated from N = (−∇f, 1)/W along ṡ (the generator takes the Weingarten form
-//! −aᵀ L ṡ).
+//! −aᵀ L ṡ). On a surface of revolution the foot point is in the centre's meridian plane,
+//! found by Newton on the meridian, and Ṅ follows from the azimuth's and the foot's rates in
+//! three dimensions (the generator takes the planar roller in the (r, Z) half-plane).
 
 use super::surface::{larger_principal_curvature, spatial, tangential_speed};
 use super::{CamFrame, ContactConst, Evaluated, Seen};
@@ -125,6 +127,112 @@ impl ContactConst {
             force_scale: 1.0,
             parameter: foot[0],
             curvature: larger_principal_curvature([fu, fv], l.hessian),
+            direction: direction.into(),
+            sliding_speed: tangential_speed(velocity, unit),
+        };
+        spatial(h, jacobian, bias, geometry, seen, columns)
+    }
+}
+
+impl ContactConst {
+    /// The meridian foot point t* of the centre at (r, Z) on (g(t), t): Newton on
+    /// ψ(t) = g′(t)(r − g) + (Z − t) from t = Z, g's jets from the tape.
+    fn meridian_foot(&self, r: f64, z: f64) -> f64 {
+        let distance2 = |t: f64| {
+            let g = self.tape.eval(t)[0];
+            (r - g).powi(2) + (z - t).powi(2)
+        };
+        let start = if distance2(z).is_finite() {
+            z
+        } else {
+            // The centre's height is off the meridian's domain: the best of a scan of the
+            // contact's range.
+            let (a, b) = self.range;
+            (0..=512)
+                .map(|k| a + (b - a) * k as f64 / 512.0)
+                .min_by(|&s, &t| distance2(s).total_cmp(&distance2(t)))
+                .unwrap_or(z)
+        };
+        let mut t = start;
+        let scale = z.abs().max(r).max(1e-3);
+        for _ in 0..STEPS {
+            let g = self.tape.eval_jet(crate::jet::Jet2::variable(t))[0];
+            let psi = g.d1 * (r - g.v) + (z - t);
+            let slope = g.d2 * (r - g.v) - g.d1 * g.d1 - 1.0;
+            let step = psi / slope;
+            if !step.is_finite() {
+                return f64::NAN;
+            }
+            t -= step;
+            if step.abs() <= 1e-15 * scale {
+                break;
+            }
+        }
+        t
+    }
+
+    /// h, J, c and the outputs of a ball outside this contact's surface of revolution, in
+    /// three dimensions: the foot point lies in the centre's meridian plane at the azimuth
+    /// φ; N = (cos φ, sin φ, −g′)/W there; Ṅ from φ̇ = (X Ẏ − Y Ẋ)/r² and the foot's rate
+    /// ṫ = −(g′ ṙ + Ż)/ψ′ (the implicit-function theorem on ψ).
+    pub(super) fn on_ball_revolution(
+        &self,
+        seen: &Seen,
+        columns: &[Seen],
+        frame: &CamFrame,
+        point: Vec3,
+        direction: Vec3,
+    ) -> Evaluated {
+        let rho = self.follower.radius().copied().unwrap_or(0.0);
+        let [x, y] = seen.p;
+        let z = seen.height[0];
+        let r = x.hypot(y);
+        let (cos, sin) = (x / r, y / r);
+        let t = self.meridian_foot(r, z);
+        let g = self.tape.eval_jet(crate::jet::Jet2::variable(t))[0];
+        let w = (1.0 + g.d1 * g.d1).sqrt();
+        let unit = [cos / w, sin / w, -g.d1 / w];
+        let foot = [g.v * cos, g.v * sin, t];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let gap = [x - foot[0], y - foot[1], z - foot[2]];
+        let h = dot(unit, gap) - rho;
+        let jacobian: Vec<f64> = columns
+            .iter()
+            .map(|c| dot(unit, [c.v[0], c.v[1], c.height[1]]))
+            .collect();
+        let velocity = [seen.v[0], seen.v[1], seen.height[1]];
+        let r_dot = cos * velocity[0] + sin * velocity[1];
+        let phi_dot = (x * velocity[1] - y * velocity[0]) / (r * r);
+        let slope = g.d2 * (r - g.v) - g.d1 * g.d1 - 1.0;
+        let t_dot = -(g.d1 * r_dot + velocity[2]) / slope;
+        // N = (cos φ / W, sin φ / W, −g′/W), W = √(1 + g′²), g′ = g′(t).
+        let w_dot = g.d1 * g.d2 * t_dot / w;
+        let radial = 1.0 / w;
+        let radial_dot = -w_dot / (w * w);
+        let up_dot = -(g.d2 * t_dot) / w + g.d1 * w_dot / (w * w);
+        let unit_dot = [
+            -sin * phi_dot * radial + cos * radial_dot,
+            cos * phi_dot * radial + sin * radial_dot,
+            up_dot,
+        ];
+        let convective = [seen.a[0], seen.a[1], seen.height[2]];
+        let bias = dot(unit, convective) + dot(unit_dot, velocity);
+        let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
+        let position = frame.origin + frame.x * foot[0] + frame.y * foot[1] + frame.axis * foot[2];
+        // Principal curvatures of the surface at the foot, positive where hollow seen from
+        // outside: the meridian's g″/W³, the parallel's −1/(g W).
+        let (along, across) = (g.d2 / w.powi(3), -1.0 / (g.v * w));
+        let geometry = ContactGeometry {
+            position: position.into(),
+            x: foot[0],
+            y: foot[1],
+            z: foot[2],
+            follower: point.into(),
+            normal: normal.into(),
+            axis: frame.axis.into(),
+            force_scale: 1.0,
+            parameter: t,
+            curvature: along.max(across),
             direction: direction.into(),
             sliding_speed: tangential_speed(velocity, unit),
         };

@@ -418,14 +418,15 @@ fn revolution(
     i: usize,
     follower: &Follower,
 ) -> Checked<Profile> {
-    let what = "a surface of revolution: it takes a point follower (`follower: Knife`)";
+    let what = "a surface of revolution: it takes a point (`follower: Knife`) or a ball \
+                (`follower: Roller(radius: …)`, its centre the marker)";
     let g = point_surface(
         cx,
         path,
         ("revolution", &["z"]),
         source,
         i,
-        (follower, what, false),
+        (follower, what, true),
     )?;
     Ok(Profile::Revolution {
         source: source.to_string(),
@@ -516,11 +517,14 @@ fn contact_range(
     covers: Option<(f64, f64)>,
 ) -> Checked<Option<(f64, f64)>> {
     let field = format!("{path}.range");
-    if c.range.is_some() && profile.is_surface() {
+    // A ball outside a surface of revolution takes the heights its contact point may reach.
+    let ball_on_revolution = matches!(profile, Profile::Revolution { .. })
+        && follower.kind().outline() == Outline::Circle;
+    if c.range.is_some() && profile.is_surface() && !ball_on_revolution {
         return Err(at.error(
             &field,
             "a surface has no `range`: the follower point may be anywhere over the cam plane \
-             (a barrel's round the cylinder)",
+             (a barrel's round the cylinder, a point on a surface of revolution at any height)",
         ));
     }
     if let Some((a, b)) = c.range {
@@ -542,14 +546,18 @@ fn contact_range(
         // A face cam's groove given as r = g(θ) runs round the turn (a law's covers it).
         (Profile::Face { .. }, _) => return Ok(Some((0.0, std::f64::consts::TAU))),
         (Profile::Parametric { .. }, _) => Some("a parametric profile".to_string()),
-        (Profile::Explicit { .. } | Profile::Revolution { .. }, Outline::Point) => None,
+        (Profile::Explicit { .. }, Outline::Point) => None,
         // A barrel's groove is a graph over the whole turn, a surface over the whole plane
         // (a ball's foot point is searched from the centre's own x, y): no range.
         (Profile::Barrel { .. } | Profile::Surface { .. }, _) => None,
-        (
-            Profile::Explicit { .. } | Profile::Revolution { .. },
-            Outline::Circle | Outline::Line,
-        ) => Some(format!(
+        // A ball on a surface of revolution: the heights its contact point may take, where
+        // the meridian is scanned when Newton from the centre's own height fails.
+        (Profile::Revolution { .. }, Outline::Point) => None,
+        (Profile::Revolution { .. }, Outline::Circle | Outline::Line) => Some(format!(
+            "a {} on a surface of revolution (the heights z its contact point may take)",
+            follower.kind().label()
+        )),
+        (Profile::Explicit { .. }, Outline::Circle | Outline::Line) => Some(format!(
             "a {} on an explicit profile",
             follower.kind().label()
         )),
