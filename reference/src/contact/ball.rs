@@ -45,15 +45,18 @@ impl ContactConst {
             if !(step[0].is_finite() && step[1].is_finite()) {
                 return [f64::NAN; 2];
             }
+            // Steps are halved while φ grows, far from the root only: near it φ's changes
+            // are rounding, and Newton's full step is what converges.
+            let size = step[0].hypot(step[1]);
             let before = phi(s);
             let mut t = 1.0;
             let mut next = [s[0] + step[0], s[1] + step[1]];
-            while phi(next) > before && t > 1e-6 {
+            while size * t > 1e-6 * scale && phi(next) > before && t > 1e-6 {
                 t *= 0.5;
                 next = [s[0] + t * step[0], s[1] + t * step[1]];
             }
             s = next;
-            if step[0].hypot(step[1]) * t <= 1e-15 * scale {
+            if size <= 1e-15 * scale {
                 break;
             }
         }
