@@ -512,12 +512,7 @@ fn frame_bounds(frames: &[Frame]) -> ((f64, f64), (f64, f64)) {
 
 fn mechanism_panel(run: &RunView, geometry: &Geometry, prefix: &str) -> MechanismPanel {
     let frames = frames(run, geometry);
-    let ground = geometry.plane.is_ground();
-    let (x_label, y_label) = if ground {
-        ("x [m]", "y [m]")
-    } else {
-        ("x in the cam plane [m]", "y in the cam plane [m]")
-    };
+    let (x_label, y_label) = geometry.plane.axis_labels();
     let cam = geometry
         .profile
         .as_ref()

@@ -28,12 +28,15 @@ struct JointFrame {
     com: Vec3,
 }
 
-/// A plane with an origin and two orthonormal in-plane axes (a cam's frame).
+/// A plane with an origin and two orthonormal in-plane axes (a cam's frame), and what its
+/// axes are called on a figure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plane {
     origin: Vec3,
     x_axis: Vec3,
     y_axis: Vec3,
+    /// The axes' labels ([`Plane::axis_labels`]).
+    labels: (&'static str, &'static str),
 }
 
 impl Plane {
@@ -43,12 +46,23 @@ impl Plane {
             origin: Vec3::zeros(),
             x_axis: Vec3::x(),
             y_axis: Vec3::y(),
+            labels: ("x [m]", "y [m]"),
         }
     }
 
     /// True for the ground x–y plane (the cam coordinates are ground coordinates).
     pub fn is_ground(&self) -> bool {
-        *self == Plane::ground()
+        let ground = Plane::ground();
+        (self.origin, self.x_axis, self.y_axis) == (ground.origin, ground.x_axis, ground.y_axis)
+    }
+
+    /// The axes' labels on a figure: ground ones for the ground x–y plane.
+    pub fn axis_labels(&self) -> (&'static str, &'static str) {
+        if self.is_ground() {
+            Plane::ground().labels
+        } else {
+            self.labels
+        }
     }
 
     /// In-plane coordinates of a ground point.
@@ -352,6 +366,7 @@ impl Geometry {
                 origin: offset + rotation * cam.origin,
                 x_axis: rotation * cam.x_axis,
                 y_axis: rotation * cam.y_axis,
+                labels: ("x in the cam plane [m]", "y in the cam plane [m]"),
             };
             // A cam turning in the ground's x–y plane is drawn in ground coordinates (y up),
             // whatever way its own frame is turned.
@@ -361,6 +376,23 @@ impl Geometry {
             }
         }
         Ok(geometry)
+    }
+
+    /// For a model with a cam surface, the same geometry seen from the side: projected on the
+    /// plane of the drawing plane's x axis and its normal (the cam's axis), the second
+    /// orthogonal projection of a spatial mechanism. `None` for plane cams.
+    pub fn side_view(&self) -> Option<Geometry> {
+        if self.surfaces.iter().all(Option::is_none) {
+            return None;
+        }
+        let mut side = self.clone();
+        side.plane = Plane {
+            origin: self.plane.origin,
+            x_axis: self.plane.x_axis,
+            y_axis: self.plane.x_axis.cross(&self.plane.y_axis),
+            labels: ("x in the cam plane [m]", "along the cam's axis [m]"),
+        };
+        Some(side)
     }
 
     /// The body (= coordinate) carrying contact `k`'s follower point.
@@ -608,6 +640,22 @@ mod tests {
                     assert!(difference < 1e-12, "{name}: contact {k}, axis {axis}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_spatial_cam_has_a_side_view_that_shows_the_height_along_its_axis() {
+        // barrel_indexer: the cam's axis is the ground z, its plane the ground x-y: the side
+        // view keeps x and shows z; plane cams have none.
+        let geometry = Geometry::new(&builtin_description("barrel_indexer").unwrap()).unwrap();
+        let side = geometry.side_view().expect("a barrel is spatial");
+        let p = [0.06, 0.01, 0.035];
+        assert_eq!(geometry.plane.project(&p), (0.06, 0.01));
+        assert_eq!(side.plane.project(&p), (0.06, 0.035));
+        assert_eq!(side.plane.axis_labels().1, "along the cam's axis [m]");
+        for name in ["paper_concave", "face_cam", "cycloidal_roller"] {
+            let plane = Geometry::new(&builtin_description(name).unwrap()).unwrap();
+            assert!(plane.side_view().is_none(), "{name}");
         }
     }
 

@@ -389,6 +389,19 @@ fn draw_run(
     if let Some(figure) = figures::surface(&run) {
         figures.push((figure, "surface"));
     }
+    // A spatial cam's mechanism seen from the side too: the second orthogonal projection.
+    let side = run.geometry.and_then(|g| g.side_view());
+    if let Some(side) = &side {
+        let label = format!("{} seen from the side", run.label);
+        let view = RunView {
+            label: &label,
+            geometry: Some(side),
+            ..run
+        };
+        if let Ok(figure) = figures::snapshots(&view) {
+            figures.push((figure, "side"));
+        }
+    }
     let mut paths = Vec::new();
     for (figure, stem) in &figures {
         paths.extend(figure.save(dir, stem).map_err(|e| e.to_string())?);
