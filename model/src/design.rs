@@ -392,6 +392,9 @@ pub struct CamDesign {
     /// The nominal speed as the file writes it: [`Scalar::Param`] `i` is the model's
     /// parameter i (what sets the speed, for running the cam at another one).
     pub speed_expression: Option<Scalar>,
+    /// The roller runs in a groove (a face cam's, a barrel cam's): the flank beyond the
+    /// pitch curve, the profile moved out (up) by 2ρ, bounds it too.
+    pub groove: bool,
 }
 
 /// Everything the designer reads at one cam angle.
@@ -700,6 +703,7 @@ mod tests {
             max_pressure_angle: 0.5,
             speed: None,
             speed_expression: None,
+            groove: false,
         }
     }
 

@@ -214,6 +214,7 @@ mod tests {
             max_pressure_angle: 0.5,
             speed: Some(10.0),
             speed_expression: None,
+            groove: false,
         }
     }
 

@@ -341,6 +341,21 @@ pub fn profile(name: &str, design: &CamDesign, analysis: &Analysis) -> Figure {
     if outline == Outline::Circle {
         let prime = circle(g.base_radius + g.roller);
         frames.push(frame("pitch curve".into(), BLUE, vec![line(pitch.clone())]));
+        if design.groove {
+            // A face cam's groove: its outer flank, the pitch curve moved out by ρ.
+            let outer: Vec<(f64, f64)> = analysis
+                .points
+                .iter()
+                .map(|p| {
+                    (
+                        2.0 * p.pitch[0] - p.contact[0],
+                        2.0 * p.pitch[1] - p.contact[1],
+                    )
+                })
+                .collect();
+            visible.extend(outer.iter().copied());
+            frames.push(frame("outer flank".into(), GREY, vec![line(outer)]));
+        }
         frames.push(frame(
             "prime circle".into(),
             ORANGE,

@@ -214,11 +214,11 @@ pub fn design_summary(
         ),
         None => "concave nowhere".to_string(),
     };
-    let groove = matches!(g.motion, Motion::Axial { .. });
-    let curve = if groove {
-        "the groove's lower flank's radius of curvature (developed)"
-    } else {
-        "profile's radius of curvature"
+    let barrel = matches!(g.motion, Motion::Axial { .. });
+    let curve = match (barrel, design.groove) {
+        (true, _) => "the groove's lower flank's radius of curvature (developed)",
+        (false, true) => "the groove's inner flank's radius of curvature",
+        (false, false) => "profile's radius of curvature",
     };
     let _ = writeln!(text, "  {curve}: {convex}; {concave}");
     if let Some(undercut) = &analysis.undercut {
@@ -232,8 +232,9 @@ pub fn design_summary(
             metres(g.roller)
         );
     }
-    if groove {
-        // The upper flank is convex where the pitch curve is hollow seen from below it.
+    if design.groove {
+        // The upper (outer) flank is convex where the pitch curve is hollow seen from the
+        // lower (inner) one.
         let (theta, pitch) = design.least(camchain_codegen::design::DESIGN_SAMPLES, |p| {
             if p.pitch_radius < 0.0 {
                 -p.pitch_radius
@@ -241,15 +242,22 @@ pub fn design_summary(
                 f64::INFINITY
             }
         });
+        let flank = if barrel { "upper" } else { "outer" };
         if pitch.is_finite() {
             let _ = writeln!(
                 text,
-                "  the groove's upper flank: undercut margin {} (the pitch curve's smallest \
+                "  the groove's {flank} flank: undercut margin {} (the pitch curve's smallest \
                  concave radius {} at {}° less the roller's {})",
                 metres(pitch - g.roller),
                 metres(pitch),
                 degrees(theta, 3),
                 metres(g.roller)
+            );
+        } else {
+            let _ = writeln!(
+                text,
+                "  the groove's {flank} flank: the pitch curve is concave nowhere, so it cannot \
+                 be undercut"
             );
         }
     }

@@ -525,3 +525,54 @@ fn a_barrel_cam_design_reports_its_law_groove_and_jump_speed() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_face_cam_design_reports_both_flanks_of_its_groove() {
+    // models/face_cam.ron: the groove's centre line is the pitch curve of a modified sine
+    // law for an oscillating roller (ρ = 10 mm). The report's radii come from the design's
+    // closed forms; here the centre line's curvature comes from forward-mode jets of the
+    // model's own expressions (`camchain_model::samples`), sampled every 0.01° (the smallest
+    // radius is smooth there: off by ~R″Δθ²/2 ≈ 1e-9 m).
+    let dir = scratch("cam-face");
+    let stdout = cam(&dir, &["face_cam"]);
+    let model = parse_model_from(
+        camchain_models::source("face_cam").expect("built in"),
+        Path::new("models/face_cam.ron"),
+        &[],
+        ParameterMode::AsDeclared,
+        Files::Embedded(camchain_models::files("face_cam")),
+    )
+    .expect("valid");
+    let Profile::Face { centre } = &model.contacts[0].profile else {
+        panic!("a face cam: {:?}", model.contacts[0].profile)
+    };
+    let rho = 0.01;
+    let samples = camchain_codegen::samples::profile_samples(centre, (0.0, TAU), 36_000);
+    // Positive curvature is hollow seen from the follower's side (outside the centre line).
+    let hollow = samples
+        .iter()
+        .map(|s| s.curvature)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let sharpest = samples
+        .iter()
+        .filter(|s| s.curvature < 0.0)
+        .map(|s| -1.0 / s.curvature)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        hollow <= 0.0,
+        "the centre line is hollow somewhere: {hollow}"
+    );
+    assert!(
+        stdout.contains("the groove's outer flank: the pitch curve is concave nowhere"),
+        "{stdout}"
+    );
+    // The inner flank's margin: the centre line's smallest convex radius less ρ, printed to
+    // the micrometre.
+    let margin = value_after(&stdout, "undercut margin:", "margin: ");
+    assert!(
+        (margin - (sharpest - rho)).abs() < 1e-6,
+        "{margin} against {}",
+        sharpest - rho
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

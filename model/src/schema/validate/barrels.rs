@@ -85,6 +85,7 @@ pub(super) fn barrel_profile(
                 max_pressure_angle: pressure_limit(cx, &at, law.max_pressure_angle, 30.0)?,
                 speed: speed.as_ref().map(|s| s.0),
                 speed_expression: speed.map(|s| s.1),
+                groove: true,
             };
             can_be_made(cx, (path, &at), name, &design)?;
             (

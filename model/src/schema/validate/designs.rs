@@ -79,6 +79,7 @@ pub(super) fn law_profile(
         max_pressure_angle,
         speed: speed.as_ref().map(|s| s.0),
         speed_expression: speed.map(|s| s.1),
+        groove: traced == Traced::Pitch,
     };
     can_be_made(cx, (path, field), name, &design)?;
     let [x, y] = match traced {
