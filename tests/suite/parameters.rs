@@ -1,7 +1,8 @@
 //! Run-time parameters (issue 12 §1), checked three ways:
 //!
 //! - against the folded code: every built-in model (n_four_bar, forty copies of four_bar,
-//!   and paper_surface, paper_concave's chain on a turret, apart) compiled with every
+//!   paper_surface, paper_concave's chain on a turret, and paper_convex_text and
+//!   driven_convex, the same code as paper_convex and driven_concave, apart) compiled with every
 //!   parameter read at run
 //!   time (`ParameterMode::AllAtRunTime`) computes what the same model compiled with every
 //!   parameter folded (`ParameterMode::FoldAll`) computes, at 100 random states, to 1e-13;
@@ -50,9 +51,10 @@ fn by_name<'a>(
 
 #[test]
 fn every_parameter_read_at_run_time_gives_the_folded_code() {
-    // Every built-in model but n_four_bar, forty copies of four_bar, and paper_surface,
-    // paper_concave's chain on a turret (build.rs).
-    assert_eq!(all_at_run_time::ALL.len(), models::ALL.len() - 2);
+    // Every built-in model but n_four_bar, forty copies of four_bar, paper_surface,
+    // paper_concave's chain on a turret, and paper_convex_text and driven_convex, the same
+    // code as paper_convex and driven_concave in each mode (build.rs).
+    assert_eq!(all_at_run_time::ALL.len(), models::ALL.len() - 4);
     assert!(by_name(&all_at_run_time::ALL, "four_bar").info().n() > 0);
     for (name, runtime) in all_at_run_time::ALL.iter() {
         let folded = by_name(&folded::ALL, name);
