@@ -348,13 +348,23 @@ pub fn profile_expressions(
     senses: Senses,
     law: &Arc<Tabulated>,
 ) -> [Scalar; 2] {
+    in_cam_frame(g, senses, law, |placed| placed.contact)
+}
+
+/// A point of the placed follower (`which`) as an expression of u = −σθ in the cam frame:
+/// the law read at θ = −σu, the point turned by R(−σθ) = R(u).
+fn in_cam_frame(
+    g: &Geometry<Scalar>,
+    senses: Senses,
+    law: &Arc<Tabulated>,
+    which: impl Fn(Placed<Scalar>) -> V<Scalar>,
+) -> [Scalar; 2] {
     let theta = signed(-senses.turning, Scalar::Var(0));
     let s = theta.clone().tabulated(law, 0);
     let ds = theta.tabulated(law, 1);
-    let placed = place(g, senses, &s, &ds);
-    // R(−σθ) = R(u).
+    let point = which(place(g, senses, &s, &ds));
     let (cos, sin) = (Scalar::Var(0).cos(), Scalar::Var(0).sin());
-    turn(&placed.contact, &cos, &sin)
+    turn(&point, &cos, &sin)
 }
 
 /// The pitch curve of a design (the follower point's path: a knife's edge, a roller's
@@ -365,12 +375,7 @@ pub fn pitch_expressions(
     senses: Senses,
     law: &Arc<Tabulated>,
 ) -> [Scalar; 2] {
-    let theta = signed(-senses.turning, Scalar::Var(0));
-    let s = theta.clone().tabulated(law, 0);
-    let ds = theta.tabulated(law, 1);
-    let placed = place(g, senses, &s, &ds);
-    let (cos, sin) = (Scalar::Var(0).cos(), Scalar::Var(0).sin());
-    turn(&placed.pitch, &cos, &sin)
+    in_cam_frame(g, senses, law, |placed| placed.pitch)
 }
 
 /// A cam designed from a motion law, with its dimensions resolved to numbers: what the

@@ -63,6 +63,26 @@ fn peak(stdout: &str, quantity: &str) -> (f64, f64) {
     )
 }
 
+/// The file values of built-in model `model`'s parameters, by name.
+fn parameters_of(model: &str) -> impl Fn(&str) -> f64 {
+    let parameters = parse_model_from(
+        camchain_models::source(model).expect("built in"),
+        Path::new(&format!("models/{model}.ron")),
+        &[],
+        ParameterMode::AsDeclared,
+        Files::Embedded(camchain_models::files(model)),
+    )
+    .expect("valid")
+    .parameters;
+    move |name: &str| {
+        parameters
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.default)
+            .unwrap_or_else(|| panic!("no parameter {name}"))
+    }
+}
+
 fn relative(got: f64, expected: f64) -> f64 {
     (got - expected).abs() / expected.abs()
 }
@@ -218,22 +238,7 @@ fn the_predicted_jump_speed_is_where_bisection_finds_it() {
     // command prints 12 significant digits; its A, B, C are the dynamics' to Newton's
     // tolerance and its root is refined between samples 0.1° apart by a parabola, whose
     // error there (the fourth derivative of the root over θ times 0.1°⁴) is below 1e-9.
-    let parameters = parse_model_from(
-        camchain_models::source("cycloidal_roller").expect("built in"),
-        Path::new("models/cycloidal_roller.ron"),
-        &[],
-        ParameterMode::AsDeclared,
-        Files::Embedded(camchain_models::files("cycloidal_roller")),
-    )
-    .expect("valid")
-    .parameters;
-    let p = |name: &str| {
-        parameters
-            .iter()
-            .find(|p| p.name == name)
-            .map(|p| p.default)
-            .unwrap_or_else(|| panic!("no parameter {name}"))
-    };
+    let p = parameters_of("cycloidal_roller");
     let closed = cycloidal::Cycloidal {
         m: p("m"),
         g: p("g"),
@@ -474,22 +479,7 @@ fn a_barrel_cam_design_reports_its_law_groove_and_jump_speed() {
     // The jump speed predicted from bilateral runs against the closed form (the spring
     // holds the follower on the lower flank; surfaces.rs checks lift-off there).
     let predicted = value_after(&stdout, "predicted jump speed", "speed ");
-    let parameters = parse_model_from(
-        camchain_models::source("barrel_indexer").expect("built in"),
-        Path::new("models/barrel_indexer.ron"),
-        &[],
-        ParameterMode::AsDeclared,
-        Files::Embedded(camchain_models::files("barrel_indexer")),
-    )
-    .expect("valid")
-    .parameters;
-    let p = |name: &str| {
-        parameters
-            .iter()
-            .find(|p| p.name == name)
-            .map(|p| p.default)
-            .unwrap_or_else(|| panic!("no parameter {name}"))
-    };
+    let p = parameters_of("barrel_indexer");
     let law = cycloidal::Cycloidal {
         m: p("m"),
         g: p("g"),

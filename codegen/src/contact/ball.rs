@@ -189,26 +189,8 @@ pub fn on_revolution(
     }
     terms.cam_point = [g.mul(u[0], foot_r), g.mul(u[1], foot_r)];
     terms.cam_height = Some(terms.parameter);
-    // The larger principal curvature, positive where hollow seen from outside: the
-    // meridian's g″/W³ and the parallel circle's −1/(g W), as (a + b + |a − b|)/2.
-    terms.curvature = {
-        let w3 = {
-            let p = g.mul(stretch, stretch);
-            g.mul(p, stretch)
-        };
-        let along = g.div(g2, w3);
-        let across = {
-            let p = g.mul(foot_r, stretch);
-            let q = g.div(one, p);
-            g.neg(q)
-        };
-        let sum = g.add(along, across);
-        let gap = g.sub(along, across);
-        let gap2 = g.mul(gap, gap);
-        let spread = g.sqrt(gap2);
-        let total = g.add(sum, spread);
-        g.scale(0.5, total)
-    };
+    // The surface's larger principal curvature at the foot point, as for a point on it.
+    terms.curvature = super::revolution::larger_curvature(g, foot_r, g2, stretch);
     let velocity = [rel.velocity[0], rel.velocity[1], rel.height_rate];
     terms.sliding = sliding_speed(g, velocity, unit, &name);
     terms.relative = rel;

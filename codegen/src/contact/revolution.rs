@@ -15,10 +15,33 @@
 use super::relative::Relative;
 use super::surface::{sliding_speed, to_ground_vector};
 use super::{ContactTerms, Formulas};
-use crate::expr::Graph;
 use crate::expr::scalar::value_and_derivatives;
+use crate::expr::{Graph, Id};
 use crate::kinematics::{Symbols, vec3};
 use crate::model::{Field, Model};
+
+/// The larger principal curvature of r = g(z) where g = `radius`, g″ = `g2` and
+/// W = √(1 + g′²) = `stretch`, positive where hollow seen from outside: the meridian's
+/// g″/W³ and the parallel circle's −1/(g W), the larger as (a + b + |a − b|)/2.
+pub(super) fn larger_curvature(g: &mut Graph, radius: Id, g2: Id, stretch: Id) -> Id {
+    let one = g.one();
+    let w3 = {
+        let p = g.mul(stretch, stretch);
+        g.mul(p, stretch)
+    };
+    let meridian = g.div(g2, w3);
+    let parallel = {
+        let p = g.mul(radius, stretch);
+        let q = g.div(one, p);
+        g.neg(q)
+    };
+    let sum = g.add(meridian, parallel);
+    let gap = g.sub(meridian, parallel);
+    let gap2 = g.mul(gap, gap);
+    let spread = g.sqrt(gap2);
+    let total = g.add(sum, spread);
+    g.scale(0.5, total)
+}
 
 /// The terms of contact `index`, a point outside a surface of revolution.
 pub fn point(
@@ -101,26 +124,7 @@ pub fn point(
         [ux, uy, n].map(|c| g.div(c, stretch))
     };
     let normal = to_ground_vector(g, &rel, unit);
-    // Principal curvatures, positive where hollow seen from outside: the meridian's
-    // g″/W³ and the parallel circle's −1/(g W); the larger, as (a + b + |a − b|)/2.
-    let curvature = {
-        let w3 = {
-            let p = g.mul(stretch, stretch);
-            g.mul(p, stretch)
-        };
-        let meridian = g.div(g2, w3);
-        let parallel = {
-            let p = g.mul(radius, stretch);
-            let q = g.div(one, p);
-            g.neg(q)
-        };
-        let sum = g.add(meridian, parallel);
-        let gap = g.sub(meridian, parallel);
-        let gap2 = g.mul(gap, gap);
-        let spread = g.sqrt(gap2);
-        let total = g.add(sum, spread);
-        g.scale(0.5, total)
-    };
+    let curvature = larger_curvature(g, radius, g2, stretch);
     let sliding = sliding_speed(g, [vx, vy, vz], unit, &name);
     // The surface's point on the follower point's radius: (X, Y) g/r at the height Z.
     let cam_point = {

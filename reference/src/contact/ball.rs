@@ -72,7 +72,6 @@ impl ContactConst {
         point: Vec3,
         direction: Vec3,
     ) -> Evaluated {
-        let rho = self.follower.radius().copied().unwrap_or(0.0);
         let c = [seen.p[0], seen.p[1], seen.height[0]];
         let s = self.foot(c);
         let l = self.local(s);
@@ -81,13 +80,6 @@ impl ContactConst {
         let w = (1.0 + fu * fu + fv * fv).sqrt();
         let unit = [-fu / w, -fv / w, 1.0 / w];
         let foot = [s[0], s[1], l.f];
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let gap: [f64; 3] = std::array::from_fn(|k| c[k] - foot[k]);
-        let h = dot(unit, gap) - rho;
-        let jacobian: Vec<f64> = columns
-            .iter()
-            .map(|col| dot(unit, [col.v[0], col.v[1], col.height[1]]))
-            .collect();
         let velocity = [seen.v[0], seen.v[1], seen.height[1]];
         // The gradient of φ vanishes at the foot: its derivative along the motion gives the
         // foot's rate, (G − (Z − f) Hess f) ṡ = (Ẋ + f_u Ż, Ẏ + f_v Ż).
@@ -115,8 +107,38 @@ impl ContactConst {
             -gv / w + fv * w_dot / (w * w),
             -w_dot / (w * w),
         ];
+        let at = Foot {
+            point: foot,
+            unit,
+            unit_dot,
+            parameter: foot[0],
+            curvature: larger_principal_curvature([fu, fv], l.hessian),
+        };
+        self.ball_at(at, (seen, columns), frame, (point, direction))
+    }
+
+    /// h = N·(C − S) − ρ, J = N·∂C/∂q, c = N·C̈° + Ṅ·Ċ and the outputs of a ball whose foot
+    /// point is `at`.
+    fn ball_at(
+        &self,
+        at: Foot,
+        (seen, columns): (&Seen, &[Seen]),
+        frame: &CamFrame,
+        (point, direction): (Vec3, Vec3),
+    ) -> Evaluated {
+        let rho = self.follower.radius().copied().unwrap_or(0.0);
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (foot, unit) = (at.point, at.unit);
+        let c = [seen.p[0], seen.p[1], seen.height[0]];
+        let gap: [f64; 3] = std::array::from_fn(|k| c[k] - foot[k]);
+        let h = dot(unit, gap) - rho;
+        let jacobian: Vec<f64> = columns
+            .iter()
+            .map(|col| dot(unit, [col.v[0], col.v[1], col.height[1]]))
+            .collect();
+        let velocity = [seen.v[0], seen.v[1], seen.height[1]];
         let convective = [seen.a[0], seen.a[1], seen.height[2]];
-        let bias = dot(unit, convective) + dot(unit_dot, velocity);
+        let bias = dot(unit, convective) + dot(at.unit_dot, velocity);
         let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
         let position = frame.origin + frame.x * foot[0] + frame.y * foot[1] + frame.axis * foot[2];
         let geometry = ContactGeometry {
@@ -128,13 +150,23 @@ impl ContactConst {
             normal: normal.into(),
             axis: frame.axis.into(),
             force_scale: 1.0,
-            parameter: foot[0],
-            curvature: larger_principal_curvature([fu, fv], l.hessian),
+            parameter: at.parameter,
+            curvature: at.curvature,
             direction: direction.into(),
             sliding_speed: tangential_speed(velocity, unit),
         };
         spatial(h, jacobian, bias, geometry, seen, columns)
     }
+}
+
+/// A ball's foot point S with the unit normal N there and its rate Ṅ (cam frame), the
+/// contact parameter and the surface's larger principal curvature at S.
+struct Foot {
+    point: [f64; 3],
+    unit: [f64; 3],
+    unit_dot: [f64; 3],
+    parameter: f64,
+    curvature: f64,
 }
 
 impl ContactConst {
@@ -186,7 +218,6 @@ impl ContactConst {
         point: Vec3,
         direction: Vec3,
     ) -> Evaluated {
-        let rho = self.follower.radius().copied().unwrap_or(0.0);
         let [x, y] = seen.p;
         let z = seen.height[0];
         let r = x.hypot(y);
@@ -196,13 +227,6 @@ impl ContactConst {
         let w = (1.0 + g.d1 * g.d1).sqrt();
         let unit = [cos / w, sin / w, -g.d1 / w];
         let foot = [g.v * cos, g.v * sin, t];
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let gap = [x - foot[0], y - foot[1], z - foot[2]];
-        let h = dot(unit, gap) - rho;
-        let jacobian: Vec<f64> = columns
-            .iter()
-            .map(|c| dot(unit, [c.v[0], c.v[1], c.height[1]]))
-            .collect();
         let velocity = [seen.v[0], seen.v[1], seen.height[1]];
         let r_dot = cos * velocity[0] + sin * velocity[1];
         let phi_dot = (x * velocity[1] - y * velocity[0]) / (r * r);
@@ -218,27 +242,16 @@ impl ContactConst {
             cos * phi_dot * radial + sin * radial_dot,
             up_dot,
         ];
-        let convective = [seen.a[0], seen.a[1], seen.height[2]];
-        let bias = dot(unit, convective) + dot(unit_dot, velocity);
-        let normal = frame.x * unit[0] + frame.y * unit[1] + frame.axis * unit[2];
-        let position = frame.origin + frame.x * foot[0] + frame.y * foot[1] + frame.axis * foot[2];
         // Principal curvatures of the surface at the foot, positive where hollow seen from
         // outside: the meridian's g″/W³, the parallel's −1/(g W).
         let (along, across) = (g.d2 / w.powi(3), -1.0 / (g.v * w));
-        let geometry = ContactGeometry {
-            position: position.into(),
-            x: foot[0],
-            y: foot[1],
-            z: foot[2],
-            follower: point.into(),
-            normal: normal.into(),
-            axis: frame.axis.into(),
-            force_scale: 1.0,
+        let at = Foot {
+            point: foot,
+            unit,
+            unit_dot,
             parameter: t,
             curvature: along.max(across),
-            direction: direction.into(),
-            sliding_speed: tangential_speed(velocity, unit),
         };
-        spatial(h, jacobian, bias, geometry, seen, columns)
+        self.ball_at(at, (seen, columns), frame, (point, direction))
     }
 }

@@ -3,6 +3,7 @@
 //! axis, each misuse located at its field (docs/model-format.md, "Barrel cams").
 
 use super::designs::{can_be_made, nominal_speed, pressure_limit, program, sense};
+use super::faces::in_a_groove;
 use super::fields::positive;
 use super::parameters::expression;
 use super::{Checked, Context, Follower, Profile};
@@ -11,7 +12,6 @@ use crate::jet::{Jet2, eval_on, own_tables};
 use crate::model::Field;
 use crate::profile::{Scalar, Tabulated};
 use crate::schema::raw;
-use camchain_runtime::kinds::FollowerKind;
 use std::f64::consts::TAU;
 
 /// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`, with its
@@ -26,19 +26,7 @@ pub(super) fn barrel_profile(
     follower: &Follower,
 ) -> Checked<(Profile, Option<CamDesign>)> {
     let field = format!("{path}.barrel");
-    match follower.kind() {
-        FollowerKind::Knife | FollowerKind::Roller => {}
-        FollowerKind::Flat | FollowerKind::Mushroom => {
-            return Err(cx.at.error(
-                &format!("{path}.follower"),
-                format!(
-                    "a {} cannot run in a barrel cam's groove: give a roller (`follower: \
-                     Roller(radius: …)`, its centre the marker) or a knife edge",
-                    follower.kind().label()
-                ),
-            ));
-        }
-    }
+    in_a_groove(cx, path, follower, "a barrel cam's groove")?;
     // The radius places the drawings and the designer's outputs; the constraint reads the
     // follower point's own distance from the axis, so it may be a run-time parameter.
     let at = format!("{field}.radius");

@@ -24,19 +24,7 @@ pub(super) fn face_profile(
     follower: &Follower,
 ) -> Checked<(Profile, Option<CamDesign>)> {
     let field = format!("{path}.face");
-    match follower.kind() {
-        FollowerKind::Knife | FollowerKind::Roller => {}
-        FollowerKind::Flat | FollowerKind::Mushroom => {
-            return Err(cx.at.error(
-                &format!("{path}.follower"),
-                format!(
-                    "a {} cannot run in a face cam's groove: give a roller (`follower: \
-                     Roller(radius: …)`, its centre the marker) or a knife edge",
-                    follower.kind().label()
-                ),
-            ));
-        }
-    }
+    in_a_groove(cx, path, follower, "a face cam's groove")?;
     let (centre, design) = match (&face.groove, &face.law) {
         (Some(source), None) => {
             let at = format!("{field}.groove");
@@ -75,6 +63,27 @@ pub(super) fn face_profile(
         },
         design,
     ))
+}
+
+/// Only a roller (its centre the marker) or a knife edge runs in a groove (`groove` names
+/// it in the message); a flat or curved face is refused at the follower.
+pub(super) fn in_a_groove(
+    cx: &Context,
+    path: &str,
+    follower: &Follower,
+    groove: &str,
+) -> Checked<()> {
+    match follower.kind() {
+        FollowerKind::Knife | FollowerKind::Roller => Ok(()),
+        FollowerKind::Flat | FollowerKind::Mushroom => Err(cx.at.error(
+            &format!("{path}.follower"),
+            format!(
+                "a {} cannot run in {groove}: give a roller (`follower: Roller(radius: …)`, its \
+                 centre the marker) or a knife edge",
+                follower.kind().label()
+            ),
+        )),
+    }
 }
 
 /// A groove holds a roller of radius ρ on both flanks only where its centre line bends
