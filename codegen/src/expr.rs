@@ -54,11 +54,20 @@ pub enum Node {
     /// a cubic) or a motion law (segment look-up and the law's closed form), evaluated by the
     /// runtime; orders 0 to 3 are exact.
     Table(u32, u8, Id),
+    /// ∂ᵖ_x ∂ᵠ_y, `.1` = (p, q), of surface `.0` of the graph ([`Graph::add_grid`]) at
+    /// (a, b): a bicubic spline through a grid of points (cell look-up and the tensor-product
+    /// cubic), evaluated by the runtime; exact for every order (zero beyond the third in
+    /// either variable).
+    Grid(u32, (u8, u8), Id, Id),
 }
 
 /// A tabulated function of the graph: a spline through a table of points or a motion law,
 /// evaluated by the runtime ([`crate::profile::Tabulated`]).
 pub type Table = std::sync::Arc<crate::profile::Tabulated>;
+
+/// A surface of the graph given on a grid, evaluated by the runtime
+/// ([`crate::profile::Gridded`]).
+pub type Grid = std::sync::Arc<crate::profile::Gridded>;
 
 /// Operation counts of a set of expressions, each shared node counted once.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -127,6 +136,8 @@ pub struct Graph {
     implicits: HashMap<u32, Implicit>,
     /// The tabulated functions [`Node::Table`] refers to.
     tables: Vec<Table>,
+    /// The surfaces [`Node::Grid`] refers to.
+    grids: Vec<Grid>,
     /// The most nodes the graph takes ([`NODE_LIMIT`] when 0).
     node_limit: usize,
     /// Set when a node was asked for beyond the limit (see [`Graph::exhausted`]).
@@ -663,6 +674,37 @@ impl Graph {
         }
     }
 
+    /// Registers a surface given on a grid (once per name); returns its index for
+    /// [`Graph::grid`].
+    pub fn add_grid(&mut self, grid: Grid) -> u32 {
+        if let Some(k) = self.grids.iter().position(|g| g.name == grid.name) {
+            return k as u32;
+        }
+        self.grids.push(grid);
+        (self.grids.len() - 1) as u32
+    }
+
+    /// The surfaces given on grids, by index.
+    pub fn grids(&self) -> &[Grid] {
+        &self.grids
+    }
+
+    /// ∂ᵖ_x ∂ᵠ_y (`order` = (p, q)) of surface `k` at (a, b), with folding: constant
+    /// arguments give a constant, an order above 3 in either variable zero (the spline is
+    /// cubic in each inside every cell).
+    pub fn grid(&mut self, k: u32, order: (u8, u8), a: Id, b: Id) -> Id {
+        let Some(grid) = self.grids.get(k as usize).cloned() else {
+            return self.constant(f64::NAN);
+        };
+        if order.0 > 3 || order.1 > 3 {
+            return self.zero();
+        }
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => self.constant(grid.derivative(order, x, y)),
+            _ => self.intern(Node::Grid(k, order, a, b)),
+        }
+    }
+
     /// sin a
     pub fn sin(&mut self, a: Id) -> Id {
         self.call(Func::Sin, a)
@@ -723,6 +765,7 @@ impl Graph {
             Node::Powi(a, n) => self.powi(new(a), n),
             Node::Call(f, a) => self.call(f, new(a)),
             Node::Table(t, order, a) => self.table(t, order, new(a)),
+            Node::Grid(k, order, a, b) => self.grid(k, order, new(a), new(b)),
         }
     }
 
@@ -758,6 +801,10 @@ impl Graph {
                     .tables
                     .get(*t as usize)
                     .map_or(f64::NAN, |table| table.derivative(*order, v(a))),
+                Node::Grid(k, order, a, b) => self
+                    .grids
+                    .get(*k as usize)
+                    .map_or(f64::NAN, |grid| grid.derivative(*order, v(a), v(b))),
             };
             values.push(value);
         }
@@ -811,7 +858,11 @@ impl Graph {
                 .map(|d| d.inputs.clone())
                 .unwrap_or_default(),
             Node::Const(_) => vec![],
-            Node::Add(a, b) | Node::Mul(a, b) | Node::Div(a, b) | Node::Powf(a, b) => vec![a, b],
+            Node::Add(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Powf(a, b)
+            | Node::Grid(_, _, a, b) => vec![a, b],
             Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Table(_, _, a) => vec![a],
         }
     }
@@ -863,9 +914,11 @@ impl Graph {
                 Node::Div(..) => count.div += 1,
                 Node::Call(Func::Sin | Func::Cos, _) => count.sin_cos += 1,
                 Node::Call(Func::Sqrt, _) => count.sqrt += 1,
-                Node::Powi(..) | Node::Powf(..) | Node::Call(..) | Node::Table(..) => {
-                    count.other += 1
-                }
+                Node::Powi(..)
+                | Node::Powf(..)
+                | Node::Call(..)
+                | Node::Table(..)
+                | Node::Grid(..) => count.other += 1,
             }
         }
         count

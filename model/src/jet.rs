@@ -6,7 +6,9 @@
 //! here the same tree is evaluated on truncated Taylor polynomials ([`Jet2`]), an independent
 //! route to the same three numbers. A function given by data ([`Scalar::Table`]) is
 //! differentiated by a [`TableDerivative`]: its own ([`own_tables`], the runtime's spline and
-//! motion law) or the caller's (the numeric reference brings its own spline).
+//! motion law) or the caller's (the numeric reference brings its own spline); a surface
+//! given on a grid ([`Scalar::Grid`]) by its own bicubic spline (the reference evaluates
+//! those on its own route in its tape).
 
 use crate::profile::{Func, Scalar, Tabulated};
 use std::ops::{Add, Div, Mul, Neg, Sub};
@@ -57,6 +59,23 @@ impl Jet2 {
             v: g,
             d1: dg * self.d1,
             d2: ddg * self.d1 * self.d1 + dg * self.d2,
+        }
+    }
+
+    /// Chain rule g(a, b) for a function of two variables, given its partial derivatives
+    /// `d(i, j)` = ∂ⁱ_a ∂ʲ_b g at (a.v, b.v), i + j ≤ 2:
+    /// (g∘(a, b))' = g_a a' + g_b b', (g∘(a, b))'' = g_aa a'² + 2 g_ab a' b' + g_bb b'² +
+    /// g_a a'' + g_b b''.
+    pub fn compose2(a: Self, b: Self, d: impl Fn(u8, u8) -> f64) -> Self {
+        let (ga, gb) = (d(1, 0), d(0, 1));
+        Self {
+            v: d(0, 0),
+            d1: ga * a.d1 + gb * b.d1,
+            d2: d(2, 0) * a.d1 * a.d1
+                + 2.0 * d(1, 1) * a.d1 * b.d1
+                + d(0, 2) * b.d1 * b.d1
+                + ga * a.d2
+                + gb * b.d2,
         }
     }
 
@@ -273,6 +292,10 @@ pub fn eval_on_all(expr: &Scalar, vars: &[Jet2], tables: &TableDerivative) -> Je
             let d = |k: u8| tables(t, order + k, inner.v);
             inner.compose(d(0), d(1), d(2))
         }
+        Scalar::Grid(g, (p, q), a, b) => {
+            let (a, b) = (ev(a), ev(b));
+            Jet2::compose2(a, b, |i, j| g.derivative((p + i, q + j), a.v, b.v))
+        }
     }
 }
 
@@ -295,6 +318,7 @@ pub fn eval_with(expr: &Scalar, x: f64, values: &[f64], tables: &TableDerivative
         Scalar::Powf(a, b) => ev(a).powf(ev(b)),
         Scalar::Call(func, a) => Jet2::constant(ev(a)).apply(*func).v,
         Scalar::Table(t, order, a) => tables(t, *order, ev(a)),
+        Scalar::Grid(g, order, a, b) => g.derivative(*order, ev(a), ev(b)),
     }
 }
 

@@ -24,6 +24,7 @@
 //! ```
 
 mod contact;
+pub mod grid;
 pub mod jet;
 mod loops;
 mod motion;

@@ -64,13 +64,18 @@ impl Hermite {
     /// The spline of `spline`'s table and ends, solved for its knot slopes in O(n) (non-finite
     /// slopes only for a table the runtime refuses anyway: a zero pivot needs a zero step).
     pub fn new(spline: &Spline) -> Self {
-        let (x, y) = (spline.abscissas().to_vec(), spline.values().to_vec());
-        let d = slopes(&x, &y, spline.ends());
+        Self::through(spline.abscissas(), spline.values(), spline.ends())
+    }
+
+    /// The spline through (x, y) with `ends`, for a table already checked (as the runtime's
+    /// [`Spline::new`] checks it: enough increasing knots, a periodic table closing).
+    pub fn through(x: &[f64], y: &[f64], ends: Ends) -> Self {
+        let d = slopes(x, y, ends);
         Hermite {
-            x,
-            y,
+            x: x.to_vec(),
+            y: y.to_vec(),
             d,
-            periodic: spline.is_periodic(),
+            periodic: ends == Ends::Periodic,
         }
     }
 

@@ -13,7 +13,7 @@
 //! those of the trees.
 
 use crate::jet::Jet2;
-use camchain_model::profile::{Func, Scalar, Tabulated};
+use camchain_model::profile::{Func, Gridded, Scalar, Tabulated};
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -32,6 +32,7 @@ enum Entry {
     Powf(usize, usize),
     Call(Func, usize),
     Table(Arc<Tabulated>, u8, usize),
+    Grid(Arc<Gridded>, (u8, u8), usize, usize),
 }
 
 /// What makes two entries the same: the operation, its constants and its operands.
@@ -42,6 +43,7 @@ enum Key {
     Unary(u8, usize, i64),
     Binary(u8, usize, usize),
     Table(usize, u8, usize),
+    Grid(usize, (u8, u8), usize, usize),
 }
 
 /// Expressions of one variable flattened with their common subexpressions merged.
@@ -85,6 +87,7 @@ impl Tape {
                 Entry::Powf(a, b) => v(a).powf(v(b)),
                 Entry::Call(f, a) => Jet2::constant(v(a)).apply(*f).v,
                 Entry::Table(t, order, a) => crate::spline::derivative(t, *order, v(a)),
+                Entry::Grid(g, order, a, b) => crate::grid::derivative(g, *order, v(a), v(b)),
             };
             values.push(value);
         }
@@ -121,6 +124,12 @@ impl Tape {
                     let inner = v(a);
                     let d = |k: u8| crate::spline::derivative(t, order + k, inner.v);
                     inner.compose(d(0), d(1), d(2))
+                }
+                Entry::Grid(g, (p, q), a, b) => {
+                    let (a, b) = (v(a), v(b));
+                    Jet2::compose2(a, b, |i, j| {
+                        crate::grid::derivative(g, (p + i, q + j), a.v, b.v)
+                    })
                 }
             };
             values.push(value);
@@ -175,6 +184,11 @@ impl Builder {
                 // The function's address identifies it: the tape holds it, so it stays.
                 let key = Key::Table(Arc::as_ptr(t) as usize, *order, a);
                 (key, Entry::Table(t.clone(), *order, a))
+            }
+            Scalar::Grid(g, order, a, b) => {
+                let (a, b) = (self.add(a), self.add(b));
+                let key = Key::Grid(Arc::as_ptr(g) as usize, *order, a, b);
+                (key, Entry::Grid(g.clone(), *order, a, b))
             }
         };
         if let Some(&k) = self.index.get(&key) {

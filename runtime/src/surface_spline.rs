@@ -240,14 +240,6 @@ pub struct SurfacePoint {
 }
 
 impl SurfacePoint {
-    /// Every component NaN: what [`evaluate`] returns for slices that do not form a grid.
-    const NAN: SurfacePoint = SurfacePoint {
-        value: f64::NAN,
-        gradient: [f64::NAN; 2],
-        hessian: [f64::NAN; 3],
-        third: [f64::NAN; 4],
-    };
-
     /// Picks the components out of `d[p][q]` = ∂ᵖ_x ∂ᵠ_y S.
     fn from_partials(d: &[[f64; 4]; 4]) -> Self {
         SurfacePoint {
@@ -379,6 +371,15 @@ impl SurfaceSpline {
     /// The value and derivatives at (x, y) ([`evaluate`]).
     pub fn eval(&self, x: f64, y: f64) -> SurfacePoint {
         evaluate(&self.table(), x, y)
+    }
+
+    /// ∂ᵖ_x ∂ᵠ_y S at (x, y) for every p, q ([`partials`]; zero beyond the third in either
+    /// variable).
+    pub fn partial(&self, (p, q): (u8, u8), x: f64, y: f64) -> f64 {
+        match (usize::from(p), usize::from(q)) {
+            (p @ 0..=3, q @ 0..=3) => partials(&self.table(), x, y)[p][q],
+            _ => 0.0,
+        }
     }
 }
 
@@ -593,13 +594,22 @@ fn wrap(knots: &[f64], periodic: bool, s: f64) -> f64 {
 /// give NaN everywhere rather than a panic; [`check_grid`] and [`SurfaceSpline::new`] are
 /// where a grid is checked, once.
 pub fn evaluate(table: &SurfaceTable<'_>, x: f64, y: f64) -> SurfacePoint {
+    SurfacePoint::from_partials(&partials(table, x, y))
+}
+
+/// Every partial derivative ∂ᵖ_x ∂ᵠ_y S at (x, y) with p, q ≤ 3, as `d[p][q]`: the same cell
+/// and polynomial as [`evaluate`]. Those with p > 3 or q > 3 vanish (S is cubic in each
+/// variable inside a cell), so these sixteen are all the derivatives there are; generated
+/// code reads its surfaces' derivatives of any order from them. NaN everywhere for slices
+/// that do not form a grid.
+pub fn partials(table: &SurfaceTable<'_>, x: f64, y: f64) -> [[f64; 4]; 4] {
     if !table.is_grid() {
-        return SurfacePoint::NAN;
+        return [[f64::NAN; 4]; 4];
     }
     let x = wrap(table.x, table.periodic[0], x);
     let y = wrap(table.y, table.periodic[1], y);
     let (i, j) = (spline::segment(table.x, x), spline::segment(table.y, y));
-    SurfacePoint::from_partials(&cell(table, i, j, x, y))
+    cell(table, i, j, x, y)
 }
 
 /// ∂ᵖ_x ∂ᵠ_y S at (x, y), `d[p][q]` for p, q ≤ 3, of the polynomial of cell (i, j) (also

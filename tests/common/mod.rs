@@ -81,6 +81,22 @@ pub fn compare_dynamics(
 /// A state (q, q̇, t) at which two models are compared.
 pub type State = (Vec<f64>, Vec<f64>, f64);
 
+/// `count` states within ±`spread` (rad or m) of the configuration `q0`, with rates in
+/// ±2 and times in [0, 10], drawn from `seed`: for models whose contacts are only defined
+/// near their assembled configuration.
+pub fn states_near(q0: &[f64], spread: f64, count: usize, seed: u64) -> Vec<State> {
+    let mut rng = Rng::new(seed);
+    (0..count)
+        .map(|_| {
+            let q = q0
+                .iter()
+                .map(|x| x + rng.uniform(-spread, spread))
+                .collect();
+            (q, rng.vec(q0.len(), -2.0, 2.0), rng.uniform(0.0, 10.0))
+        })
+        .collect()
+}
+
 /// [`compare_dynamics`] at the given states (for models whose contacts are only defined
 /// near their assembled configuration: a flat face on an open profile).
 pub fn compare_dynamics_at(
@@ -250,6 +266,7 @@ pub fn for_tables(model: &camchain_reference::NumericModel, tol: f64) -> f64 {
         matches!(
             c.profile_expression(),
             camchain_codegen::profile::Scalar::Table(..)
+                | camchain_codegen::profile::Scalar::Grid(..)
         )
     });
     if tabulated { tol.max(1e-10) } else { tol }

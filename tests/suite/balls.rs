@@ -206,18 +206,7 @@ fn the_compiled_balls_agree_with_the_numeric_reference_at_random_states() {
         let numeric =
             NumericModel::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
         let start = generated.assemble(0.0).expect("assembles");
-        let n = start.q.len();
-        let mut rng = crate::common::Rng::new(0xba11);
-        let states: Vec<crate::common::State> = (0..100)
-            .map(|_| {
-                let q = start
-                    .q
-                    .iter()
-                    .map(|x| x + rng.uniform(-0.02, 0.02))
-                    .collect();
-                (q, rng.vec(n, -2.0, 2.0), rng.uniform(0.0, 10.0))
-            })
-            .collect();
+        let states = crate::common::states_near(&start.q, 0.02, 100, 0xba11);
         // As for the built-in models (generated_vs_numeric.rs): 1e-12 relative to
         // max(1, |·|); the foot points are Newton's to rounding on both sides (measured
         // 7e-15 on the bowl).

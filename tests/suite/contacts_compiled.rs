@@ -9,7 +9,7 @@ use crate::common;
 use camchain::runtime::{Dynamics, Simulate};
 use camchain_models::contact_models;
 use camchain_reference::NumericModel;
-use common::{Rng, State, compare_dynamics_at, max_rel_diff};
+use common::{compare_dynamics_at, max_rel_diff};
 use std::path::Path;
 
 fn numeric() -> NumericModel {
@@ -26,20 +26,9 @@ fn the_compiled_zoo_agrees_with_the_numeric_reference() {
     let numeric = numeric();
     assert_eq!(generated.info(), numeric.info(), "model information");
     let start = generated.assemble().expect("assembles");
-    let n = start.q.len();
-    let mut rng = Rng::new(0x5eed);
     // Within 0.05 rad or m of the assembled configuration: each follower stays near its cam
     // (a flat face on the open cap has no support point once turned past its slopes).
-    let states: Vec<State> = (0..100)
-        .map(|_| {
-            let q = start
-                .q
-                .iter()
-                .map(|x| x + rng.uniform(-0.05, 0.05))
-                .collect();
-            (q, rng.vec(n, -2.0, 2.0), rng.uniform(0.0, 10.0))
-        })
-        .collect();
+    let states = common::states_near(&start.q, 0.05, 100, 0x5eed);
     // As for the built-in models (generated_vs_numeric.rs): 1e-12 relative to max(1, |·|).
     let worst = compare_dynamics_at("zoo", &generated.clone(), &numeric, 1e-12, &states);
     println!("zoo: largest relative difference generated vs numeric {worst:.2e}");

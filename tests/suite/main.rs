@@ -16,6 +16,7 @@ mod designs;
 mod eccentric;
 mod faces;
 mod generated_vs_numeric;
+mod grids;
 mod integrators;
 mod loops;
 mod metrics;

@@ -68,7 +68,7 @@ fn the_paper_cam_as_a_surface_reproduces_the_planar_run() {
 }
 
 /// Ten revolutions of the paraboloid orbit at tight tolerances.
-fn orbit(m: &dyn Dynamics) -> Vec<camchain::runtime::Sample> {
+pub(crate) fn orbit(m: &dyn Dynamics) -> Vec<camchain::runtime::Sample> {
     let mut settings: SimSettings = m.info().defaults.clone();
     settings.rtol = 1e-13;
     settings.atol = 1e-15;

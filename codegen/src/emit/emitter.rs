@@ -49,6 +49,8 @@ pub(super) struct Emitter<'g> {
     /// The bound result of each tabulated function's call, by (function, argument): every
     /// derivative read at one argument comes from one look-up.
     table_calls: HashMap<(u32, Id), String>,
+    /// The bound result of each surface's call, by (surface, x, y), likewise.
+    grid_calls: HashMap<(u32, Id, Id), String>,
 }
 
 impl<'g> Emitter<'g> {
@@ -106,6 +108,7 @@ impl<'g> Emitter<'g> {
             solve_inputs,
             solves_read_derived: false,
             table_calls: HashMap::new(),
+            grid_calls: HashMap::new(),
         }
     }
 
@@ -118,7 +121,7 @@ impl<'g> Emitter<'g> {
         }
         match self.g.node(id) {
             Node::Const(_) | Node::Var(_) | Node::Neg(_) => false,
-            Node::Call(..) | Node::Powf(..) | Node::Table(..) => true,
+            Node::Call(..) | Node::Powf(..) | Node::Table(..) | Node::Grid(..) => true,
             _ => self.uses[id.index()] >= 2 || self.g.label_of(id).is_some(),
         }
     }
@@ -207,6 +210,9 @@ impl<'g> Emitter<'g> {
             if let Node::Table(t, _, a) = self.g.node(id) {
                 self.bind_table_call(t, a, &mut text, &mut taken);
             }
+            if let Node::Grid(k, _, a, b) = self.g.node(id) {
+                self.bind_grid_call(k, (a, b), &mut text, &mut taken);
+            }
             let expr = match self.given.get(&id) {
                 Some(source) => source.clone(),
                 None => self.render(id).0,
@@ -229,7 +235,11 @@ impl<'g> Emitter<'g> {
         }
         let operands = match self.g.node(id) {
             Node::Const(_) | Node::Var(_) => return 1,
-            Node::Add(a, b) | Node::Mul(a, b) | Node::Div(a, b) | Node::Powf(a, b) => [a, b],
+            Node::Add(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Powf(a, b)
+            | Node::Grid(_, _, a, b) => [a, b],
             Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Table(_, _, a) => [a, a],
         };
         let of = |c: Id| {
@@ -348,6 +358,33 @@ impl<'g> Emitter<'g> {
         self.table_calls.insert((t, a), call);
     }
 
+    /// `let <name>_at = eval_<name>(x, y);` the first time surface `k` is read at (x, y):
+    /// every partial derivative there comes from that one call.
+    fn bind_grid_call(
+        &mut self,
+        k: u32,
+        (a, b): (Id, Id),
+        text: &mut String,
+        taken: &mut HashSet<String>,
+    ) {
+        if self.grid_calls.contains_key(&(k, a, b)) {
+            return;
+        }
+        let name = self
+            .g
+            .grids()
+            .get(k as usize)
+            .map_or("surface", |g| g.name.as_str());
+        let call = fresh(&format!("{name}_at"), taken);
+        let _ = writeln!(
+            text,
+            "let {call} = eval_{name}({}, {});",
+            self.print(a, 0),
+            self.print(b, 0)
+        );
+        self.grid_calls.insert((k, a, b), call);
+    }
+
     /// `let (s_a, c_a) = rt::sin_cos_memo(a, &mut cache[k..k + 3]);`, naming both nodes.
     fn memo_binding(&mut self, m: TrigMemo, taken: &mut HashSet<String>) -> String {
         let angle = match self.g.node(m.sin) {
@@ -398,6 +435,13 @@ impl<'g> Emitter<'g> {
                     .get(usize::from(order))
                     .unwrap_or(&"");
                 format!("{}{suffix}", t.name)
+            }),
+            Node::Grid(k, (p, q), ..) => self.g.grids().get(k as usize).map(|g| {
+                let (x, y) = ("x".repeat(usize::from(p)), "y".repeat(usize::from(q)));
+                match (p, q) {
+                    (0, 0) => g.name.clone(),
+                    _ => format!("{}_d{x}{y}", g.name),
+                }
             }),
             Node::Add(..) => angle_name(self.g, id).map(|parts| format!("angle_{parts}")),
             Node::Mul(a, b) if a == b => self.names.get(&a).map(|name| format!("{name}_sq")),
@@ -461,6 +505,18 @@ impl<'g> Emitter<'g> {
                 None => {
                     let name = self.g.tables().get(t as usize).map_or("table", |t| &t.name);
                     (format!("eval_{name}({})[{order}]", self.print(a, 0)), 4)
+                }
+            },
+            Node::Grid(k, (p, q), a, b) => match self.grid_calls.get(&(k, a, b)) {
+                Some(call) => (format!("{call}[{p}][{q}]"), 5),
+                None => {
+                    let name = self
+                        .g
+                        .grids()
+                        .get(k as usize)
+                        .map_or("surface", |g| &g.name);
+                    let (x, y) = (self.print(a, 0), self.print(b, 0));
+                    (format!("eval_{name}({x}, {y})[{p}][{q}]"), 4)
                 }
             },
         }

@@ -67,7 +67,11 @@ impl FusedTerms {
             .filter(|&id| {
                 matches!(
                     g.node(id),
-                    Node::Call(..) | Node::Powf(..) | Node::Div(..) | Node::Table(..)
+                    Node::Call(..)
+                        | Node::Powf(..)
+                        | Node::Div(..)
+                        | Node::Table(..)
+                        | Node::Grid(..)
                 ) || g.implicit_of(id).is_some()
             })
             .collect();

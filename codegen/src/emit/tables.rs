@@ -19,7 +19,67 @@ pub(super) fn table_helpers(g: &Graph) -> String {
         };
         out.push_str(&text);
     }
+    for grid in g.grids() {
+        out.push_str(&grid_helper(&grid.name, &grid.spline));
+    }
     out
+}
+
+/// The constants and the evaluation function of a spline surface named `name`: its knots,
+/// values and knot derivatives (computed at build time) for
+/// `camchain_runtime::surface_spline::partials`.
+pub(super) fn grid_helper(
+    name: &str,
+    surface: &camchain_runtime::surface_spline::SurfaceSpline,
+) -> String {
+    let upper = name.to_uppercase();
+    let (nx, ny) = surface.shape();
+    let n = nx * ny;
+    let periodic = surface.is_periodic();
+    let array = |suffix: &str, what: &str, len: usize, values: &[f64]| {
+        format!(
+            "/// {name}: {what}.\n{ALLOW_LITERALS}\nconst {upper}_{suffix}: [f64; {len}] = {};\n",
+            float_list(values)
+        )
+    };
+    let axis = |p: bool| {
+        if p {
+            "periodic"
+        } else {
+            "open, its end cells' cubics continuing beyond the grid"
+        }
+    };
+    format!(
+        "{}{}{}{}{}{}\
+         /// {name}: a C² bicubic spline surface through a {nx} × {ny} grid (x {}; y {}).\n\
+         const {upper}: rt::surface_spline::SurfaceTable<'static> = \
+         rt::surface_spline::SurfaceTable {{ x: &{upper}_X, y: &{upper}_Y, z: &{upper}_Z, \
+         mx: &{upper}_MX, my: &{upper}_MY, mxy: &{upper}_MXY, periodic: [{}, {}] }};\n\
+         /// {name}: ∂ᵖ_x ∂ᵠ_y at (x, y) as `[p][q]`, p, q ≤ 3.\n\
+         #[inline]\n\
+         fn eval_{name}(x: f64, y: f64) -> [[f64; 4]; 4] {{\n\
+         rt::surface_spline::partials(&{upper}, x, y)\n}}\n",
+        array("X", "the x knots", nx, surface.x_knots()),
+        array("Y", "the y knots", ny, surface.y_knots()),
+        array(
+            "Z",
+            "the values z(x_i, y_j), row i after row",
+            n,
+            surface.values()
+        ),
+        array("MX", "∂²z/∂x² at the knots", n, surface.knot_curvatures_x()),
+        array("MY", "∂²z/∂y² at the knots", n, surface.knot_curvatures_y()),
+        array(
+            "MXY",
+            "∂⁴z/∂x²∂y² at the knots",
+            n,
+            surface.knot_cross_curvatures()
+        ),
+        axis(periodic[0]),
+        axis(periodic[1]),
+        periodic[0],
+        periodic[1],
+    )
 }
 
 /// The constants and the evaluation function of a spline named `name`.

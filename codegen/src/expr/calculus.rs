@@ -26,9 +26,11 @@ enum Task {
 fn operands(node: Node) -> [Option<Id>; 2] {
     match node {
         Node::Const(_) | Node::Var(_) => [None, None],
-        Node::Add(a, b) | Node::Mul(a, b) | Node::Div(a, b) | Node::Powf(a, b) => {
-            [Some(a), Some(b)]
-        }
+        Node::Add(a, b)
+        | Node::Mul(a, b)
+        | Node::Div(a, b)
+        | Node::Powf(a, b)
+        | Node::Grid(_, _, a, b) => [Some(a), Some(b)],
         Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Table(_, _, a) => {
             [Some(a), None]
         }
@@ -153,6 +155,23 @@ impl Graph {
                 }
                 let outer = self.table(t, order + 1, a);
                 self.mul(outer, da)
+            }
+            Node::Grid(k, (p, q), a, b) => {
+                // ∂S_pq/∂v = S_(p+1)q ∂a/∂v + S_p(q+1) ∂b/∂v.
+                let (da, db) = (d(a), d(b));
+                let along_x = if self.is_zero(da) {
+                    self.zero()
+                } else {
+                    let outer = self.grid(k, (p + 1, q), a, b);
+                    self.mul(outer, da)
+                };
+                let along_y = if self.is_zero(db) {
+                    self.zero()
+                } else {
+                    let outer = self.grid(k, (p, q + 1), a, b);
+                    self.mul(outer, db)
+                };
+                self.add(along_x, along_y)
             }
         }
     }

@@ -61,6 +61,11 @@ pub fn scalar_to_expr_in(g: &mut Graph, s: &Scalar, vars: &[Id], params: &[Id]) 
             let k = g.add_table(t.clone());
             g.table(k, *order, a)
         }
+        Scalar::Grid(grid, order, a, b) => {
+            let (a, b) = (to(a), to(b));
+            let k = g.add_grid(grid.clone());
+            g.grid(k, *order, a, b)
+        }
     }
 }
 

@@ -41,8 +41,40 @@ pub struct Kind {
     pub turn: f64,
 }
 
+/// The surface of the kinds "knife on surface" and "ball on surface" sampled on a grid
+/// (`tests/tables/scene_surface.csv`, made by evaluating the formula at the grid's points),
+/// found from either crate that includes this file.
+const GRID_SURFACE: &str = concat!(
+    "table: (form: Surface, file: \"",
+    env!("CARGO_MANIFEST_DIR"),
+    "/../tests/tables/scene_surface.csv\"),"
+);
+
+impl Kind {
+    /// The spacing of the knots of a surface given on a grid: its third derivatives jump
+    /// across the knot lines (it is C², not C³), so second differences across one lose
+    /// their order of accuracy. None for the other kinds (smooth to every order).
+    pub fn knot_spacing(&self) -> Option<f64> {
+        self.profile.contains("form: Surface").then_some(0.01)
+    }
+
+    /// True when second differences of this kind's terms between the follower points `a`
+    /// and `b` (cam frame x, y) may cross a knot line of its grid: one lies between them or
+    /// within 1.5 mm (a ball's foot lies within ρ sin α of its centre). False for a kind
+    /// without a grid.
+    pub fn crosses_a_knot(&self, a: [f64; 2], b: [f64; 2]) -> bool {
+        let Some(spacing) = self.knot_spacing() else {
+            return false;
+        };
+        (0..2).any(|k| {
+            let (lo, hi) = (a[k].min(b[k]) - 1.5e-3, a[k].max(b[k]) + 1.5e-3);
+            (lo / spacing).floor() != (hi / spacing).floor()
+        })
+    }
+}
+
 /// Every follower on every profile form.
-pub const KINDS: [Kind; 19] = [
+pub const KINDS: [Kind; 21] = [
     Kind {
         name: "knife on explicit",
         follower: "",
@@ -156,6 +188,24 @@ pub const KINDS: [Kind; 19] = [
         name: "ball on surface",
         follower: "follower: Roller(radius: 0.004),",
         profile: "surface: \"0.001 + 0.3*x*y - 0.5*x*x + 0.002*(30.0*y).sin() + 0.4*y*y*x\",",
+        offset: 0.0,
+        planar_only: false,
+        turn: 0.4,
+    },
+    // The same surface as points: a 41 × 41 grid of it over [-0.2, 0.2]² (spacing 0.01 m),
+    // interpolated by the bicubic spline, followed by a point and by a ball.
+    Kind {
+        name: "knife on grid",
+        follower: "",
+        profile: GRID_SURFACE,
+        offset: 0.0,
+        planar_only: false,
+        turn: 0.4,
+    },
+    Kind {
+        name: "ball on grid",
+        follower: "follower: Roller(radius: 0.004),",
+        profile: GRID_SURFACE,
         offset: 0.0,
         planar_only: false,
         turn: 0.4,

@@ -25,6 +25,7 @@
 
 use camchain_runtime::motion_law::MotionProgram;
 use camchain_runtime::spline::Spline;
+use camchain_runtime::surface_spline::SurfaceSpline;
 use std::sync::Arc;
 
 mod convert;
@@ -90,6 +91,39 @@ pub enum Scalar {
     /// spline through a table of points, or a follower's motion law ([`Tabulated`]). Built by
     /// the schema (profiles from points, cams from motion laws), never parsed.
     Table(Arc<Tabulated>, u8, Box<Scalar>),
+    /// ∂ᵖ_x ∂ᵠ_y, `.1` = (p, q) ((0, 0): the value), of a function of two variables given on
+    /// a grid ([`Gridded`], a C² bicubic spline surface) at (a, b). Built by the schema
+    /// (surfaces from grid tables), never parsed.
+    Grid(Arc<Gridded>, (u8, u8), Box<Scalar>, Box<Scalar>),
+}
+
+/// A function of two variables given by a grid of values instead of a formula: a cam
+/// surface z(x, y) through measured or exported points, interpolated by a C² bicubic spline
+/// (`camchain_runtime::surface_spline`). Its partial derivatives are exact to every order
+/// (zero beyond the third in either variable). Generated code keeps its tables in constants
+/// and evaluates them with the runtime's `surface_spline::partials`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gridded {
+    /// Its name in the generated code (`<contact>_<what>`, a Rust identifier); unique in a
+    /// model.
+    pub name: String,
+    /// The spline surface.
+    pub spline: SurfaceSpline,
+}
+
+impl Gridded {
+    /// A named spline surface.
+    pub fn new(name: impl Into<String>, spline: SurfaceSpline) -> Arc<Self> {
+        Arc::new(Gridded {
+            name: name.into(),
+            spline,
+        })
+    }
+
+    /// ∂ᵖ_x ∂ᵠ_y of the surface at (x, y), `order` = (p, q).
+    pub fn derivative(&self, order: (u8, u8), x: f64, y: f64) -> f64 {
+        self.spline.partial(order, x, y)
+    }
 }
 
 /// A function of one variable given by data instead of a formula, with its first three
@@ -174,6 +208,7 @@ impl Scalar {
             Scalar::Powf(a, b) => ev(a).powf(ev(b)),
             Scalar::Call(f, a) => apply(*f, ev(a)),
             Scalar::Table(t, order, a) => t.derivative(*order, ev(a)),
+            Scalar::Grid(g, order, a, b) => g.derivative(*order, ev(a), ev(b)),
         }
     }
 }
@@ -195,6 +230,7 @@ impl Scalar {
             Scalar::Powf(a, b) => Scalar::Powf(r(a), r(b)),
             Scalar::Call(f, a) => Scalar::Call(*f, r(a)),
             Scalar::Table(t, order, a) => Scalar::Table(t.clone(), *order, r(a)),
+            Scalar::Grid(g, order, a, b) => Scalar::Grid(g.clone(), *order, r(a), r(b)),
         }
     }
 
@@ -217,7 +253,8 @@ impl Scalar {
                 | Scalar::Sub(a, b)
                 | Scalar::Mul(a, b)
                 | Scalar::Div(a, b)
-                | Scalar::Powf(a, b) => {
+                | Scalar::Powf(a, b)
+                | Scalar::Grid(_, _, a, b) => {
                     walk(a, out);
                     walk(b, out);
                 }
@@ -271,6 +308,11 @@ impl Scalar {
     /// The derivative of order `order` of `table` at self.
     pub fn tabulated(self, table: &Arc<Tabulated>, order: u8) -> Scalar {
         Scalar::Table(table.clone(), order, Box::new(self))
+    }
+
+    /// ∂ᵖ_x ∂ᵠ_y (`order` = (p, q)) of the surface `grid` at (x, y).
+    pub fn gridded(grid: &Arc<Gridded>, order: (u8, u8), x: Scalar, y: Scalar) -> Scalar {
+        Scalar::Grid(grid.clone(), order, Box::new(x), Box::new(y))
     }
 }
 

@@ -1,4 +1,5 @@
-//! Tables of points in a CSV file: two numeric columns, one point per line.
+//! Tables of points in a CSV file: two numeric columns (three for a surface's grid), one point
+//! per line.
 //!
 //! The format is the plain one CAD programs and spreadsheets export: cells separated by a
 //! comma (or a semicolon or a tab), spaces around them ignored, blank lines and lines whose
@@ -6,15 +7,15 @@
 //! table has no quoting or other cell types, so it is read here in a few lines that locate
 //! every problem by line and column rather than through a general CSV library.
 
-/// One point of a table and where it is written.
+/// One point of a table (of N columns) and where it is written.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Row {
-    /// The two numbers.
-    pub values: [f64; 2],
+pub(crate) struct Row<const N: usize = 2> {
+    /// The numbers.
+    pub values: [f64; N],
     /// 1-based line.
     pub line: usize,
     /// 1-based column of each cell.
-    pub columns: [usize; 2],
+    pub columns: [usize; N],
 }
 
 /// A problem in a table file, at a 1-based line and column.
@@ -27,7 +28,7 @@ pub(crate) struct CsvError {
 
 /// The rows of `text`, whose header, if it has one, must name the columns `names` (in any
 /// letter case).
-pub(crate) fn read(text: &str, names: [&str; 2]) -> Result<Vec<Row>, CsvError> {
+pub(crate) fn read<const N: usize>(text: &str, names: [&str; N]) -> Result<Vec<Row<N>>, CsvError> {
     let mut rows = Vec::new();
     let mut seen_data_or_header = false;
     for (index, line) in text.lines().enumerate() {
@@ -42,27 +43,27 @@ pub(crate) fn read(text: &str, names: [&str; 2]) -> Result<Vec<Row>, CsvError> {
             .is_some_and(|(_, cell)| cell.parse::<f64>().is_err());
         if !seen_data_or_header && first_is_text {
             seen_data_or_header = true;
-            header(&cells, names, number)?;
+            header(&cells, &names, number)?;
             continue;
         }
         seen_data_or_header = true;
-        if cells.len() != 2 {
+        if cells.len() != N {
             return Err(CsvError {
                 line: number,
                 column: cells.first().map_or(1, |(c, _)| *c),
                 message: format!(
-                    "a row holds two numbers ({}, {}), this one has {} cell{}",
-                    names[0],
-                    names[1],
+                    "a row holds {} numbers ({}), this one has {} cell{}",
+                    count(N),
+                    names.join(", "),
                     cells.len(),
                     if cells.len() == 1 { "" } else { "s" }
                 ),
             });
         }
-        let mut values = [0.0; 2];
-        let mut columns = [0; 2];
+        let mut values = [0.0; N];
+        let mut columns = [0; N];
         for (k, (column, cell)) in cells.iter().enumerate() {
-            values[k] = number_in(cell, names[k], number, *column)?;
+            values[k] = number_in(cell, names[k], N, (number, *column))?;
             columns[k] = *column;
         }
         rows.push(Row {
@@ -102,30 +103,45 @@ fn split(line: &str) -> Vec<(usize, &str)> {
 }
 
 /// The header must name the columns as expected.
-fn header(cells: &[(usize, &str)], names: [&str; 2], line: usize) -> Result<(), CsvError> {
+fn header(cells: &[(usize, &str)], names: &[&str], line: usize) -> Result<(), CsvError> {
     let given: Vec<String> = cells.iter().map(|(_, c)| c.to_ascii_lowercase()).collect();
-    if given.len() == 2 && given[0] == names[0] && given[1] == names[1] {
+    if given.len() == names.len() && given.iter().zip(names).all(|(g, n)| g == n) {
         return Ok(());
     }
     Err(CsvError {
         line,
         column: cells.first().map_or(0, |(c, _)| *c),
         message: format!(
-            "the header names the columns `{}`, but this table's columns are `{}, {}` (or write \
-             no header)",
+            "the header names the columns `{}`, but this table's columns are `{}` (or write no \
+             header)",
             cells.iter().map(|(_, c)| *c).collect::<Vec<_>>().join(", "),
-            names[0],
-            names[1]
+            names.join(", ")
         ),
     })
 }
 
-/// A cell's finite number.
-fn number_in(cell: &str, name: &str, line: usize, column: usize) -> Result<f64, CsvError> {
+/// "two" or "three": how many numbers a row holds.
+fn count(n: usize) -> String {
+    match n {
+        2 => "two".to_string(),
+        3 => "three".to_string(),
+        _ => n.to_string(),
+    }
+}
+
+/// A cell's finite number (of a row of `n`).
+fn number_in(
+    cell: &str,
+    name: &str,
+    n: usize,
+    (line, column): (usize, usize),
+) -> Result<f64, CsvError> {
     let message = match cell.parse::<f64>() {
         Ok(v) if v.is_finite() => return Ok(v),
         Ok(_) => format!("{name} must be a finite number, not `{cell}`"),
-        Err(_) if cell.is_empty() => format!("the {name} cell is empty: a row holds two numbers"),
+        Err(_) if cell.is_empty() => {
+            format!("the {name} cell is empty: a row holds {} numbers", count(n))
+        }
         Err(_) => format!("`{cell}` is not a number ({name})"),
     };
     Err(CsvError {

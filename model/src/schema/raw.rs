@@ -335,6 +335,9 @@ pub(super) struct Table {
     pub points: Option<Vec<(f64, f64)>>,
     #[serde(default)]
     pub ends: Option<TableEnds>,
+    /// A surface's ends along y (default: its `ends`, which are those along x).
+    #[serde(default)]
+    pub y_ends: Option<TableEnds>,
     /// A polar table's angles are in degrees (default: radians).
     #[serde(default)]
     pub degrees: bool,
@@ -349,6 +352,8 @@ pub(super) enum TableForm {
     Polar,
     /// x, y of a curve, in order along it.
     Parametric,
+    /// x, y, z of a surface z(x, y) on a grid, in any order.
+    Surface,
 }
 
 /// A spline's end conditions.

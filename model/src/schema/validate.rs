@@ -17,11 +17,13 @@ mod contacts;
 mod designs;
 mod faces;
 mod fields;
+mod grids;
 mod initial;
 mod loops;
 mod markers;
 mod parameters;
 mod settings;
+mod table_files;
 mod tables;
 pub use settings::ranges;
 

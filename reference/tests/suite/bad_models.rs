@@ -1090,6 +1090,45 @@ const CASES: &[Case] = &[
         "contacts[0].surface",
         "the surface is not defined over its region: f = NaN",
     ),
+    // Surfaces through grids of points. The table's `(` in the model file: points written
+    // inline.
+    case(
+        "grid_inline_points.ron",
+        43,
+        20,
+        "contacts[0].table",
+        "a surface's table is read from a CSV file of x, y, z rows",
+    ),
+    // The z cell of the point (0.2, 0.1), which should repeat (-0.2, 0.1)'s on line 5.
+    Case {
+        file: "grid_periodic_edges_differ.ron",
+        line: 25,
+        column: 11,
+        field: "contacts[0].table.file",
+        phrase: "the grid is periodic in x, so z[4][3] must repeat z[0][3]",
+        reference: Reference::Load,
+        located: Some("tables/grid_periodic_edges_differ.csv"),
+    },
+    // The first row of x = 0.1 (line 17), whose point (0.1, -0.1) no row gives.
+    Case {
+        file: "grid_point_missing.ron",
+        line: 17,
+        column: 1,
+        field: "contacts[0].table.file",
+        phrase: "no row gives z at (x, y) = (0.1, -0.1)",
+        reference: Reference::Load,
+        located: Some("tables/grid_point_missing.csv"),
+    },
+    // The second row of (0, 0.1), line 16 (the first is line 15).
+    Case {
+        file: "grid_point_repeated.ron",
+        line: 16,
+        column: 1,
+        field: "contacts[0].table.file",
+        phrase: "gives the point (x, y) = (0, 0.1) again, after line 15",
+        reference: Reference::Load,
+        located: Some("tables/grid_point_repeated.csv"),
+    },
     // `Flat(normal: …)` on a cam surface.
     case(
         "surface_with_flat.ron",

@@ -233,10 +233,10 @@ fn profile(
         return Err(cx.at.error(&field, message));
     }
     if let Some(table) = &c.table {
-        let (profile, covers) = super::tables::table_profile(cx, path, table, name)?;
+        let (profile, covers) = super::tables::table_profile(cx, path, table, (name, follower))?;
         return Ok(Shaped {
             profile,
-            covers: Some(covers),
+            covers,
             design: None,
         });
     }
@@ -477,16 +477,8 @@ fn point_surface(
         variables,
         Field::Profile(i),
     )?;
-    match follower {
-        Follower::Knife => Ok(f),
-        Follower::Roller { .. } if balls => Ok(f),
-        Follower::Roller { .. } | Follower::Flat { .. } | Follower::Mushroom { .. } => {
-            Err(cx.at.error(
-                &format!("{path}.follower"),
-                format!("a {} cannot follow {what}", follower.kind().label()),
-            ))
-        }
-    }
+    super::grids::surface_follower(cx, path, (follower, what, balls))?;
+    Ok(f)
 }
 
 fn follower(cx: &Context, path: &str, f: &raw::Follower, i: usize) -> Checked<Follower> {
@@ -646,6 +638,7 @@ fn profile_field(contact: &Contact) -> &'static str {
         Profile::Explicit { f, .. } if is_table(f) => "table",
         Profile::Polar { r, .. } if is_table(r) => "table",
         Profile::Parametric { x, .. } if is_table(x) => "table",
+        Profile::Surface { f, .. } if is_table(f) => "table",
         Profile::Explicit { .. } => "profile",
         Profile::Polar { .. } => "polar",
         Profile::Parametric { .. } => "parametric",
@@ -656,9 +649,13 @@ fn profile_field(contact: &Contact) -> &'static str {
     }
 }
 
-/// True for a profile read from a table of points (its expression a tabulated leaf).
+/// True for a profile or a surface read from a table of points (its expression a tabulated
+/// leaf).
 fn is_table(e: &crate::profile::Scalar) -> bool {
-    matches!(e, crate::profile::Scalar::Table(..))
+    matches!(
+        e,
+        crate::profile::Scalar::Table(..) | crate::profile::Scalar::Grid(..)
+    )
 }
 
 /// A flat face's normal stays in the cam plane only if the follower turns relative to the

@@ -17,16 +17,16 @@
 //! within ±[`LARGEST`], so that the spline's arithmetic cannot overflow, and the spline
 //! built is checked finite.
 
+use super::table_files::{LARGEST, ends_of, read_file};
 use super::{Checked, Context, Profile};
 use crate::error::ModelError;
-use crate::model::ModelFile;
+use crate::model::Follower;
 use crate::profile::{Scalar, Tabulated};
 use crate::schema::csv;
-use crate::schema::raw::{self, TableEnds, TableForm};
-use crate::schema::{Files, read_text};
+use crate::schema::raw::{self, TableForm};
 use camchain_runtime::spline::{CLOSURE_TOLERANCE, Ends, Spline, SplineError};
 use std::f64::consts::TAU;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Where one point of a table is written.
 #[derive(Debug, Clone)]
@@ -52,13 +52,6 @@ impl At {
     }
 }
 
-/// Largest magnitude of a number in a table. The spline's arithmetic squares and cubes
-/// differences of the table's numbers and sums up to a table's length of them (chord
-/// lengths, slopes, the cubic's terms): below 1e100 every such product stays below 1e300,
-/// far inside f64's 1.8e308, while any physical table (metres, radians, degrees) is many
-/// orders of magnitude below it.
-pub(crate) const LARGEST: f64 = 1e100;
-
 /// The points of a table with where each is written.
 struct Points {
     values: Vec<[f64; 2]>,
@@ -69,19 +62,40 @@ struct Points {
     from: Option<String>,
 }
 
-/// The profile of `table` for contact `name` (path `path`), and the interval of its
-/// variable the table covers (the contact's default range).
+/// A table that makes a curve.
+#[derive(Clone, Copy)]
+enum Curve {
+    Explicit,
+    Polar,
+    Parametric,
+}
+
+/// The profile of `table` for contact `name` (path `path`) followed by `follower`, and the
+/// interval of its variable the table covers (the contact's default range; none for a
+/// surface, [`super::grids`]).
 pub(super) fn table_profile(
     cx: &Context,
     path: &str,
     table: &raw::Table,
-    name: &str,
-) -> Checked<(Profile, (f64, f64))> {
+    (name, follower): (&str, &Follower),
+) -> Checked<(Profile, Option<(f64, f64)>)> {
     let field = format!("{path}.table");
-    let names = match table.form {
-        TableForm::Polar => ["theta", "r"],
-        TableForm::Explicit | TableForm::Parametric => ["x", "y"],
+    let (form, names) = match table.form {
+        TableForm::Explicit => (Curve::Explicit, ["x", "y"]),
+        TableForm::Polar => (Curve::Polar, ["theta", "r"]),
+        TableForm::Parametric => (Curve::Parametric, ["x", "y"]),
+        TableForm::Surface => {
+            let profile = super::grids::grid_profile(cx, (path, &field), table, name, follower)?;
+            return Ok((profile, None));
+        }
     };
+    if table.y_ends.is_some() {
+        return Err(cx.at.error(
+            &format!("{field}.y_ends"),
+            "only a surface's table (`form: Surface`) has ends along y; a profile's table has \
+             `ends` only",
+        ));
+    }
     let points = points(cx, &field, table, names)?;
     within_range(cx, &field, &points)?;
     let ends = table.ends.map(ends_of);
@@ -92,8 +106,8 @@ pub(super) fn table_profile(
         ),
         None => format!("{what} through {} points", points.values.len()),
     };
-    match table.form {
-        TableForm::Explicit => {
+    match form {
+        Curve::Explicit => {
             let ends = ends.unwrap_or(Ends::Natural);
             if ends == Ends::Periodic {
                 closes(cx, &field, &points, "a periodic table")?;
@@ -104,9 +118,9 @@ pub(super) fn table_profile(
                 Scalar::Var(0).tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
             let range = (x[0], x[x.len() - 1]);
             let source = described("a spline");
-            Ok((Profile::Explicit { source, f }, range))
+            Ok((Profile::Explicit { source, f }, Some(range)))
         }
-        TableForm::Polar => {
+        Curve::Polar => {
             if let Some(other) = ends.filter(|e| *e != Ends::Periodic) {
                 return Err(cx.at.error(
                     &format!("{field}.ends"),
@@ -124,9 +138,11 @@ pub(super) fn table_profile(
             let r =
                 Scalar::Var(0).tabulated(&Tabulated::spline(format!("{name}_table"), spline), 0);
             let source = described("a periodic spline");
-            Ok((Profile::Polar { source, r }, (0.0, TAU)))
+            Ok((Profile::Polar { source, r }, Some((0.0, TAU))))
         }
-        TableForm::Parametric => parametric(cx, &field, points, ends, name),
+        Curve::Parametric => {
+            parametric(cx, &field, points, ends, name).map(|(p, covers)| (p, Some(covers)))
+        }
     }
 }
 
@@ -213,15 +229,6 @@ fn signed_area(p: &[[f64; 2]]) -> f64 {
             a[0] * b[1] - a[1] * b[0]
         })
         .sum()
-}
-
-/// The spline's ends as the runtime names them.
-fn ends_of(ends: TableEnds) -> Ends {
-    match ends {
-        TableEnds::Natural => Ends::Natural,
-        TableEnds::Clamped { start, end } => Ends::Clamped { start, end },
-        TableEnds::Periodic => Ends::Periodic,
-    }
 }
 
 fn columns(values: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
@@ -471,43 +478,4 @@ fn point_error(cx: &Context, field: &str, at: &At, cell: usize, message: String)
             message,
         },
     }
-}
-
-/// The text of the file the model names `written`, and the path its messages show (beside
-/// the model file's); recorded among the files the model read.
-fn read_file(cx: &Context, field: &str, written: &str) -> Checked<(String, PathBuf)> {
-    let beside = cx.at.file.parent().unwrap_or(Path::new(""));
-    let shown = beside.join(written);
-    let (text, path) = match cx.files {
-        Files::BesideModel => (read_text(&shown), shown.clone()),
-        Files::In(dir) => {
-            let path = dir.join(written);
-            (read_text(&path), path)
-        }
-        Files::Embedded(list) => match list.iter().find(|(name, _)| *name == written) {
-            Some((_, text)) => (Ok((*text).to_string()), PathBuf::new()),
-            None => (
-                Err(std::io::Error::new(
-                    std::io::ErrorKind::NotFound,
-                    "not among the files embedded with the model",
-                )),
-                PathBuf::new(),
-            ),
-        },
-    };
-    let text = text.map_err(|e| {
-        cx.at.error(
-            field,
-            format!(
-                "cannot read the table file `{written}` ({}): {e}",
-                shown.display()
-            ),
-        )
-    })?;
-    cx.read.borrow_mut().push(ModelFile {
-        written: written.to_string(),
-        path,
-        text: text.clone(),
-    });
-    Ok((text, shown))
 }
