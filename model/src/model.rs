@@ -420,6 +420,10 @@ pub struct Contact {
     /// The motion law and follower the profile was designed for, when the file gives the
     /// cam as a `law` (its profile is then the synthesised [`Profile::Parametric`]).
     pub design: Option<crate::design::CamDesign>,
+    /// How much wider than the roller a barrel or face cam's groove is (m): the roller moves
+    /// freely between the flanks and touches one at a time (one-sided, with the model's
+    /// restitution); 0 for a closed groove and for every other cam.
+    pub backlash: f64,
 }
 
 impl Contact {

@@ -93,6 +93,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
             .cam_body
             .filter(|&b| model.bodies[b].joint.kind == JointKind::Revolute),
         cam_moves: c.cam_body.is_some(),
+        backlash: c.backlash,
     }
 }
 
@@ -683,6 +684,7 @@ mod tests {
             y_axis: [y_axis.x, y_axis.y, y_axis.z],
             range: None,
             design: None,
+            backlash: 0.0,
         }
     }
 

@@ -103,6 +103,20 @@ pub struct ContactInfo {
     /// it drives the follower, and the pressure angle is defined. A chain's point sliding
     /// along a fixed cam (the paper's) has none.
     pub cam_moves: bool,
+    /// A barrel or face cam's groove wider than its roller by this much (m): the roller moves
+    /// freely between the flanks and touches one at a time ([`crate::clearance`]); 0 for a
+    /// closed groove (the roller held on the centre line both ways) and for every other cam.
+    pub backlash: f64,
+}
+
+/// A flank of a barrel or face cam's groove.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flank {
+    /// The flank a positive normal force of the closed groove presses the roller against:
+    /// a face cam's inner flank, a barrel's lower one.
+    Inner,
+    /// The other: a face cam's outer flank, a barrel's upper one.
+    Outer,
 }
 
 impl ContactInfo {
@@ -114,6 +128,7 @@ impl ContactInfo {
             profile: ProfileKind::Explicit,
             cam_coordinate: None,
             cam_moves: false,
+            backlash: 0.0,
         }
     }
 }
@@ -440,6 +455,14 @@ pub trait Dynamics {
     fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
         let _ = (t, q, qd);
         0.0
+    }
+
+    /// The flank of contact `k`'s groove that the roller is nearer at q when the groove has
+    /// backlash (as the one-sided run sees it, [`crate::clearance::Clearance`]); `None` for
+    /// every other contact.
+    fn groove_flank(&self, q: &[f64], k: usize) -> Option<Flank> {
+        let _ = (q, k);
+        None
     }
 
     /// M, F and Q in one call. Generated models override it so that the kinematics shared by

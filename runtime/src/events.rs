@@ -47,6 +47,9 @@ pub struct ContactEvent {
     pub q: Vec<f64>,
     /// Velocities at the event (before an impact).
     pub qd: Vec<f64>,
+    /// For a groove with backlash, the flank the roller leaves or lands on
+    /// ([`crate::clearance`]); `None` otherwise.
+    pub flank: Option<crate::dynamics::Flank>,
 }
 
 /// The root of `g` in the bracket [t0, t1] where g(t0) = g0 and g(t1) = g1 have opposite

@@ -25,16 +25,19 @@
 //!   modified trapezoid and sine) in closed form, and programs of them over a turn.
 //! - [`spline`]: C² cubic splines through tables of points (profiles given as points).
 //! - [`surface_spline`]: C² bicubic spline surfaces z(x, y) through grids of points (spatial
-//!   cams given as points; not yet read from model files).
+//!   cams given as points, `table: (form: Surface, …)`).
 //! - [`contact`]: contact parameters (Newton on the profile) and the checks that a
 //!   follower can follow its profile.
 //! - [`metrics`]: runs that keep a summary (extreme forces, lift-off, drift) instead of a
 //!   trajectory, for parameter sweeps.
 //! - [`unilateral`]: one-sided contact: lift-off, flight, impact with restitution.
+//! - [`clearance`]: grooves with backlash, seen by the one-sided run as contacts on the
+//!   nearer flank.
 //! - [`events`]: contact events (force sign changes, lift-off, impact) and their location.
 //! - [`error`]: simulation errors with time and state.
 
 pub mod assembly;
+pub mod clearance;
 pub mod contact;
 pub mod control;
 pub mod dynamics;

@@ -618,6 +618,7 @@ impl Phase<'_, '_, '_> {
                 kind,
                 q,
                 qd,
+                flank: None,
             });
         }
         Ok(None)

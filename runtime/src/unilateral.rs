@@ -24,6 +24,7 @@
 
 use crate::SimSettings;
 use crate::assembly::state_at;
+use crate::clearance::Clearance;
 use crate::dynamics::VelocityTerms;
 use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, Energy, ModelInfo};
 use crate::error::SimError;
@@ -300,7 +301,16 @@ pub(crate) fn run_phases(
     let gap = |q: &[f64], qd: &[f64]| gap_reading(model, n, q, qd);
     let complete = |sample: &mut Sample| complete_flight_sample(model, sample);
     let mut grid = Grid::new(state.t, settings);
-    let mut mode = Mode::Contact(state);
+    // A roller in a groove with backlash starts where it was put, usually between the flanks
+    // ([`crate::clearance`]): in flight unless it touches one.
+    let start = gap(&state.q, &state.qd).g;
+    let mut mode = if Clearance::applies_to(model) && start > tolerance {
+        let mut flying = state_at(&detached, state.t, (&state.q, &state.qd))?;
+        flying.set_quadratures((state.dissipated, state.driven_work));
+        Mode::Flight(flying, &detached)
+    } else {
+        Mode::Contact(state)
+    };
     loop {
         if record.events.len() > MAX_EVENTS {
             return Err(SimError::InvalidSettings {
@@ -356,6 +366,7 @@ pub(crate) fn run_phases(
                 },
                 q: stop.q.clone(),
                 qd: stop.qd.clone(),
+                flank: model.groove_flank(&stop.q, stop.contact),
             });
             let quadratures = (dissipated + hit.loss, driven_work + hit.drive_work);
             if hit.stays {
@@ -374,6 +385,7 @@ pub(crate) fn run_phases(
                 kind: EventKind::LiftOff,
                 q: stop.q.clone(),
                 qd: stop.qd.clone(),
+                flank: model.groove_flank(&stop.q, stop.contact),
             });
             let mut next = state_at(&detached, stop.t, (&stop.q, &stop.qd))?;
             next.set_quadratures((dissipated, driven_work));

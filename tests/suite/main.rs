@@ -4,6 +4,7 @@
 //! contains NAME, e.g. a module's name.
 
 mod andrews;
+mod backlash;
 mod balls;
 mod cams;
 #[path = "../common/mod.rs"]

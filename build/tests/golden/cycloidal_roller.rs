@@ -377,6 +377,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             profile: rt::ProfileKind::Parametric,
             cam_coordinate: Some(0),
             cam_moves: true,
+            backlash: 0.0,
         },
     ]),
     loops: Vec::from([]),

@@ -174,6 +174,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             profile: rt::ProfileKind::Explicit,
             cam_coordinate: None,
             cam_moves: false,
+            backlash: 0.0,
         },
     ]),
     loops: Vec::from([]),

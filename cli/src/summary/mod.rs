@@ -22,7 +22,7 @@ pub use digest::Digest;
 use camchain_runtime::assembly::{AssemblyReport, ChangeCause, RootChoice};
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::{
-    ContactInfo, IntegratorKind, JointKind, ModelInfo, ProfileKind, SimSettings, Stats,
+    ContactInfo, Flank, IntegratorKind, JointKind, ModelInfo, ProfileKind, SimSettings, Stats,
 };
 use std::fmt::Write;
 use std::time::Duration;
@@ -353,6 +353,12 @@ fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
                 | ProfileKind::Surface
                 | ProfileKind::Revolution => None,
             });
+        // A groove with backlash: which flank the roller leaves or lands on.
+        let flank = match (event.flank, groove) {
+            (Some(Flank::Inner), Some((_, own))) => format!(" the groove's {own} flank"),
+            (Some(Flank::Outer), Some((other, _))) => format!(" the groove's {other} flank"),
+            _ => " the cam".to_string(),
+        };
         let what = match (event.kind, groove) {
             (EventKind::ForceBecameNegative, Some((other, own))) => format!(
                 "{name} changes flanks: the groove's {other} flank takes over (a follower on the \
@@ -368,7 +374,7 @@ fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
             (EventKind::ForceBecamePositive, None) => {
                 format!("the normal force on {name} becomes positive again")
             }
-            (EventKind::LiftOff, _) => format!("{name} lifts off the cam"),
+            (EventKind::LiftOff, _) => format!("{name} lifts off{flank}"),
             (
                 EventKind::Impact {
                     normal_velocity,
@@ -378,10 +384,14 @@ fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {
                 },
                 _,
             ) => format!(
-                "{name} lands at {:.3e} m/s, {}; impact loss {loss:.2e} J",
+                "{name} lands{} at {:.3e} m/s, {}; impact loss {loss:.2e} J",
+                match event.flank {
+                    Some(_) => format!(" on{flank}"),
+                    None => String::new(),
+                },
                 -normal_velocity,
                 if stays {
-                    "stays on the cam".to_string()
+                    format!("stays on{flank}")
                 } else {
                     format!("rebounds at {rebound:.3e} m/s")
                 }

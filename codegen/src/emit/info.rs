@@ -40,9 +40,10 @@ pub(super) fn info_static(model: &Model) -> String {
             format!(
                 "rt::ContactInfo {{ name: {:?}.to_string(), follower: rt::FollowerKind::{follower}, \
                  profile: rt::ProfileKind::{profile}, cam_coordinate: {cam_coordinate}, \
-                 cam_moves: {} }}",
+                 cam_moves: {}, backlash: {} }}",
                 c.name,
-                c.cam_body.is_some()
+                c.cam_body.is_some(),
+                super::literals::lit(c.backlash)
             )
         })
         .collect();

@@ -123,6 +123,7 @@ pub fn paper_concave() -> Model {
             y_axis: [0.0, 1.0, 0.0],
             range: None,
             design: None,
+            backlash: 0.0,
         }],
         loops: Vec::new(),
         initial: Initial {
@@ -259,6 +260,7 @@ pub fn spatial_tree() -> Model {
             y_axis: [0.0, s, c],
             range: None,
             design: None,
+            backlash: 0.0,
         }],
         loops: Vec::new(),
         initial: Initial {

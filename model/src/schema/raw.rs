@@ -281,6 +281,9 @@ pub(super) struct Barrel {
     /// must lie on it.
     #[serde(default)]
     pub length: Option<Number>,
+    /// How much wider than the roller the groove is (m).
+    #[serde(default)]
+    pub backlash: Option<f64>,
 }
 
 /// `face: (groove: "g(theta)")` or `face: (law: (…))`: a face cam's groove.
@@ -293,6 +296,9 @@ pub(super) struct Face {
     /// The centre line designed from the follower's motion law (a disc cam's `law`).
     #[serde(default)]
     pub law: Option<Law>,
+    /// How much wider than the roller the groove is (m).
+    #[serde(default)]
+    pub backlash: Option<f64>,
 }
 
 /// `law: (base: z₀, turning: …, segments: […])` of a barrel cam: the follower's travel along

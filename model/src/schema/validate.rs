@@ -99,6 +99,24 @@ pub(super) fn validate(
             ),
         ));
     }
+    if let Some((i, c)) = contacts.iter().enumerate().find(|(_, c)| c.backlash > 0.0)
+        && simulation.restitution.is_none()
+    {
+        let groove = match c.profile {
+            Profile::Face { .. } => "face",
+            _ => "barrel",
+        };
+        return Err(at.error(
+            &format!("contacts[{i}].{groove}.backlash"),
+            format!(
+                "a groove with backlash lets the roller fly between its flanks and land on one or \
+                 the other: give the flanks' coefficient of restitution in the model's \
+                 `simulation: (restitution: e)` (0 for impacts that do not rebound), or make \
+                 the groove closed (backlash 0, the default; {} m given)",
+                c.backlash
+            ),
+        ));
+    }
     if simulation.restitution.is_some() && !file.loops.is_empty() {
         return Err(at.error(
             "simulation.restitution",

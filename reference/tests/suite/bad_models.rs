@@ -1065,7 +1065,22 @@ const CASES: &[Case] = &[
         "loops[0].b.body",
         "unknown body `rocket`",
     ),
-    // Cam surfaces and barrel cams.
+    // Cam surfaces and barrel cams. `-0.001` after the groove's `backlash:`.
+    case(
+        "backlash_negative.ron",
+        51,
+        27,
+        "contacts[0].barrel.backlash",
+        "a length of 0 m or more, got -0.001",
+    ),
+    // `0.001` after `backlash:`, in a model without `restitution`.
+    case(
+        "backlash_without_restitution.ron",
+        51,
+        27,
+        "contacts[0].barrel.backlash",
+        "give the flanks' coefficient of restitution",
+    ),
     // `"0.01*theta + base"`, the barrel's groove.
     case(
         "barrel_groove_open.ron",

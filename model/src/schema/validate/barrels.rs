@@ -37,8 +37,10 @@ pub(super) fn barrel_profile(
             let at = format!("{field}.groove");
             let f = expression(cx, &at, source, &["theta"], Field::Profile(i))?;
             closes(cx, &at, &f)?;
-            let roller = follower.radius().copied().unwrap_or(0.0);
-            groove_fits(cx, path, (name, &f), radius, roller)?;
+            // The flanks lie the roller's radius and half the backlash from the pitch curve.
+            let half_width =
+                follower.radius().copied().unwrap_or(0.0) + 0.5 * barrel.backlash.unwrap_or(0.0);
+            groove_fits(cx, path, (name, &f), radius, half_width)?;
             (source.clone(), f, None)
         }
         (None, Some(law)) => {

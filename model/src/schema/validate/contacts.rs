@@ -142,6 +142,7 @@ fn contact(
     let (x_axis, y_axis) = cam_axes(cx, &format!("{path}.frame"), &c.frame)?;
     let follower = follower(cx, &path, &c.follower, i)?;
     let name = c.name.clone().unwrap_or_else(|| c.marker.clone());
+    let backlash = super::faces::backlash(cx, &path, c)?;
     let Shaped {
         profile,
         covers,
@@ -164,6 +165,7 @@ fn contact(
         y_axis,
         range,
         design,
+        backlash,
     })
 }
 

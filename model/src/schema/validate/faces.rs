@@ -65,6 +65,27 @@ pub(super) fn face_profile(
     ))
 }
 
+/// A groove's backlash (`face: (…, backlash: b)` or `barrel: (…, backlash: b)`, m): finite
+/// and not negative; 0 when not given and for every other cam.
+pub(super) fn backlash(cx: &Context, path: &str, c: &raw::Contact) -> Checked<f64> {
+    let (field, value) = match (&c.face, &c.barrel) {
+        (Some(face), _) => ("face", face.backlash),
+        (None, Some(barrel)) => ("barrel", barrel.backlash),
+        (None, None) => return Ok(0.0),
+    };
+    match value {
+        Some(b) if !(b.is_finite() && b >= 0.0) => Err(cx.at.error(
+            &format!("{path}.{field}.backlash"),
+            format!(
+                "the backlash is how much wider than the roller the groove is: a length of 0 m \
+                 or more, got {b}"
+            ),
+        )),
+        Some(b) => Ok(b),
+        None => Ok(0.0),
+    }
+}
+
 /// Only a roller (its centre the marker) or a knife edge runs in a groove (`groove` names
 /// it in the message); a flat or curved face is refused at the follower.
 pub(super) fn in_a_groove(
@@ -99,7 +120,12 @@ pub(super) fn groove_fits(at: &Locator, path: &str, contact: &Contact) -> Checke
         Some(_) => format!("{path}.face.law"),
         None => format!("{path}.face.groove"),
     };
-    let rho = contact.follower.radius().copied().unwrap_or(0.0);
+    // The flanks lie the roller's radius plus half the backlash from the centre line.
+    let rho = contact.follower.radius().copied().unwrap_or(0.0) + 0.5 * contact.backlash;
+    let label = match contact.backlash > 0.0 {
+        true => "groove's half-width (the roller's radius and half the backlash)",
+        false => contact.follower.kind().label(),
+    };
     let range = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
     let samples = profile_samples(centre, range, GROOVE_SAMPLES);
     if let Profile::Polar { r, .. } = centre.as_ref() {
@@ -122,10 +148,8 @@ pub(super) fn groove_fits(at: &Locator, path: &str, contact: &Contact) -> Checke
                 &field,
                 format!(
                     "the groove's inner flank reaches the cam's axis: its centre line's radius \
-                     is {:.6} m at θ = {:.4} rad, not more than the {}'s radius {rho} m",
-                    sample.radius,
-                    sample.at,
-                    contact.follower.kind().label()
+                     is {:.6} m at θ = {:.4} rad, not more than the {label} {rho} m",
+                    sample.radius, sample.at,
                 ),
             ));
         }
@@ -138,14 +162,12 @@ pub(super) fn groove_fits(at: &Locator, path: &str, contact: &Contact) -> Checke
             return Err(at.error(
                 &format!("{path}.follower.radius"),
                 format!(
-                    "contact `{}`: the {} ({rho} m) undercuts the groove's {flank} flank: at θ = \
-                     {:.4} rad the centre line is {shape} with a radius of curvature of {:.6} \
-                     m, smaller than the {}'s",
+                    "contact `{}`: the {label} ({rho} m) undercuts the groove's {flank} flank: \
+                     at θ = {:.4} rad the centre line is {shape} with a radius of curvature of \
+                     {:.6} m, smaller than that",
                     contact.name,
-                    contact.follower.kind().label(),
                     sample.at,
                     1.0 / sample.curvature.abs(),
-                    contact.follower.kind().label()
                 ),
             ));
         }

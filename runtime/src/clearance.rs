@@ -1,0 +1,263 @@
+//! Grooves with backlash: a roller (or a pin) in a barrel or face cam's groove wider than it.
+//!
+//! A closed groove holds the roller on its centre line: the contact's gap function is d(q), the
+//! signed distance of the roller's centre from the centre line (positive towards the flank a
+//! negative normal force would press: a face cam's outer flank, a barrel's upper one), and the
+//! contact is bilateral. With a backlash b > 0 the groove is b wider than the roller, so the
+//! centre moves freely while |d| < b/2 and touches a flank at d = ±b/2: two one-sided
+//! contacts, never both at once. [`Clearance`] presents them to the one-sided run
+//! ([`crate::unilateral`]) as one contact whose gap is the distance to the nearer flank,
+//!
+//! ```text
+//! g = b/2 − s d,   s = sign d (s = +1 at d = 0),
+//! ∂g/∂q = −s J,   c_g = −s c,
+//! ```
+//!
+//! smooth wherever the roller can touch (|d| = b/2 > 0; the kink at d = 0 lies in the middle
+//! of the clearance, where no contact is active). The force a flank exerts pushes the roller
+//! away from it, towards the centre line: the normal is −s n (n the closed groove's normal,
+//! from the inner or lower flank towards the roller), and the contact point is the roller's
+//! rim on that side, C − ρ (−s n) with C its centre and ρ its radius (the closed groove's
+//! reported point is C − (d + ρ) n, which gives ρ). A lift-off is the roller leaving a flank,
+//! a landing an impact on one ([`Dynamics::groove_flank`] says which).
+//!
+//! The cam-frame coordinates of the contact point (`x`, `y`, `z` of [`ContactGeometry`], what
+//! the drawings of the cam plot) stay those of the closed groove's reported point: the
+//! centre line moved by ρ towards the inner or lower flank.
+
+use crate::dynamics::{
+    ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo, VelocityTerms,
+};
+use std::cell::RefCell;
+
+/// A model whose grooves with backlash ([`crate::dynamics::ContactInfo::backlash`] > 0)
+/// are seen as one-sided contacts on the nearer flank (see the module documentation). Its
+/// other contacts and everything else are the inner model's.
+pub struct Clearance<'a, D: ?Sized> {
+    inner: &'a D,
+    /// b/2 of each contact (0 for a contact without backlash, left as it is).
+    half: Vec<f64>,
+    /// The last q seen (by its bits), the inner model's h there and the signs s: a
+    /// right-hand side asks for them at one q several times.
+    last: RefCell<(Vec<u64>, Vec<f64>, Vec<f64>)>,
+}
+
+impl<'a, D: Dynamics + ?Sized> Clearance<'a, D> {
+    /// `inner` with its grooves' backlash.
+    pub fn new(inner: &'a D) -> Self {
+        let info = inner.info();
+        Clearance {
+            inner,
+            half: info.contacts.iter().map(|c| 0.5 * c.backlash).collect(),
+            last: RefCell::new((Vec::new(), Vec::new(), Vec::new())),
+        }
+    }
+
+    /// True when some contact of `model` has backlash.
+    pub fn applies_to(model: &D) -> bool {
+        model.info().contacts.iter().any(|c| c.backlash > 0.0)
+    }
+
+    /// The signs s of the contacts with backlash at q (1 for the others) and the inner
+    /// model's h there.
+    fn signs(&self, q: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        {
+            let last = self.last.borrow();
+            if last.0.len() == q.len() && last.0.iter().zip(q).all(|(a, b)| *a == b.to_bits()) {
+                return (last.2.clone(), last.1.clone());
+            }
+        }
+        let mut h = vec![0.0; self.inner.info().n_constraints()];
+        self.inner.constraint(q, &mut h);
+        self.remember(q, &h)
+    }
+
+    /// Keeps the inner model's h at q (as computed by the caller) and its signs.
+    fn remember(&self, q: &[f64], h: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let s: Vec<f64> = self
+            .half
+            .iter()
+            .zip(h)
+            .map(|(&half, &d)| if half > 0.0 && d < 0.0 { -1.0 } else { 1.0 })
+            .collect();
+        *self.last.borrow_mut() = (
+            q.iter().map(|x| x.to_bits()).collect(),
+            h.to_vec(),
+            s.clone(),
+        );
+        (s, h.to_vec())
+    }
+
+    /// h, J and c rows of the contacts with backlash turned into the nearer flank's gap.
+    fn transform(
+        &self,
+        s: &[f64],
+        h: Option<&mut [f64]>,
+        j: Option<&mut [f64]>,
+        c: Option<&mut [f64]>,
+    ) {
+        let n = self.inner.info().n();
+        let mut h = h;
+        let mut j = j;
+        let mut c = c;
+        for (k, (&half, &s)) in self.half.iter().zip(s).enumerate() {
+            if half <= 0.0 {
+                continue;
+            }
+            if let Some(h) = h.as_deref_mut() {
+                h[k] = half - s * h[k];
+            }
+            if let Some(j) = j.as_deref_mut() {
+                for v in &mut j[k * n..(k + 1) * n] {
+                    *v *= -s;
+                }
+            }
+            if let Some(c) = c.as_deref_mut() {
+                c[k] *= -s;
+            }
+        }
+    }
+
+    /// The geometry of contact k at the flank of sign s, from the closed groove's `g` with
+    /// gap function d.
+    fn flank_geometry(g: &mut ContactGeometry, d: f64, s: f64) {
+        let offset: Vec<f64> = (0..3).map(|i| g.follower[i] - g.position[i]).collect();
+        let radius = offset
+            .iter()
+            .zip(&g.normal)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            - d;
+        g.normal = g.normal.map(|x| -s * x);
+        for i in 0..3 {
+            g.position[i] = g.follower[i] - radius * g.normal[i];
+        }
+    }
+}
+
+impl<D: Dynamics + ?Sized> Dynamics for Clearance<'_, D> {
+    fn info(&self) -> &ModelInfo {
+        self.inner.info()
+    }
+    fn parameter_values(&self) -> &[f64] {
+        self.inner.parameter_values()
+    }
+    fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
+        self.inner.mass_matrix(q, m);
+    }
+    fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
+        self.inner.inertial_forces(q, qd, f);
+    }
+    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.inner.applied_forces(t, q, qd, out);
+    }
+    fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
+        self.inner.loop_points(q, out);
+    }
+    fn constraint(&self, q: &[f64], h: &mut [f64]) {
+        self.inner.constraint(q, h);
+        let (s, _) = self.remember(q, h);
+        self.transform(&s, Some(h), None, None);
+    }
+    fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
+        self.inner.constraint_jacobian(q, j);
+        let (s, _) = self.signs(q);
+        self.transform(&s, None, Some(j), None);
+    }
+    fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
+        self.inner.constraint_bias(q, qd, c);
+        let (s, _) = self.signs(q);
+        self.transform(&s, None, None, Some(c));
+    }
+    fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
+        self.inner.constraint_terms(q, qd, j, c);
+        let (s, _) = self.signs(q);
+        self.transform(&s, None, Some(j), Some(c));
+    }
+    fn contact_geometry(&self, q: &[f64], qd: &[f64], out: &mut [ContactGeometry]) {
+        self.inner.contact_geometry(q, qd, out);
+        let (s, h) = self.signs(q);
+        for (k, g) in out.iter_mut().enumerate() {
+            if self.half.get(k).is_some_and(|&half| half > 0.0) {
+                Self::flank_geometry(g, h[k], s[k]);
+            }
+        }
+    }
+    fn contact_kinematics_into(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        k: usize,
+        out: &mut ContactKinematics,
+    ) {
+        self.inner.contact_kinematics_into(q, qd, k, out);
+        if self.half.get(k).is_some_and(|&half| half > 0.0) {
+            let (s, h) = self.signs(q);
+            Self::flank_geometry(&mut out.geometry, h[k], s[k]);
+        }
+    }
+    fn groove_flank(&self, q: &[f64], k: usize) -> Option<Flank> {
+        if !self.half.get(k).is_some_and(|&half| half > 0.0) {
+            return None;
+        }
+        let (s, _) = self.signs(q);
+        Some(if s[k] < 0.0 {
+            Flank::Inner
+        } else {
+            Flank::Outer
+        })
+    }
+    fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
+        self.inner.prescribed(t, q, qd, qdd);
+    }
+    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy {
+        self.inner.energy(q, qd)
+    }
+    fn damper_power(&self, qd: &[f64]) -> f64 {
+        self.inner.damper_power(qd)
+    }
+    fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+        self.inner.load_power(t, q, qd)
+    }
+    fn equations(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        m: &mut [f64],
+        f: &mut [f64],
+        applied: &mut [f64],
+    ) {
+        self.inner.equations(t, q, qd, m, f, applied);
+    }
+    fn cache_len(&self) -> usize {
+        self.inner.cache_len()
+    }
+    fn position_terms(&self, q: &[f64], h: &mut [f64], j: &mut [f64], cache: &mut [f64]) {
+        self.inner.position_terms(q, h, j, cache);
+        let (s, _) = self.remember(q, h);
+        self.transform(&s, Some(h), Some(j), None);
+    }
+    fn velocity_terms(&self, t: f64, q: &[f64], qd: &[f64], cache: &[f64], out: VelocityTerms) {
+        let (s, _) = self.signs(q);
+        let VelocityTerms {
+            mass,
+            inertial,
+            applied,
+            bias,
+        } = out;
+        self.inner.velocity_terms(
+            t,
+            q,
+            qd,
+            cache,
+            VelocityTerms {
+                mass,
+                inertial,
+                applied,
+                bias: &mut *bias,
+            },
+        );
+        self.transform(&s, None, None, Some(bias));
+    }
+}
