@@ -71,7 +71,7 @@ fn profile_check(g: &mut Graph, model: &Model, s: &Symbols, k: usize) -> Profile
     let c = crate::contact::curve::curve_at(g, model, s, k, at);
     let side = crate::contact::curve::follower_side(&contact.profile);
     let f = crate::contact::curve::frame(g, &c, side);
-    let radius = match &contact.profile {
+    let radius = match contact.profile.curve() {
         crate::model::Profile::Polar { r, .. } => {
             let r = s.expression(model, Field::Profile(k), r);
             Some(scalar_to_expr(g, r, at, &s.params))

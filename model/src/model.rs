@@ -427,6 +427,18 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// What lies between a groove's centre line and its flanks, as messages name it: the
+    /// roller's radius, plus half the backlash where there is one.
+    pub fn groove_label(&self) -> &'static str {
+        groove_label(self.follower.kind(), self.backlash)
+    }
+
+    /// The distance from a groove's centre line to its flanks (m): the roller's radius (0
+    /// for a knife edge) plus half the backlash.
+    pub fn groove_half_width(&self) -> f64 {
+        self.follower.radius().copied().unwrap_or(0.0) + 0.5 * self.backlash
+    }
+
     /// The profile's expression of the field `Field::Profile(c)` (f, r, x(s), or a
     /// surface's f(x, y)).
     pub fn profile_expression(&self) -> &Scalar {
@@ -591,8 +603,18 @@ pub enum RuntimeCheck {
     Inertia(usize, FieldLocation),
     /// Contact c's follower can follow its profile (no undercutting roller, a flat face on a
     /// convex profile, a positive polar radius): `camchain_runtime::contact::followable`,
-    /// reported at the roller's radius, the follower and the profile (in that order).
+    /// or for a face cam's groove `camchain_runtime::contact::groove_fits`, reported at the
+    /// roller's radius, the follower and the profile (in that order).
     Followable(usize, [FieldLocation; 3]),
+}
+
+/// What lies between a groove's centre line and its flanks, as messages name it: the
+/// follower of kind `kind` (a roller), or with a backlash the groove's half-width.
+pub fn groove_label(kind: FollowerKind, backlash: f64) -> &'static str {
+    match backlash > 0.0 {
+        true => "groove's half-width (the roller's radius and half the backlash)",
+        false => kind.label(),
+    }
 }
 
 /// A numeric field of the model, by position (body and coordinate indices are the sorted,

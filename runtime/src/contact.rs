@@ -209,18 +209,128 @@ fn followable_unnamed(
     }
 }
 
-/// [`followable`] on `samples` + 1 points of `range` evaluated by `at` (the polar radius and
-/// the curvature there), located by `places` ([`Place::Radius`], [`Place::Follower`],
-/// [`Place::Profile`] in that order): what generated `check` functions call.
-pub fn followable_located(
+/// A groove's centre line (samples `samples`, its polar radius and curvature, positive where
+/// it is hollow seen from the roller) holds a roller whose flanks lie `half_width` from it
+/// (the roller's radius, plus half the groove's backlash; `label` names that width in
+/// messages): the line is defined everywhere, a polar line keeps the inner flank off the
+/// cam's axis (r > w), and it bends less sharply than the half width on either side,
+/// |κ| w < 1 (else the roller undercuts the inner flank where the line is convex, the
+/// outer one where it is hollow). The build checks a face cam's groove with it; generated
+/// code repeats it when the groove or the roller depends on run-time parameters.
+pub fn groove_fits(
+    contact: &str,
+    (label, half_width): (&str, f64),
+    samples: &[ProfileSample],
+) -> Result<(), (Place, String)> {
+    for sample in samples {
+        if !(sample.curvature.is_finite() && (sample.radius.is_finite() || sample.radius.is_nan()))
+        {
+            return Err((
+                Place::Profile,
+                format!(
+                    "the groove's centre line is not defined at θ = {:.4} rad (its radius or \
+                     curvature is not a finite number)",
+                    sample.at
+                ),
+            ));
+        }
+        if sample.radius <= half_width {
+            return Err((
+                Place::Profile,
+                format!(
+                    "the groove's inner flank reaches the cam's axis: its centre line's radius \
+                     is {:.6} m at θ = {:.4} rad, not more than the {label} {half_width} m",
+                    sample.radius, sample.at,
+                ),
+            ));
+        }
+        if sample.curvature.abs() * half_width >= 1.0 {
+            let (flank, shape) = if sample.curvature < 0.0 {
+                ("inner", "convex")
+            } else {
+                ("outer", "hollow")
+            };
+            return Err((
+                Place::Radius,
+                format!(
+                    "contact `{contact}`: the {label} ({half_width} m) undercuts the groove's \
+                     {flank} flank: at θ = {:.4} rad the centre line is {shape} with a radius of \
+                     curvature of {:.6} m, smaller than that",
+                    sample.at,
+                    1.0 / sample.curvature.abs(),
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Angles of a turn at which a barrel's developed groove is checked.
+pub const BARREL_CHECK_SAMPLES: usize = 3600;
+
+/// A barrel cam's groove holds a roller whose flanks lie `half_width` from the pitch curve
+/// (the roller's radius, plus half the backlash; `label` names it): the pitch curve developed
+/// at the pitch radius R, (Rθ, g(θ)), bends with the radius (R² + g′²)^{3/2}/(R |g″|), which
+/// must exceed the half width on both sides. `samples` hold the developed curve's curvature
+/// R g″/(R² + g′²)^{3/2} at angles θ (the lower flank is undercut where it is negative, the
+/// upper one where it is positive); a curvature that is not a number is not checked (the
+/// build refuses such a groove where it evaluates it). The build checks a barrel's groove
+/// given as an expression with it; generated code repeats it when the groove or the roller
+/// depends on run-time parameters.
+pub fn developed_groove_fits(
+    contact: &str,
+    (label, half_width): (&str, f64),
+    samples: &[ProfileSample],
+) -> Result<(), (Place, String)> {
+    if half_width <= 0.0 {
+        return Ok(());
+    }
+    match samples
+        .iter()
+        .find(|s| s.curvature.abs() * half_width >= 1.0)
+    {
+        Some(s) => {
+            let flank = if s.curvature < 0.0 { "lower" } else { "upper" };
+            Err((
+                Place::Radius,
+                format!(
+                    "contact `{contact}`: the {label} ({half_width} m) undercuts the groove's \
+                     {flank} flank: at θ = {:.3}° the groove's pitch curve, developed at the \
+                     pitch radius, bends with a radius of {:.6} m, smaller than that",
+                    s.at.to_degrees(),
+                    1.0 / s.curvature.abs()
+                ),
+            ))
+        }
+        None => Ok(()),
+    }
+}
+
+/// [`developed_groove_fits`] at [`BARREL_CHECK_SAMPLES`] angles of a turn, the curvature
+/// evaluated by `at` (its second component; the first is not read), located by `places`.
+pub fn developed_groove_fits_located(
     places: [crate::parameters::Location; 3],
     contact: &str,
-    variable: &str,
-    shape: Shape,
-    range: (f64, f64),
+    (label, half_width): (&str, f64),
     at: impl Fn(f64) -> [f64; 2],
 ) -> Result<(), crate::ParameterError> {
-    let samples: Vec<ProfileSample> = (0..=PROFILE_CHECK_SAMPLES)
+    let samples: Vec<ProfileSample> = (0..BARREL_CHECK_SAMPLES)
+        .map(|k| {
+            let theta = std::f64::consts::TAU * k as f64 / BARREL_CHECK_SAMPLES as f64;
+            ProfileSample {
+                at: theta,
+                radius: f64::NAN,
+                curvature: at(theta)[1],
+            }
+        })
+        .collect();
+    developed_groove_fits(contact, (label, half_width), &samples).map_err(|e| located(places, e))
+}
+
+/// `samples` + 1 points of `range` evaluated by `at` (the polar radius and the curvature
+/// there).
+fn samples_of(range: (f64, f64), at: impl Fn(f64) -> [f64; 2]) -> Vec<ProfileSample> {
+    (0..=PROFILE_CHECK_SAMPLES)
         .map(|k| {
             let s = range.0 + (range.1 - range.0) * k as f64 / PROFILE_CHECK_SAMPLES as f64;
             let [radius, curvature] = at(s);
@@ -230,21 +340,55 @@ pub fn followable_located(
                 curvature,
             }
         })
-        .collect();
-    followable(contact, variable, shape, &samples).map_err(|(place, message)| {
-        let at = match place {
-            Place::Radius => places[0],
-            Place::Follower => places[1],
-            Place::Profile => places[2],
-        };
-        crate::ParameterError {
-            file: at.file.to_string(),
-            line: at.line,
-            column: at.column,
-            field: at.field.to_string(),
-            message,
-        }
-    })
+        .collect()
+}
+
+/// A problem found at `place`, located by `places` ([`Place::Radius`], [`Place::Follower`],
+/// [`Place::Profile`] in that order).
+fn located(
+    places: [crate::parameters::Location; 3],
+    (place, message): (Place, String),
+) -> crate::ParameterError {
+    let at = match place {
+        Place::Radius => places[0],
+        Place::Follower => places[1],
+        Place::Profile => places[2],
+    };
+    crate::ParameterError {
+        file: at.file.to_string(),
+        line: at.line,
+        column: at.column,
+        field: at.field.to_string(),
+        message,
+    }
+}
+
+/// [`followable`] on [`PROFILE_CHECK_SAMPLES`] + 1 points of `range` evaluated by `at` (the
+/// polar radius and the curvature there), located by `places` ([`Place::Radius`],
+/// [`Place::Follower`], [`Place::Profile`] in that order): what generated `check` functions
+/// call.
+pub fn followable_located(
+    places: [crate::parameters::Location; 3],
+    contact: &str,
+    variable: &str,
+    shape: Shape,
+    range: (f64, f64),
+    at: impl Fn(f64) -> [f64; 2],
+) -> Result<(), crate::ParameterError> {
+    followable(contact, variable, shape, &samples_of(range, at)).map_err(|e| located(places, e))
+}
+
+/// [`groove_fits`] on the samples of [`followable_located`], for a groove whose flanks lie
+/// `half_width` (the roller's radius plus half the backlash) from its centre line.
+pub fn groove_fits_located(
+    places: [crate::parameters::Location; 3],
+    contact: &str,
+    (label, half_width): (&str, f64),
+    range: (f64, f64),
+    at: impl Fn(f64) -> [f64; 2],
+) -> Result<(), crate::ParameterError> {
+    groove_fits(contact, (label, half_width), &samples_of(range, at))
+        .map_err(|e| located(places, e))
 }
 
 #[cfg(test)]

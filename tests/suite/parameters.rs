@@ -294,22 +294,46 @@ fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {
     // hollow's radius of curvature is 1/(2 depth) = 0.1 m by default) or the polar cam's
     // radius negative (base < 0.01): the generated check samples the profile as the build
     // does, with the build's message and location.
-    let cases: [(&str, f64, &str); 3] = [
+    // The barrel's groove g = 0.02 + a sin 2θ (a = 5 mm) developed at R = 0.06 m bends with
+    // the radius (R² + g′²)^{3/2}/(R |g″|); a roller of 0.2 m undercuts the lower flank
+    // (g″ < 0) from the first of the check's 3600 angles where that radius is 0.2 m or less.
+    let (a, radius) = (0.005f64, 0.06f64);
+    let first = (0..3600)
+        .map(|k| std::f64::consts::TAU * f64::from(k) / 3600.0)
+        .find(|t| {
+            let (d1, d2) = (2.0 * a * (2.0 * t).cos(), -4.0 * a * (2.0 * t).sin());
+            (radius * radius + d1 * d1).powf(1.5) / (radius * d2.abs()) <= 0.2
+        })
+        .expect("the roller undercuts");
+    let barrel = format!(
+        "undercut.ron:42:48: contacts[3].follower.radius: contact `B`: the roller (0.2 m) \
+         undercuts the groove's lower flank: at θ = {:.3}° the groove's pitch curve",
+        first.to_degrees()
+    );
+    let cases: [(&str, f64, &str); 5] = [
         (
             "rho",
             0.2,
-            "undercut.ron:26:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
+            "undercut.ron:38:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
         ),
         (
             "depth",
             50.0,
-            "undercut.ron:26:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
+            "undercut.ron:38:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
         ),
         (
             "base",
             0.005,
-            "undercut.ron:27:30: contacts[1].polar: contact `K`: the polar radius must be positive over the cam, but r(theta = 2.095418)",
+            "undercut.ron:39:30: contacts[1].polar: contact `K`: the polar radius must be positive over the cam, but r(theta = 2.095418)",
         ),
+        // The face cam's groove: a roller wider than the centre line's convex radius at
+        // θ = 0, 1/κ = r³/(r² − r r″) = 0.055³/(0.055² + 0.055·0.045) = 0.03025 m.
+        (
+            "rg",
+            0.04,
+            "undercut.ron:40:48: contacts[2].follower.radius: contact `G`: the roller (0.04 m) undercuts the groove's inner flank: at θ = 0.0000 rad the centre line is convex with a radius of curvature of 0.030250 m",
+        ),
+        ("rb", 0.2, &barrel),
     ];
     let text = std::fs::read_to_string(format!(
         "{}/tests/parameter_models/undercut.ron",
@@ -337,7 +361,8 @@ fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {
         );
     }
     // Values that keep every follower on its profile are accepted.
-    assert!(checks::undercut::Model::with(&[("rho", 0.09), ("base", 0.011)]).is_ok());
+    let fine = [("rho", 0.09), ("base", 0.011), ("rg", 0.03), ("rb", 0.15)];
+    assert!(checks::undercut::Model::with(&fine).is_ok());
 }
 
 #[test]

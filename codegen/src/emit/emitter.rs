@@ -221,7 +221,14 @@ impl<'g> Emitter<'g> {
                 Some(field) => fresh(&field, &mut taken),
                 None => self.fresh_name(id, &mut taken),
             };
-            let _ = writeln!(text, "let {name} = {expr};");
+            // A constant bound to a name is typed: a bare float literal read as a method's
+            // receiver (`zero.atan2(x)`) would leave its type ambiguous.
+            let annotation = if matches!(self.g.node(id), Node::Const(_)) {
+                ": f64"
+            } else {
+                ""
+            };
+            let _ = writeln!(text, "let {name}{annotation} = {expr};");
             self.names.insert(id, name);
         }
         (text, used_vars)

@@ -411,12 +411,41 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
                     }
                     None => "0.0".to_string(),
                 };
+                let (a, b) = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
+                let places: Vec<String> = at.iter().map(|a| location_from(a, file)).collect();
+                if matches!(contact.profile, crate::model::Profile::Barrel { .. }) {
+                    // A barrel's groove developed at its pitch radius.
+                    let _ = writeln!(
+                        statements,
+                        "rt::contact::developed_groove_fits_located([{}], {:?}, ({:?}, {radius} + {}), |s| {}(p, s))?;",
+                        places.join(", "),
+                        contact.name,
+                        contact.groove_label(),
+                        lit(0.5 * contact.backlash),
+                        followable_name(model, *k)
+                    );
+                    continue;
+                }
+                if matches!(contact.profile, crate::model::Profile::Face { .. }) {
+                    // A face cam's groove: its flanks lie the roller's radius and half the
+                    // backlash from the centre line.
+                    let label = contact.groove_label();
+                    let _ = writeln!(
+                        statements,
+                        "rt::contact::groove_fits_located([{}], {:?}, ({label:?}, {radius} + {}), ({}, {}), |s| {}(p, s))?;",
+                        places.join(", "),
+                        contact.name,
+                        lit(0.5 * contact.backlash),
+                        lit(a),
+                        lit(b),
+                        followable_name(model, *k)
+                    );
+                    continue;
+                }
                 let shape = format!(
                     "rt::contact::Shape {{ kind: rt::FollowerKind::{}, radius: {radius} }}",
                     contact.follower.kind().keyword()
                 );
-                let (a, b) = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
-                let places: Vec<String> = at.iter().map(|a| location_from(a, file)).collect();
                 let _ = writeln!(
                     statements,
                     "rt::contact::followable_located([{}], {:?}, {:?}, {shape}, ({}, {}), |s| {}(p, s))?;",

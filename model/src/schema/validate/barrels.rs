@@ -12,6 +12,7 @@ use crate::jet::{Jet2, eval_on, own_tables};
 use crate::model::Field;
 use crate::profile::{Scalar, Tabulated};
 use crate::schema::raw;
+use camchain_runtime::contact::{BARREL_CHECK_SAMPLES, ProfileSample, developed_groove_fits};
 use std::f64::consts::TAU;
 
 /// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`, with its
@@ -38,9 +39,10 @@ pub(super) fn barrel_profile(
             let f = expression(cx, &at, source, &["theta"], Field::Profile(i))?;
             closes(cx, &at, &f)?;
             // The flanks lie the roller's radius and half the backlash from the pitch curve.
-            let half_width =
-                follower.radius().copied().unwrap_or(0.0) + 0.5 * barrel.backlash.unwrap_or(0.0);
-            groove_fits(cx, path, (name, &f), radius, half_width)?;
+            let backlash = barrel.backlash.unwrap_or(0.0);
+            let half_width = follower.radius().copied().unwrap_or(0.0) + 0.5 * backlash;
+            let label = crate::model::groove_label(follower.kind(), backlash);
+            groove_fits(cx, path, (name, &f), radius, (label, half_width))?;
             (source.clone(), f, None)
         }
         (None, Some(law)) => {
@@ -104,16 +106,25 @@ pub(super) fn barrel_profile(
         let at = format!("{field}.length");
         let (_, length) = cx.dimension(&at, length)?;
         let length = positive(cx.at, &at, "the barrel's length", length)?;
-        let roller = follower.radius().copied().unwrap_or(0.0);
-        on_the_cylinder(cx, &at, &f, roller, length)?;
+        // The flanks lie the roller's radius and half the backlash from the pitch surface.
+        let half_width =
+            follower.radius().copied().unwrap_or(0.0) + 0.5 * barrel.backlash.unwrap_or(0.0);
+        on_the_cylinder(cx, &at, &f, half_width, length)?;
     }
     Ok((Profile::Barrel { source, f, radius }, design))
 }
 
-/// The groove's flanks, the roller's radius below and above its pitch surface, lie on the
-/// cylinder: 0 ≤ g(θ) − ρ and g(θ) + ρ ≤ length at 3600 angles of a turn (a law's
+/// The groove's flanks, its half-width w (the roller's radius and half the backlash) below
+/// and above its pitch surface, lie on the cylinder: 0 ≤ g(θ) − w and g(θ) + w ≤ length at
+/// 3600 angles of a turn (a law's
 /// extremes lie on its segments' joints, which are multiples of 0.1° in practice).
-fn on_the_cylinder(cx: &Context, at: &str, f: &Scalar, roller: f64, length: f64) -> Checked<()> {
+fn on_the_cylinder(
+    cx: &Context,
+    at: &str,
+    f: &Scalar,
+    half_width: f64,
+    length: f64,
+) -> Checked<()> {
     let samples = 3600;
     let heights = (0..samples).map(|k| {
         let theta = TAU * k as f64 / samples as f64;
@@ -121,11 +132,11 @@ fn on_the_cylinder(cx: &Context, at: &str, f: &Scalar, roller: f64, length: f64)
     });
     let (mut lowest, mut highest) = ((0.0, f64::INFINITY), (0.0, f64::NEG_INFINITY));
     for (theta, z) in heights {
-        if z - roller < lowest.1 {
-            lowest = (theta, z - roller);
+        if z - half_width < lowest.1 {
+            lowest = (theta, z - half_width);
         }
-        if z + roller > highest.1 {
-            highest = (theta, z + roller);
+        if z + half_width > highest.1 {
+            highest = (theta, z + half_width);
         }
     }
     // A flank exactly at an end is on the cylinder: rounding of a few ulps is let pass.
@@ -153,36 +164,30 @@ fn on_the_cylinder(cx: &Context, at: &str, f: &Scalar, roller: f64, length: f64)
 
 /// A roller fits a groove given as an expression: the pitch curve developed at the pitch
 /// radius R, (Rθ, g(θ)), bends with the radius (R² + g′²)^{3/2}/(R |g″|), which must exceed
-/// the roller's on both sides (at 3600 angles; a law's design is checked by
-/// `designs::can_be_made` the same way).
+/// the groove's half-width (the roller's radius and half the backlash) on both sides: the
+/// runtime's check (`camchain_runtime::contact::developed_groove_fits`, which generated code
+/// repeats when a run-time parameter changes the groove or the roller) at its 3600 angles (a
+/// law's design is checked by `designs::can_be_made` the same way).
 fn groove_fits(
     cx: &Context,
     path: &str,
     (name, f): (&str, &Scalar),
     radius: f64,
-    roller: f64,
+    (label, half_width): (&str, f64),
 ) -> Checked<()> {
-    if roller <= 0.0 {
-        return Ok(());
-    }
-    for k in 0..3600 {
-        let theta = TAU * k as f64 / 3600.0;
-        let g = eval_on(f, Jet2::variable(theta), &own_tables);
-        let bend = (radius * radius + g.d1 * g.d1).powf(1.5) / (radius * g.d2.abs());
-        if bend <= roller {
-            let flank = if g.d2 < 0.0 { "lower" } else { "upper" };
-            return Err(cx.at.error(
-                &format!("{path}.follower.radius"),
-                format!(
-                    "contact `{name}`: the roller ({roller} m) undercuts the groove's {flank} \
-                     flank: at θ = {:.3}° the groove's pitch curve, developed at the pitch \
-                     radius, bends with a radius of {bend:.6} m, smaller than the roller's",
-                    theta.to_degrees()
-                ),
-            ));
-        }
-    }
-    Ok(())
+    let samples: Vec<ProfileSample> = (0..BARREL_CHECK_SAMPLES)
+        .map(|k| {
+            let theta = TAU * k as f64 / BARREL_CHECK_SAMPLES as f64;
+            let g = eval_on(f, Jet2::variable(theta), &own_tables);
+            ProfileSample {
+                at: theta,
+                radius: f64::NAN,
+                curvature: radius * g.d2 / (radius * radius + g.d1 * g.d1).powf(1.5),
+            }
+        })
+        .collect();
+    developed_groove_fits(name, (label, half_width), &samples)
+        .map_err(|(_, message)| cx.at.error(&format!("{path}.follower.radius"), message))
 }
 
 /// A barrel's pitch surface closes on itself round the cylinder: f(θ + 2π) = f(θ), checked

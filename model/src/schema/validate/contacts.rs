@@ -608,13 +608,16 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
     let runtime_radius = table.is_runtime(Field::Radius(i));
     let runtime_profile =
         table.is_runtime(Field::Profile(i)) || table.is_runtime(Field::ProfileY(i));
-    // A face cam's groove is checked for the file's values only (`faces::groove_fits`).
+    // A face or barrel cam's groove: the roller fits it on both flanks (`faces::groove_fits`,
+    // `barrels::groove_fits`; a barrel designed from a law is checked by its design).
     let matters = match contact.follower.kind().outline() {
-        _ if matches!(contact.profile, Profile::Face { .. }) => false,
+        _ if matches!(contact.profile, Profile::Face { .. }) => true,
+        _ if matches!(contact.profile, Profile::Barrel { .. }) => contact.design.is_none(),
         Outline::Point => matches!(contact.profile, Profile::Polar { .. }),
         Outline::Circle | Outline::Line => true,
     };
-    if contact.range.is_some() && matters && (runtime_radius || runtime_profile) {
+    let groove = matches!(contact.profile, Profile::Barrel { .. });
+    if (contact.range.is_some() || groove) && matters && (runtime_radius || runtime_profile) {
         let path = format!("contacts[{i}]");
         table.check(RuntimeCheck::Followable(
             i,

@@ -9,10 +9,8 @@ use crate::design::CamDesign;
 use crate::model::{Contact, Field};
 use crate::samples::profile_samples;
 use crate::schema::raw;
+use camchain_runtime::contact::{PROFILE_CHECK_SAMPLES, Place, groove_fits as groove_fits_checked};
 use camchain_runtime::kinds::FollowerKind;
-
-/// Samples of the turn at which the groove's flanks are checked.
-const GROOVE_SAMPLES: usize = 3600;
 
 /// The profile of a face cam (contact `i` named `name`, path `path`) followed by
 /// `follower`, with its design when the groove is designed from a law.
@@ -108,10 +106,12 @@ pub(super) fn in_a_groove(
 }
 
 /// A groove holds a roller of radius ρ on both flanks only where its centre line bends
-/// less sharply than the roller: |κ| ρ < 1 at every one of 3600 points of the turn (the
-/// inner flank, the centre line moved towards the cam's axis by ρ, is undercut where the
-/// line is convex with a radius below ρ; the outer one where it is hollow). A polar centre
-/// line also keeps its inner flank off the axis (r > ρ) and closes on itself.
+/// less sharply than its half-width w (ρ, plus half the backlash): |κ| w < 1 at every one of
+/// 4097 points of the turn (the inner flank, the centre line moved towards the cam's axis by
+/// w, is undercut where the line is convex with a radius below w; the outer one where it is
+/// hollow). A polar centre line also keeps its inner flank off the axis (r > w) and closes on
+/// itself. The check is the runtime's (`camchain_runtime::contact::groove_fits`), which
+/// generated code repeats when the groove or the roller depends on run-time parameters.
 pub(super) fn groove_fits(at: &Locator, path: &str, contact: &Contact) -> Checked<()> {
     let Profile::Face { centre } = &contact.profile else {
         return Ok(());
@@ -120,57 +120,18 @@ pub(super) fn groove_fits(at: &Locator, path: &str, contact: &Contact) -> Checke
         Some(_) => format!("{path}.face.law"),
         None => format!("{path}.face.groove"),
     };
-    // The flanks lie the roller's radius plus half the backlash from the centre line.
-    let rho = contact.follower.radius().copied().unwrap_or(0.0) + 0.5 * contact.backlash;
-    let label = match contact.backlash > 0.0 {
-        true => "groove's half-width (the roller's radius and half the backlash)",
-        false => contact.follower.kind().label(),
-    };
     let range = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
-    let samples = profile_samples(centre, range, GROOVE_SAMPLES);
     if let Profile::Polar { r, .. } = centre.as_ref() {
         super::fields::closes(at, &field, r)?;
     }
-    for sample in &samples {
-        if !(sample.curvature.is_finite() && (sample.radius.is_finite() || sample.radius.is_nan()))
-        {
-            return Err(at.error(
-                &field,
-                format!(
-                    "the groove's centre line is not defined at θ = {:.4} rad (its radius or \
-                     curvature is not a finite number)",
-                    sample.at
-                ),
-            ));
-        }
-        if sample.radius <= rho {
-            return Err(at.error(
-                &field,
-                format!(
-                    "the groove's inner flank reaches the cam's axis: its centre line's radius \
-                     is {:.6} m at θ = {:.4} rad, not more than the {label} {rho} m",
-                    sample.radius, sample.at,
-                ),
-            ));
-        }
-        if sample.curvature.abs() * rho >= 1.0 {
-            let (flank, shape) = if sample.curvature < 0.0 {
-                ("inner", "convex")
-            } else {
-                ("outer", "hollow")
-            };
-            return Err(at.error(
-                &format!("{path}.follower.radius"),
-                format!(
-                    "contact `{}`: the {label} ({rho} m) undercuts the groove's {flank} flank: \
-                     at θ = {:.4} rad the centre line is {shape} with a radius of curvature of \
-                     {:.6} m, smaller than that",
-                    contact.name,
-                    sample.at,
-                    1.0 / sample.curvature.abs(),
-                ),
-            ));
-        }
-    }
-    Ok(())
+    let samples = profile_samples(centre, range, PROFILE_CHECK_SAMPLES);
+    groove_fits_checked(
+        &contact.name,
+        (contact.groove_label(), contact.groove_half_width()),
+        &samples,
+    )
+    .map_err(|(place, message)| match place {
+        Place::Radius => at.error(&format!("{path}.follower.radius"), message),
+        Place::Follower | Place::Profile => at.error(&field, message),
+    })
 }
