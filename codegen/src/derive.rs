@@ -76,6 +76,8 @@ fn profile_check(g: &mut Graph, model: &Model, s: &Symbols, k: usize) -> Profile
             let r = s.expression(model, Field::Profile(k), r);
             Some(scalar_to_expr(g, r, at, &s.params))
         }
+        // A barrel's pitch height g(θ), for its cylinder's length.
+        crate::model::Profile::Barrel { .. } => Some(c.point[1]),
         _ => None,
     };
     ProfileCheck {

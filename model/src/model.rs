@@ -251,6 +251,9 @@ pub enum Profile {
         f: Scalar,
         /// The pitch cylinder's radius R (m): where the roller's centre runs.
         radius: f64,
+        /// The cylinder's length along its axis from the cam frame's origin (m), when the
+        /// file gives it: the groove's flanks must lie on it.
+        length: Option<f64>,
     },
     /// A surface of revolution r = g(z) about the cam frame's axis x̂ × ŷ, r the distance
     /// from that axis: the cam's material inside it (r < g(z)), the follower outside
@@ -356,10 +359,12 @@ impl Profile {
                 source: s,
                 f,
                 radius,
+                length,
             } => Profile::Barrel {
                 source: source(s),
                 f: f.resolve_all(values),
                 radius: *radius,
+                length: *length,
             },
             Profile::Revolution { source: s, g } => Profile::Revolution {
                 source: source(s),
@@ -603,8 +608,10 @@ pub enum RuntimeCheck {
     Inertia(usize, FieldLocation),
     /// Contact c's follower can follow its profile (no undercutting roller, a flat face on a
     /// convex profile, a positive polar radius): `camchain_runtime::contact::followable`,
-    /// or for a face cam's groove `camchain_runtime::contact::groove_fits`, reported at the
-    /// roller's radius, the follower and the profile (in that order).
+    /// or for a face cam's groove `camchain_runtime::contact::groove_fits` and for a barrel's
+    /// `developed_groove_fits` and `groove_on_cylinder`, reported at the roller's radius, the
+    /// follower (a barrel's `length`, which barrels' followers never need) and the profile
+    /// (in that order).
     Followable(usize, [FieldLocation; 3]),
 }
 

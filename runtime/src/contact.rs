@@ -306,25 +306,74 @@ pub fn developed_groove_fits(
     }
 }
 
-/// [`developed_groove_fits`] at [`BARREL_CHECK_SAMPLES`] angles of a turn, the curvature
-/// evaluated by `at` (its second component; the first is not read), located by `places`.
+/// A barrel's groove lies on its cylinder of length `length` (from the cam frame's origin
+/// along its axis): its flanks, `half_width` below and above the pitch surface, stay within
+/// [0, length] at the angles θ of `heights` (θ, g(θ)), up to rounding (1e-12 of the length).
+/// The build checks it with the file's values; generated code repeats it when a run-time
+/// parameter moves the groove or changes the roller.
+pub fn groove_on_cylinder(
+    length: f64,
+    half_width: f64,
+    heights: &[(f64, f64)],
+) -> Result<(), String> {
+    let (mut lowest, mut highest) = ((0.0, f64::INFINITY), (0.0, f64::NEG_INFINITY));
+    for &(theta, z) in heights {
+        if z - half_width < lowest.1 {
+            lowest = (theta, z - half_width);
+        }
+        if z + half_width > highest.1 {
+            highest = (theta, z + half_width);
+        }
+    }
+    // A flank exactly at an end is on the cylinder: rounding of a few ulps is let pass.
+    let slack = 1e-12 * length;
+    let beyond = if highest.1 > length + slack {
+        Some(("upper", highest, "its length"))
+    } else if lowest.1 < -slack {
+        Some(("lower", lowest, "its start (z = 0)"))
+    } else {
+        None
+    };
+    match beyond {
+        None => Ok(()),
+        Some((side, (theta, value), edge)) => Err(format!(
+            "the groove leaves the cylinder: its {side} flank reaches z = {value:.6} m at θ = \
+             {:.3}°, beyond {edge}; the cylinder is {length} m long (lengthen it, or move the \
+             groove with `base`)",
+            theta.to_degrees()
+        )),
+    }
+}
+
+/// [`developed_groove_fits`] and, for a cylinder of `length` (located at `length_at`),
+/// [`groove_on_cylinder`] at [`BARREL_CHECK_SAMPLES`] angles of a turn, `at` giving the pitch
+/// height g(θ) and the developed curvature there; the first located by `places`.
 pub fn developed_groove_fits_located(
     places: [crate::parameters::Location; 3],
     contact: &str,
     (label, half_width): (&str, f64),
+    length: Option<(f64, crate::parameters::Location)>,
     at: impl Fn(f64) -> [f64; 2],
 ) -> Result<(), crate::ParameterError> {
     let samples: Vec<ProfileSample> = (0..BARREL_CHECK_SAMPLES)
         .map(|k| {
             let theta = std::f64::consts::TAU * k as f64 / BARREL_CHECK_SAMPLES as f64;
+            let [height, curvature] = at(theta);
             ProfileSample {
                 at: theta,
-                radius: f64::NAN,
-                curvature: at(theta)[1],
+                radius: height,
+                curvature,
             }
         })
         .collect();
-    developed_groove_fits(contact, (label, half_width), &samples).map_err(|e| located(places, e))
+    developed_groove_fits(contact, (label, half_width), &samples)
+        .map_err(|e| located(places, e))?;
+    let Some((length, length_at)) = length else {
+        return Ok(());
+    };
+    let heights: Vec<(f64, f64)> = samples.iter().map(|s| (s.at, s.radius)).collect();
+    groove_on_cylinder(length, half_width, &heights)
+        .map_err(|message| located([length_at; 3], (Place::Profile, message)))
 }
 
 /// `samples` + 1 points of `range` evaluated by `at` (the polar radius and the curvature

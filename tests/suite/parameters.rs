@@ -306,34 +306,41 @@ fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {
         })
         .expect("the roller undercuts");
     let barrel = format!(
-        "undercut.ron:42:48: contacts[3].follower.radius: contact `B`: the roller (0.2 m) \
+        "undercut.ron:44:48: contacts[3].follower.radius: contact `B`: the roller (0.2 m) \
          undercuts the groove's lower flank: at θ = {:.3}° the groove's pitch curve",
         first.to_degrees()
     );
-    let cases: [(&str, f64, &str); 5] = [
+    let cases: [(&str, f64, &str); 6] = [
         (
             "rho",
             0.2,
-            "undercut.ron:38:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
+            "undercut.ron:40:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.2 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-1 m",
         ),
         (
             "depth",
             50.0,
-            "undercut.ron:38:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
+            "undercut.ron:40:48: contacts[0].follower.radius: contact `R`: the roller (radius 0.02 m) is larger than the profile's hollow at x = 0.000000, whose radius of curvature is 1.000000e-2 m",
         ),
         (
             "base",
             0.005,
-            "undercut.ron:39:30: contacts[1].polar: contact `K`: the polar radius must be positive over the cam, but r(theta = 2.095418)",
+            "undercut.ron:41:30: contacts[1].polar: contact `K`: the polar radius must be positive over the cam, but r(theta = 2.095418)",
         ),
         // The face cam's groove: a roller wider than the centre line's convex radius at
         // θ = 0, 1/κ = r³/(r² − r r″) = 0.055³/(0.055² + 0.055·0.045) = 0.03025 m.
         (
             "rg",
             0.04,
-            "undercut.ron:40:48: contacts[2].follower.radius: contact `G`: the roller (0.04 m) undercuts the groove's inner flank: at θ = 0.0000 rad the centre line is convex with a radius of curvature of 0.030250 m",
+            "undercut.ron:42:48: contacts[2].follower.radius: contact `G`: the roller (0.04 m) undercuts the groove's inner flank: at θ = 0.0000 rad the centre line is convex with a radius of curvature of 0.030250 m",
         ),
         ("rb", 0.2, &barrel),
+        // A roller of 0.03 m (no undercut: the groove bends with 0.18 m at least) whose
+        // upper flank, 0.02 + 0.005 + 0.03 m at θ = 45°, leaves the 0.05 m cylinder.
+        (
+            "rb",
+            0.03,
+            "undercut.ron:45:83: contacts[3].barrel.length: the groove leaves the cylinder: its upper flank reaches z = 0.055000 m at θ = 45.000°, beyond its length",
+        ),
     ];
     let text = std::fs::read_to_string(format!(
         "{}/tests/parameter_models/undercut.ron",
@@ -361,7 +368,7 @@ fn a_follower_that_cannot_follow_its_profile_is_refused_at_run_time() {
         );
     }
     // Values that keep every follower on its profile are accepted.
-    let fine = [("rho", 0.09), ("base", 0.011), ("rg", 0.03), ("rb", 0.15)];
+    let fine = [("rho", 0.09), ("base", 0.011), ("rg", 0.03), ("rb", 0.015)];
     assert!(checks::undercut::Model::with(&fine).is_ok());
 }
 

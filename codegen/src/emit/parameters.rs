@@ -413,11 +413,15 @@ fn check_function(model: &Model, d: &Derivation, file: &str) -> String {
                 };
                 let (a, b) = contact.range.unwrap_or((0.0, std::f64::consts::TAU));
                 let places: Vec<String> = at.iter().map(|a| location_from(a, file)).collect();
-                if matches!(contact.profile, crate::model::Profile::Barrel { .. }) {
-                    // A barrel's groove developed at its pitch radius.
+                if let crate::model::Profile::Barrel { length, .. } = &contact.profile {
+                    // A barrel's groove developed at its pitch radius, on its cylinder.
+                    let length = match length {
+                        Some(l) => format!("Some(({}, {}))", lit(*l), places[1]),
+                        None => "None".to_string(),
+                    };
                     let _ = writeln!(
                         statements,
-                        "rt::contact::developed_groove_fits_located([{}], {:?}, ({:?}, {radius} + {}), |s| {}(p, s))?;",
+                        "rt::contact::developed_groove_fits_located([{}], {:?}, ({:?}, {radius} + {}), {length}, |s| {}(p, s))?;",
                         places.join(", "),
                         contact.name,
                         contact.groove_label(),

@@ -12,7 +12,9 @@ use crate::jet::{Jet2, eval_on, own_tables};
 use crate::model::Field;
 use crate::profile::{Scalar, Tabulated};
 use crate::schema::raw;
-use camchain_runtime::contact::{BARREL_CHECK_SAMPLES, ProfileSample, developed_groove_fits};
+use camchain_runtime::contact::{
+    BARREL_CHECK_SAMPLES, ProfileSample, developed_groove_fits, groove_on_cylinder,
+};
 use std::f64::consts::TAU;
 
 /// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`, with its
@@ -102,22 +104,37 @@ pub(super) fn barrel_profile(
             ));
         }
     };
-    if let Some(length) = &barrel.length {
-        let at = format!("{field}.length");
-        let (_, length) = cx.dimension(&at, length)?;
-        let length = positive(cx.at, &at, "the barrel's length", length)?;
-        // The flanks lie the roller's radius and half the backlash from the pitch surface.
-        let half_width =
-            follower.radius().copied().unwrap_or(0.0) + 0.5 * barrel.backlash.unwrap_or(0.0);
-        on_the_cylinder(cx, &at, &f, half_width, length)?;
-    }
-    Ok((Profile::Barrel { source, f, radius }, design))
+    let length = match &barrel.length {
+        Some(length) => {
+            // A number the generated check reads as it is: it may not depend on run-time
+            // parameters (the groove and the roller may, and are checked against it again).
+            let at = format!("{field}.length");
+            let length = cx.number(&at, length, None)?;
+            let length = positive(cx.at, &at, "the barrel's length", length)?;
+            // The flanks lie the roller's radius and half the backlash from the pitch surface.
+            let half_width =
+                follower.radius().copied().unwrap_or(0.0) + 0.5 * barrel.backlash.unwrap_or(0.0);
+            on_the_cylinder(cx, &at, &f, half_width, length)?;
+            Some(length)
+        }
+        None => None,
+    };
+    Ok((
+        Profile::Barrel {
+            source,
+            f,
+            radius,
+            length,
+        },
+        design,
+    ))
 }
 
 /// The groove's flanks, its half-width w (the roller's radius and half the backlash) below
 /// and above its pitch surface, lie on the cylinder: 0 ≤ g(θ) − w and g(θ) + w ≤ length at
-/// 3600 angles of a turn (a law's
-/// extremes lie on its segments' joints, which are multiples of 0.1° in practice).
+/// 3600 angles of a turn (a law's extremes lie on its segments' joints, which are multiples
+/// of 0.1° in practice), by the runtime's check (`contact::groove_on_cylinder`), which
+/// generated code repeats when a run-time parameter moves the groove or changes the roller.
 fn on_the_cylinder(
     cx: &Context,
     at: &str,
@@ -125,41 +142,13 @@ fn on_the_cylinder(
     half_width: f64,
     length: f64,
 ) -> Checked<()> {
-    let samples = 3600;
-    let heights = (0..samples).map(|k| {
-        let theta = TAU * k as f64 / samples as f64;
-        (theta, f.eval(theta))
-    });
-    let (mut lowest, mut highest) = ((0.0, f64::INFINITY), (0.0, f64::NEG_INFINITY));
-    for (theta, z) in heights {
-        if z - half_width < lowest.1 {
-            lowest = (theta, z - half_width);
-        }
-        if z + half_width > highest.1 {
-            highest = (theta, z + half_width);
-        }
-    }
-    // A flank exactly at an end is on the cylinder: rounding of a few ulps is let pass.
-    let slack = 1e-12 * length;
-    let beyond = if highest.1 > length + slack {
-        Some(("upper", highest, "its length"))
-    } else if lowest.1 < -slack {
-        Some(("lower", lowest, "its start (z = 0)"))
-    } else {
-        None
-    };
-    match beyond {
-        None => Ok(()),
-        Some((side, (theta, value), edge)) => Err(cx.at.error(
-            at,
-            format!(
-                "the groove leaves the cylinder: its {side} flank reaches z = {value:.6} m at θ \
-                 = {:.3}°, beyond {edge}; the cylinder is {length} m long (lengthen it, or \
-                 move the groove with `base`)",
-                theta.to_degrees()
-            ),
-        )),
-    }
+    let heights: Vec<(f64, f64)> = (0..BARREL_CHECK_SAMPLES)
+        .map(|k| {
+            let theta = TAU * k as f64 / BARREL_CHECK_SAMPLES as f64;
+            (theta, f.eval(theta))
+        })
+        .collect();
+    groove_on_cylinder(length, half_width, &heights).map_err(|message| cx.at.error(at, message))
 }
 
 /// A roller fits a groove given as an expression: the pitch curve developed at the pitch

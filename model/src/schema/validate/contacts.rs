@@ -609,21 +609,31 @@ fn recheck_at_run_time(cx: &Context, i: usize, contact: &Contact) {
     let runtime_profile =
         table.is_runtime(Field::Profile(i)) || table.is_runtime(Field::ProfileY(i));
     // A face or barrel cam's groove: the roller fits it on both flanks (`faces::groove_fits`,
-    // `barrels::groove_fits`; a barrel designed from a law is checked by its design).
+    // `barrels::groove_fits`), and a barrel's groove stays on its cylinder.
     let matters = match contact.follower.kind().outline() {
-        _ if matches!(contact.profile, Profile::Face { .. }) => true,
-        _ if matches!(contact.profile, Profile::Barrel { .. }) => contact.design.is_none(),
+        _ if matches!(
+            contact.profile,
+            Profile::Face { .. } | Profile::Barrel { .. }
+        ) =>
+        {
+            true
+        }
         Outline::Point => matches!(contact.profile, Profile::Polar { .. }),
         Outline::Circle | Outline::Line => true,
     };
     let groove = matches!(contact.profile, Profile::Barrel { .. });
     if (contact.range.is_some() || groove) && matters && (runtime_radius || runtime_profile) {
         let path = format!("contacts[{i}]");
+        // A barrel refuses flat faces: the follower's place holds its length's instead.
+        let second = match contact.profile {
+            Profile::Barrel { .. } => format!("{path}.barrel.length"),
+            _ => format!("{path}.follower"),
+        };
         table.check(RuntimeCheck::Followable(
             i,
             [
                 super::location(cx.at, &format!("{path}.follower.radius")),
-                super::location(cx.at, &format!("{path}.follower")),
+                super::location(cx.at, &second),
                 super::location(cx.at, &format!("{path}.{}", profile_field(contact))),
             ],
         ));
