@@ -297,3 +297,97 @@ fn a_surface_is_checked_over_its_region_before_running() {
         "only a surface",
     );
 }
+
+/// BASE with its surface given as the grid table `grid.csv`, embedded as `csv`.
+fn grid_model(csv: &str, ends: &str) -> Result<camchain_model::Model, camchain_model::ModelError> {
+    use camchain_model::model::ParameterMode;
+    use camchain_model::schema::{Files, parse_model_from};
+    let source = edited(
+        r#"surface: "c*(x*x + y*y) + 0.1*(x*y).sin()","#,
+        &format!(r#"table: (form: Surface, file: "grid.csv"{ends}),"#),
+    );
+    let files = [("grid.csv", csv)];
+    parse_model_from(
+        &source,
+        Path::new("models/surface.ron"),
+        &[],
+        ParameterMode::AsDeclared,
+        Files::Embedded(&files),
+    )
+}
+
+/// x, y, z rows of z = x² − x y + 3 y on nx × ny knots, in the order given by `order`.
+fn grid_rows(nx: usize, ny: usize, order: impl Fn(usize, usize) -> (usize, usize)) -> String {
+    let mut text = String::from("x, y, z\n");
+    for a in 0..nx {
+        for b in 0..ny {
+            let (i, j) = order(a, b);
+            let (x, y) = (0.1 * i as f64 - 0.2, 0.05 * j as f64);
+            text.push_str(&format!("{x}, {y}, {}\n", x * x - x * y + 3.0 * y));
+        }
+    }
+    text
+}
+
+#[test]
+fn a_grid_table_is_a_surface_whatever_the_order_of_its_rows() {
+    // The same 5 × 4 grid written row by row and column by column (reversed): the two
+    // surfaces agree at every point, and interpolate the grid's values at its knots.
+    let by_rows = grid_model(&grid_rows(5, 4, |a, b| (a, b)), "").expect("a grid");
+    let by_columns = grid_model(&grid_rows(4, 5, |a, b| (4 - b, 3 - a)), "").expect("a grid");
+    let f = |m: &camchain_model::Model| match &m.contacts[0].profile {
+        Profile::Surface { f, source } => {
+            assert!(source.contains("5 × 4 grid of grid.csv"), "{source}");
+            f.clone()
+        }
+        other => panic!("{other:?}"),
+    };
+    let (a, b) = (f(&by_rows), f(&by_columns));
+    for (x, y) in [
+        (-0.2, 0.0),
+        (0.0, 0.1),
+        (0.13, 0.07),
+        (0.2, 0.15),
+        (-0.05, 0.12),
+    ] {
+        let (u, v) = (a.eval_at(&[x, y]), b.eval_at(&[x, y]));
+        // The same spline from the same numbers: equal to rounding.
+        assert!((u - v).abs() < 1e-15, "({x}, {y}): {u} against {v}");
+    }
+    // At the knots the surface takes the grid's values (the spline interpolates).
+    let (x, y) = (0.1 * 3.0 - 0.2, 0.05 * 2.0);
+    assert!((a.eval_at(&[x, y]) - (x * x - x * y + 3.0 * y)).abs() < 1e-15);
+}
+
+#[test]
+fn a_grid_table_refuses_its_misuses_where_they_are() {
+    // A grid needs a file, and no more than 250 000 points (the generated code keeps each).
+    let error = grid_model(&grid_rows(501, 500, |a, b| (a, b)), "").expect_err("too large");
+    assert_eq!(
+        (error.line, error.field.as_str()),
+        (250_002, "contacts[0].table.file")
+    );
+    assert!(
+        error
+            .message
+            .contains("more than the 250000 a table may hold"),
+        "{error}"
+    );
+    // `y_ends` belongs to surfaces only; `degrees` to polar tables only.
+    let source = edited(
+        r#"surface: "c*(x*x + y*y) + 0.1*(x*y).sin()","#,
+        r#"table: (form: Explicit, points: [(0.0, 0.0), (1.0, 1.0)], y_ends: Natural),"#,
+    );
+    rejected(
+        &source,
+        "contacts[0].table.y_ends",
+        16,
+        "only a surface's table",
+    );
+    let error =
+        grid_model(&grid_rows(3, 3, |a, b| (a, b)), ", degrees: true").expect_err("degrees");
+    assert_eq!(error.field, "contacts[0].table.degrees");
+    // Too few knots along y for a periodic axis (4 at least).
+    let error = grid_model(&grid_rows(4, 3, |a, b| (a, b)), ", y_ends: Periodic").expect_err("few");
+    assert!(error.message.contains("the y knots"), "{error}");
+}

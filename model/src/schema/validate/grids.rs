@@ -10,7 +10,7 @@
 //! values that change too fast for their spacing. The spline is built in O(n) for n points
 //! (the runtime's solves along the grid lines) when the file is read.
 
-use super::table_files::{LARGEST, ends_of, read_file};
+use super::table_files::{LARGEST, MAX_TABLE_POINTS, ends_of, read_file, too_many_points};
 use super::{Checked, Context, Profile};
 use crate::error::ModelError;
 use crate::model::Follower;
@@ -57,6 +57,9 @@ pub(super) fn grid_profile(
         message,
     };
     let rows = csv::read(&text, ["x", "y", "z"]).map_err(|e| at(e.line, e.column, e.message))?;
+    if let Some(row) = rows.get(MAX_TABLE_POINTS) {
+        return Err(at(row.line, row.columns[0], too_many_points(rows.len())));
+    }
     for row in &rows {
         for (k, &v) in row.values.iter().enumerate() {
             if v.abs() > LARGEST {

@@ -9,6 +9,20 @@ use crate::schema::{Files, read_text};
 use camchain_runtime::spline::Ends;
 use std::path::{Path, PathBuf};
 
+/// Most points a table (or a surface's grid) holds: the generated code keeps them and the
+/// spline's derivatives at them as constants (three or four numbers a point), which the Rust
+/// compiler takes about 10 s and 1 GB per million to build; 250 000 points (a 500 × 500 grid)
+/// stay within a few seconds, far beyond what a cam needs (a 0.1° polar table has 3601).
+pub(crate) const MAX_TABLE_POINTS: usize = 250_000;
+
+/// The error of a table of `count` points beyond [`MAX_TABLE_POINTS`].
+pub(super) fn too_many_points(count: usize) -> String {
+    format!(
+        "the table has {count} points, more than the {MAX_TABLE_POINTS} a table may hold (the \
+         generated code keeps every point as a constant): sample it more coarsely"
+    )
+}
+
 /// Largest magnitude of a number in a table. The spline's arithmetic squares and cubes
 /// differences of the table's numbers and sums up to a table's length of them (chord
 /// lengths, slopes, the cubic's terms): below 1e100 every such product stays below 1e300,

@@ -17,7 +17,7 @@
 //! within ±[`LARGEST`], so that the spline's arithmetic cannot overflow, and the spline
 //! built is checked finite.
 
-use super::table_files::{LARGEST, ends_of, read_file};
+use super::table_files::{LARGEST, MAX_TABLE_POINTS, ends_of, read_file, too_many_points};
 use super::{Checked, Context, Profile};
 use crate::error::ModelError;
 use crate::model::Follower;
@@ -97,6 +97,16 @@ pub(super) fn table_profile(
         ));
     }
     let points = points(cx, &field, table, names)?;
+    if points.values.len() > MAX_TABLE_POINTS {
+        let at = &points.at[MAX_TABLE_POINTS];
+        return Err(point_error(
+            cx,
+            &field,
+            at,
+            0,
+            too_many_points(points.values.len()),
+        ));
+    }
     within_range(cx, &field, &points)?;
     let ends = table.ends.map(ends_of);
     let described = |what: &str| match &points.from {
