@@ -1,9 +1,12 @@
 //! Grooves with backlash: a roller (or a pin) in a barrel or face cam's groove wider than it.
 //!
 //! A closed groove holds the roller on its centre line: the contact's gap function is d(q), the
-//! signed distance of the roller's centre from the centre line (positive towards the flank a
-//! negative normal force would press: a face cam's outer flank, a barrel's upper one), and the
-//! contact is bilateral. With a backlash b > 0 the groove is b wider than the roller, so the
+//! signed offset of the roller's centre from it (positive towards the flank a negative normal
+//! force would press: a face cam's outer flank, a barrel's upper one), and the contact is
+//! bilateral. For a face cam d is the distance from the centre line; for a barrel it is the
+//! height above the pitch surface along the cam's axis, so a barrel's backlash is the roller's
+//! axial play (the flanks are the pitch surface moved b/2 up and down the axis, then offset by
+//! the roller's radius). With a backlash b > 0 the groove is b wider than the roller, so the
 //! centre moves freely while |d| < b/2 and touches a flank at d = ±b/2: two one-sided
 //! contacts, never both at once. [`Clearance`] presents them to the one-sided run
 //! ([`crate::unilateral`]) as one contact whose gap is the distance to the nearer flank,
@@ -18,7 +21,8 @@
 //! away from it, towards the centre line: the normal is −s n (n the closed groove's normal,
 //! from the inner or lower flank towards the roller), and the contact point is the roller's
 //! rim on that side, C − ρ (−s n) with C its centre and ρ its radius (the closed groove's
-//! reported point is C − (d + ρ) n, which gives ρ). A lift-off is the roller leaving a flank,
+//! reported point is C − d u − ρ n, u = n for a face cam and the cam's axis for a barrel,
+//! which gives ρ). A lift-off is the roller leaving a flank,
 //! a landing an impact on one ([`Dynamics::groove_flank`] says which).
 //!
 //! The cam-frame coordinates of the contact point (`x`, `y`, `z` of [`ContactGeometry`], what
@@ -119,19 +123,26 @@ impl<'a, D: Dynamics + ?Sized> Clearance<'a, D> {
     }
 
     /// The geometry of contact k at the flank of sign s, from the closed groove's `g` with
-    /// gap function d.
-    fn flank_geometry(g: &mut ContactGeometry, d: f64, s: f64) {
-        let offset: Vec<f64> = (0..3).map(|i| g.follower[i] - g.position[i]).collect();
-        let radius = offset
-            .iter()
-            .zip(&g.normal)
-            .map(|(a, b)| a * b)
-            .sum::<f64>()
-            - d;
+    /// gap function d: the centre C is the closed groove's point plus d u + ρ n, u the normal
+    /// n itself for a face cam (d a distance) and the cam's axis for a barrel (`axial`: d a
+    /// height), which gives ρ.
+    fn flank_geometry(g: &mut ContactGeometry, d: f64, s: f64, axial: bool) {
+        let dot = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|i| a[i] * b[i]).sum::<f64>();
+        let offset: [f64; 3] = std::array::from_fn(|i| g.follower[i] - g.position[i]);
+        let along_normal = if axial { dot(&g.axis, &g.normal) } else { 1.0 };
+        let radius = dot(&offset, &g.normal) - d * along_normal;
         g.normal = g.normal.map(|x| -s * x);
         for i in 0..3 {
             g.position[i] = g.follower[i] - radius * g.normal[i];
         }
+    }
+}
+
+impl<D: Dynamics + ?Sized> Clearance<'_, D> {
+    /// Whether contact k's gap is a height along the cam's axis (a barrel's pitch surface)
+    /// rather than a distance (a face cam's centre line).
+    fn axial(&self, k: usize) -> bool {
+        self.inner.info().contacts[k].profile == crate::dynamics::ProfileKind::Barrel
     }
 }
 
@@ -179,7 +190,7 @@ impl<D: Dynamics + ?Sized> Dynamics for Clearance<'_, D> {
         let (s, h) = self.signs(q);
         for (k, g) in out.iter_mut().enumerate() {
             if self.half.get(k).is_some_and(|&half| half > 0.0) {
-                Self::flank_geometry(g, h[k], s[k]);
+                Self::flank_geometry(g, h[k], s[k], self.axial(k));
             }
         }
     }
@@ -193,7 +204,7 @@ impl<D: Dynamics + ?Sized> Dynamics for Clearance<'_, D> {
         self.inner.contact_kinematics_into(q, qd, k, out);
         if self.half.get(k).is_some_and(|&half| half > 0.0) {
             let (s, h) = self.signs(q);
-            Self::flank_geometry(&mut out.geometry, h[k], s[k]);
+            Self::flank_geometry(&mut out.geometry, h[k], s[k], self.axial(k));
         }
     }
     fn groove_flank(&self, q: &[f64], k: usize) -> Option<Flank> {

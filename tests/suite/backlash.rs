@@ -146,6 +146,13 @@ fn a_roller_crosses_its_grooves_backlash_as_the_closed_form_says() {
     }
     // The whole trajectory: z = base until the first impact, then on the lower flank, in
     // flight, on the upper flank.
+    let rho = m
+        .model()
+        .parameters
+        .iter()
+        .find(|p| p.name == "rho")
+        .map(|p| p.default)
+        .expect("declared");
     let mut worst = 0.0f64;
     for sample in &run.samples {
         let t = sample.t;
@@ -160,6 +167,30 @@ fn a_roller_crosses_its_grooves_backlash_as_the_closed_form_says() {
             g.base + s + half
         };
         worst = worst.max((sample.q[1] - z).abs());
+        // The contact point and normal are the flank's: above the roller's centre on the
+        // upper flank, whose normal pushes down, below it on the lower one.
+        let g = &sample.contacts[0];
+        let reach = (0..3)
+            .map(|i| (g.position[i] - g.follower[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        // The rim is the roller's radius from its centre (rounding of a few operations on
+        // lengths of 0.01–0.06 m).
+        assert!(
+            (reach - rho).abs() < 1e-15,
+            "t = {t}: {reach} from the centre"
+        );
+        if t > t2 + 1e-6 {
+            assert!(
+                g.position[2] > sample.q[1] && g.normal[2] < 0.0,
+                "t = {t}: {g:?}"
+            );
+        } else if t > t1 + 1e-6 && t < t_star - 1e-6 {
+            assert!(
+                g.position[2] < sample.q[1] && g.normal[2] > 0.0,
+                "t = {t}: {g:?}"
+            );
+        }
     }
     println!(
         "backlash: impacts at {:.9} s and {:.9} s, lift-off at {:.9} s, events within \
