@@ -268,3 +268,59 @@ fn a_rebound_in_the_groove_lands_where_its_flight_meets_a_flank() {
         second.t
     );
 }
+
+#[test]
+fn the_clearance_gap_has_the_jacobian_and_convective_term_of_its_differences() {
+    // (K1)–(K2) of docs/method.md §13.10 against finite differences of g = b/2 − s d itself,
+    // on both sides of the centre line (s = ±1) and with the cam turning.
+    use camchain::runtime::clearance::Clearance;
+    let m = model();
+    let view = Clearance::new(&m);
+    let start = m.assemble(0.0).expect("assembles");
+    let n = start.q.len();
+    let g = |q: &[f64]| {
+        let mut h = [0.0];
+        view.constraint(q, &mut h);
+        h[0]
+    };
+    for (lift, rate) in [(0.0006, 0.3), (-0.0004, -0.2), (0.0009, 0.05)] {
+        let mut q = start.q.clone();
+        q[0] = 1.3; // the cam angle: inside the rise
+        q[1] += lift;
+        let qd = vec![10.0, rate];
+        let mut j = vec![0.0; n];
+        view.constraint_jacobian(&q, &mut j);
+        for k in 0..n {
+            let step = 1e-7;
+            let (mut up, mut down) = (q.clone(), q.clone());
+            up[k] += step;
+            down[k] -= step;
+            let fd = (g(&up) - g(&down)) / (2.0 * step);
+            // Central differences of a function of order 1e-3 m with derivatives of order 1:
+            // truncation ~1e-14 · |g‴|, rounding ~1e-19/1e-7: 1e-8.
+            assert!(
+                (j[k] - fd).abs() < 1e-8,
+                "lift {lift}: ∂g/∂q{k} {} against {fd}",
+                j[k]
+            );
+        }
+        let mut c = [0.0];
+        view.constraint_bias(&q, &qd, &mut c);
+        let along = |tau: f64| {
+            let p: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + tau * b).collect();
+            g(&p)
+        };
+        let plain = |tau: f64| (along(tau) - 2.0 * along(0.0) + along(-tau)) / (tau * tau);
+        // Richardson from τ = 2e-4 and 1e-4 (as the contact scenes' tests): 1e-6 relative.
+        let fd = (4.0 * plain(1e-4) - plain(2e-4)) / 3.0;
+        assert!(
+            (c[0] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+            "lift {lift}: c {} against {fd}",
+            c[0]
+        );
+        // The sign: the gap shrinks towards the flank the offset points to.
+        let mut h = [0.0];
+        m.constraint(&q, &mut h);
+        assert!((g(&q) - (0.001 - h[0].abs())).abs() < 1e-15);
+    }
+}
