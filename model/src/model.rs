@@ -429,6 +429,10 @@ pub struct Contact {
     /// freely between the flanks and touches one at a time (one-sided, with the model's
     /// restitution); 0 for a closed groove and for every other cam.
     pub backlash: f64,
+    /// The half-angle (rad) of a tapered roller in a barrel's groove (`tapered: true`), its
+    /// apex on the cam's axis: atan(ρ/R), ρ the roller's radius at the pitch radius R; 0 for a
+    /// straight roller and every other cam.
+    pub taper: f64,
 }
 
 impl Contact {

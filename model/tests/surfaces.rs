@@ -391,3 +391,34 @@ fn a_grid_table_refuses_its_misuses_where_they_are() {
     let error = grid_model(&grid_rows(4, 3, |a, b| (a, b)), ", y_ends: Periodic").expect_err("few");
     assert!(error.message.contains("the y knots"), "{error}");
 }
+
+#[test]
+fn a_tapered_groove_takes_a_roller_of_constant_size() {
+    // A roller of 10 mm at the pitch radius 60 mm: half-angle atan(1/6).
+    let with_roller = |radius: &str| {
+        edited(
+            "marker: \"tip\",\n",
+            &format!("marker: \"tip\", follower: Roller(radius: {radius}),\n"),
+        )
+        .replace(
+            "surface: \"c*(x*x + y*y) + 0.1*(x*y).sin()\",",
+            "barrel: (radius: 0.06, groove: \"0.01*theta.sin()\", tapered: true),",
+        )
+    };
+    let model = parse_model(&with_roller("0.01"), Path::new("models/surface.ron")).expect("parses");
+    assert_eq!(model.contacts[0].taper, (0.01f64 / 0.06).atan());
+    // A knife edge has no cone; a roller read at run time would change the half-angle the
+    // generated code keeps.
+    rejected(
+        &barrel("radius: 0.06, groove: \"0.01*theta.sin()\", tapered: true"),
+        "contacts[0].barrel.tapered",
+        16,
+        "a tapered groove takes a roller",
+    );
+    rejected(
+        &with_roller("\"c/200.0\""),
+        "contacts[0].follower.radius",
+        15,
+        "half-angle atan(ρ/R) is fixed",
+    );
+}

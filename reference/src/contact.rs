@@ -63,6 +63,9 @@ pub(crate) struct ContactConst {
     /// In a face cam's groove, the roller's radius (0 for a knife edge): its centre is on
     /// `profile`, it touches the inner flank that far in.
     groove: Option<f64>,
+    /// A tapered roller's half-angle in a barrel's groove (0: straight): its geometry then
+    /// carries the radial direction.
+    taper: f64,
     /// The profile's expressions (f, r, or x and y) as one tape, for the many evaluations of
     /// the search.
     tape: Tape,
@@ -154,6 +157,7 @@ impl ContactConst {
                 Profile::Face { .. } => Some(contact.follower.radius().copied().unwrap_or(0.0)),
                 _ => None,
             },
+            taper: contact.taper,
             tape: match contact.profile.curve() {
                 Profile::Explicit { f, .. }
                 | Profile::Surface { f, .. }
@@ -517,6 +521,7 @@ impl ContactConst {
             curvature: kappa,
             direction: direction.into(),
             sliding_speed: dot(tangent, material),
+            radial: [0.0; 3],
         };
         let kinematics = ContactKinematics {
             geometry,

@@ -94,6 +94,7 @@ pub fn contact_info(model: &Model, c: &Contact) -> ContactInfo {
             .filter(|&b| model.bodies[b].joint.kind == JointKind::Revolute),
         cam_moves: c.cam_body.is_some(),
         backlash: c.backlash,
+        taper: c.taper,
     }
 }
 
@@ -685,6 +686,7 @@ mod tests {
             range: None,
             design: None,
             backlash: 0.0,
+            taper: 0.0,
         }
     }
 

@@ -107,6 +107,10 @@ pub struct ContactInfo {
     /// freely between the flanks and touches one at a time ([`crate::clearance`]); 0 for a
     /// closed groove (the roller held on the centre line both ways) and for every other cam.
     pub backlash: f64,
+    /// The half-angle γ (rad) of a tapered roller in a barrel's groove, its apex on the cam's
+    /// axis (γ = atan(ρ/R)): the force on the roller leans outward by γ
+    /// ([`ContactGeometry::flank_force`]); 0 for a straight roller and every other cam.
+    pub taper: f64,
 }
 
 /// A flank of a barrel or face cam's groove.
@@ -129,6 +133,7 @@ impl ContactInfo {
             cam_coordinate: None,
             cam_moves: false,
             backlash: 0.0,
+            taper: 0.0,
         }
     }
 }
@@ -267,6 +272,10 @@ pub struct ContactGeometry {
     /// body's material at the contact point (a roller rolls: for it this is the rim speed
     /// of its spin relative to the follower, the slip a seized roller would have).
     pub sliding_speed: f64,
+    /// For a barrel cam's groove that takes a tapered roller ([`ContactInfo::taper`]): the
+    /// unit vector from the cam's axis towards the follower point, perpendicular to the axis,
+    /// ground coordinates. Zero otherwise.
+    pub radial: [f64; 3],
 }
 
 impl Default for ContactGeometry {
@@ -285,11 +294,30 @@ impl Default for ContactGeometry {
             curvature: 0.0,
             direction: [0.0; 3],
             sliding_speed: 0.0,
+            radial: [0.0; 3],
         }
     }
 }
 
 impl ContactGeometry {
+    /// The normal force of a contact whose constraint force along the groove's normal is
+    /// `along` (N = −λ · force_scale), and the normal turned to the flank that exerts it, for
+    /// a tapered roller of half-angle `taper` (rad) in a barrel's groove: either flank pushes
+    /// the roller along its cone's normal, cos γ n + sign(N) sin γ e_r (e_r [`Self::radial`]),
+    /// with the force N / cos γ, whose part along n is the constraint's and whose radial part,
+    /// N tan γ outward, the follower's guide takes. A straight roller (γ = 0) is unchanged.
+    pub fn flank_force(&mut self, taper: f64, along: f64) -> f64 {
+        if taper == 0.0 {
+            return along;
+        }
+        let (sin, cos) = taper.sin_cos();
+        let side = if along < 0.0 { -1.0 } else { 1.0 };
+        for (n, r) in self.normal.iter_mut().zip(self.radial) {
+            *n = cos * *n + side * sin * r;
+        }
+        along / cos
+    }
+
     /// The pressure angle (rad): the angle between the contact normal and the follower's
     /// direction of motion, in [−π/2, π/2], positive when the normal is turned from the
     /// direction counterclockwise about the cam's axis. On a cam surface the normal need not

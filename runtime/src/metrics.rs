@@ -217,8 +217,17 @@ fn point_from_workspace(
     point.forces.extend(
         ws.lambda()
             .iter()
-            .zip(&point.geometry)
-            .map(|(&l, g)| normal_force(l, g.force_scale)),
+            .zip(point.geometry.iter_mut())
+            // A loop's rows after the contacts' have no taper.
+            .zip(
+                model
+                    .info()
+                    .contacts
+                    .iter()
+                    .map(|c| c.taper)
+                    .chain(std::iter::repeat(0.0)),
+            )
+            .map(|((&l, g), taper)| g.flank_force(taper, normal_force(l, g.force_scale))),
     );
     point.residuals.resize(nc, 0.0);
     model.constraint(ws.q(), &mut point.residuals);

@@ -137,8 +137,9 @@ pub(crate) fn complete_sample(
     let lambda = ws.full_lambda();
     sample.normal_force = lambda
         .iter()
-        .zip(&contacts)
-        .map(|(&l, g)| normal_force(l, g.force_scale))
+        .zip(&mut contacts)
+        .zip(&info.contacts)
+        .map(|((&l, g), c)| g.flank_force(c.taper, normal_force(l, g.force_scale)))
         .collect();
     sample.qdd = ws.qdd().to_vec();
     sample.lambda = lambda;

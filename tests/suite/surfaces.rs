@@ -421,3 +421,77 @@ fn surface_models_run_alike_generated_and_numeric_and_keep_their_energy() {
         assert!(drift < 1e-8 * scale, "{path}: energy drifts by {drift:e} J");
     }
 }
+
+#[test]
+fn a_tapered_roller_moves_as_the_straight_one_and_leans_its_force_outward() {
+    // tests/contact_models/barrel_tapered.ron is barrel_indexer with `tapered: true`: the same
+    // motion, and each flank's force F = N/cos γ along cos γ n + sign(N) sin γ e_r, with
+    // γ = atan(ρ/R) and e_r the outward radial direction at the roller, which is the ground's
+    // x axis here (the follower's guide runs parallel to the camshaft at (R, 0)). At 80 rad/s,
+    // above the spring's jump speed (59 rad/s), the upper flank drives the roller for part of
+    // each turn (N < 0), so both flanks' leanings are met.
+    let omega = [("omega", 80.0)];
+    let straight = models::barrel_indexer::Model::with(&omega).expect("valid");
+    let tapered = contact_models::barrel_tapered::Model::with(&omega).expect("valid");
+    let path = format!(
+        "{}/tests/contact_models/barrel_tapered.ron",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).expect("the test model");
+    let numeric = NumericModel::from_source_with(
+        &text,
+        std::path::Path::new(&path),
+        &[("omega".to_string(), 80.0)],
+        camchain_codegen::ParameterMode::AsDeclared,
+    )
+    .expect("valid");
+    let p = file_parameters("barrel_indexer");
+    let gamma = (p("rho") / p("R")).atan();
+    assert_eq!(tapered.info().contacts[0].taper, gamma);
+    let mut settings = straight.info().defaults.clone();
+    settings.t_end = 0.7;
+    let run = |m: &dyn Dynamics| {
+        m.simulate(m.assemble(0.0).expect("assembles"), &settings)
+            .unwrap_or_else(|f| panic!("{}", f.error))
+    };
+    let (a, b, c) = (run(&straight), run(&tapered), run(&numeric));
+    let (mut motion, mut force, mut normal, mut apart) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut pulled = 0;
+    for ((s, t), u) in a.samples.iter().zip(&b.samples).zip(&c.samples) {
+        for (x, y) in s.q.iter().zip(&t.q) {
+            motion = motion.max((x - y).abs());
+        }
+        let (n0, n1) = (s.normal_force[0], t.normal_force[0]);
+        force = force.max((n1 - n0 / gamma.cos()).abs() / n0.abs().max(1.0));
+        let side = if n0 < 0.0 { -1.0 } else { 1.0 };
+        pulled += usize::from(n0 < 0.0);
+        let (g0, g1) = (&s.contacts[0], &t.contacts[0]);
+        let expected = [
+            gamma.cos() * g0.normal[0] + side * gamma.sin(),
+            gamma.cos() * g0.normal[1],
+            gamma.cos() * g0.normal[2],
+        ];
+        for (k, e) in expected.iter().enumerate() {
+            normal = normal.max((g1.normal[k] - e).abs());
+            apart = apart.max((u.contacts[0].normal[k] - g1.normal[k]).abs());
+        }
+        apart = apart.max((u.normal_force[0] - n1).abs() / n1.abs().max(1.0));
+    }
+    println!(
+        "tapered barrel: motion {motion:.1e}, N/cos γ {force:.1e}, normal {normal:.1e}, \
+         generated vs numeric {apart:.1e}; {pulled} samples on the upper flank"
+    );
+    assert!(
+        pulled > 10,
+        "the upper flank drives at {pulled} samples only"
+    );
+    // The same generated functions of the motion: identical runs (the taper changes outputs
+    // only).
+    assert_eq!(motion, 0.0, "the taper changed the motion");
+    // One division and a few products of order-1 numbers.
+    assert!(force < 1e-14, "N/cos γ to {force:e}");
+    assert!(normal < 1e-15, "the leaning normal to {normal:e}");
+    // Generated against numeric, both with their own radial direction: runs agreeing to
+    // ~1e-10 at rtol 1e-10 (as surface_models_run_alike…).
+    assert!(apart < 1e-8, "generated vs numeric {apart:e}");
+}

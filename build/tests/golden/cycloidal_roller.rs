@@ -378,6 +378,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             cam_coordinate: Some(0),
             cam_moves: true,
             backlash: 0.0,
+            taper: 0.0,
         },
     ]),
     loops: Vec::from([]),

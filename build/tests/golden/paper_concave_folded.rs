@@ -175,6 +175,7 @@ static INFO: ::std::sync::LazyLock<rt::ModelInfo> = ::std::sync::LazyLock::new(|
             cam_coordinate: None,
             cam_moves: false,
             backlash: 0.0,
+            taper: 0.0,
         },
     ]),
     loops: Vec::from([]),

@@ -344,6 +344,7 @@ fn terms(
         curvature,
         sliding,
         relative: rel,
+        radial: None,
         formulas: Formulas {
             kind: "a ball on a surface z = f(x, y), its centre on the offset surface".to_string(),
             h: "h = N·(C − S) − ρ, eq. (B2)",

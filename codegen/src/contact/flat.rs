@@ -125,6 +125,7 @@ pub fn flat(
         curvature: f.curvature,
         sliding,
         relative: rel,
+        radial: None,
         formulas: Formulas {
             kind: "a flat face on the profile's support point".to_string(),
             h: "h = m·(F − c(s*)), eq. (C11)",

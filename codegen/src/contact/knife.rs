@@ -77,6 +77,7 @@ pub fn explicit(
         curvature,
         sliding,
         relative: rel,
+        radial: None,
         formulas: Formulas {
             kind: "a knife edge on y = f(x)".to_string(),
             h: "h = f2 − f3(f1), eq. (3)",

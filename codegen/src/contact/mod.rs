@@ -58,6 +58,9 @@ pub struct ContactTerms {
     pub sliding: Id,
     /// The follower seen from the cam (its point's cam-frame kinematics, the cam frame).
     pub relative: Relative,
+    /// For a tapered roller in a barrel's groove, the unit vector from the cam's axis to the
+    /// follower point, ground coordinates (`ContactGeometry::radial`); `None` otherwise.
+    pub radial: Option<V3>,
     /// How this kind writes h, J and c: what the generated functions' docs say.
     pub formulas: Formulas,
 }

@@ -165,6 +165,7 @@ pub fn nearest(
         curvature,
         sliding,
         relative: rel,
+        radial: None,
         formulas: if let Rim::Groove(_) = rim {
             Formulas {
                 kind: format!(

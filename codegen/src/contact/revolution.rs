@@ -146,6 +146,7 @@ pub fn point(
         curvature,
         sliding,
         relative: rel,
+        radial: None,
         formulas: Formulas {
             kind: "a point outside a surface of revolution r = g(z)".to_string(),
             h: "h = √(X² + Y²) − g(Z), eq. (S8)",

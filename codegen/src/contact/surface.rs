@@ -321,6 +321,20 @@ pub fn point(
         cam_height = g.sub(d.f, c);
     }
     vec3::label(g, position, &format!("{name}_contact"));
+    // A tapered roller leans its force outward from the cam's axis: the runtime turns the
+    // normal along e_r = (X x̂ + Y ŷ)/r (`ContactGeometry::flank_force`).
+    let radial = (barrel.is_some() && model.contacts[index].taper > 0.0).then(|| {
+        g.set_section(format!(
+            "contact {name}: the radial direction of a tapered roller"
+        ));
+        let (xx, yy) = (g.mul(x, x), g.mul(y, y));
+        let r2 = g.add(xx, yy);
+        let r = g.sqrt(r2);
+        let (u, v) = (g.div(x, r), g.div(y, r));
+        let along_x = vec3::scale(g, u, rel.x_axis);
+        let along_y = vec3::scale(g, v, rel.y_axis);
+        vec3::add(g, along_x, along_y)
+    });
     ContactTerms {
         h,
         jacobian,
@@ -334,6 +348,7 @@ pub fn point(
         curvature,
         sliding,
         relative: rel,
+        radial,
         formulas: Formulas {
             kind: match (&barrel, radius) {
                 (None, _) => "a point on a surface z = f(x, y)".to_string(),

@@ -64,6 +64,11 @@ pub(super) fn geometry_outputs(g: &mut Graph, c: &ContactTerms, prefix: &str) ->
     if let Some(z) = c.cam_height {
         outputs.push((format!("{prefix}z"), z));
     }
+    if let Some(radial) = c.radial {
+        for (a, &p) in radial.iter().enumerate() {
+            outputs.push((format!("{prefix}radial[{a}]"), p));
+        }
+    }
     outputs
 }
 

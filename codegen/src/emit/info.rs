@@ -40,10 +40,11 @@ pub(super) fn info_static(model: &Model) -> String {
             format!(
                 "rt::ContactInfo {{ name: {:?}.to_string(), follower: rt::FollowerKind::{follower}, \
                  profile: rt::ProfileKind::{profile}, cam_coordinate: {cam_coordinate}, \
-                 cam_moves: {}, backlash: {} }}",
+                 cam_moves: {}, backlash: {}, taper: {} }}",
                 c.name,
                 c.cam_body.is_some(),
-                super::literals::lit(c.backlash)
+                super::literals::lit(c.backlash),
+                super::literals::lit(c.taper)
             )
         })
         .collect();

@@ -124,6 +124,7 @@ pub fn paper_concave() -> Model {
             range: None,
             design: None,
             backlash: 0.0,
+            taper: 0.0,
         }],
         loops: Vec::new(),
         initial: Initial {
@@ -261,6 +262,7 @@ pub fn spatial_tree() -> Model {
             range: None,
             design: None,
             backlash: 0.0,
+            taper: 0.0,
         }],
         loops: Vec::new(),
         initial: Initial {

@@ -284,6 +284,9 @@ pub(super) struct Barrel {
     /// How much wider than the roller the groove is (m).
     #[serde(default)]
     pub backlash: Option<f64>,
+    /// The groove takes a tapered roller whose apex lies on the cam's axis.
+    #[serde(default)]
+    pub tapered: bool,
 }
 
 /// `face: (groove: "g(theta)")` or `face: (law: (…))`: a face cam's groove.

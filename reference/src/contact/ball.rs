@@ -154,6 +154,7 @@ impl ContactConst {
             curvature: at.curvature,
             direction: direction.into(),
             sliding_speed: tangential_speed(velocity, unit),
+            radial: [0.0; 3],
         };
         spatial(h, jacobian, bias, geometry, seen, columns)
     }

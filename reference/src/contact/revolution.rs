@@ -79,6 +79,7 @@ impl ContactConst {
             curvature: larger_curvature(unit, &hessian, stretch),
             direction: direction.into(),
             sliding_speed: sliding,
+            radial: [0.0; 3],
         };
         spatial(h, jacobian, bias, geometry, seen, columns)
     }

@@ -134,6 +134,14 @@ impl ContactConst {
             curvature,
             direction: direction.into(),
             sliding_speed: sliding,
+            // A tapered roller leans its force outward from the cam's axis (the runtime
+            // turns the normal, `ContactGeometry::flank_force`).
+            radial: if self.taper > 0.0 {
+                let r = p[0].hypot(p[1]);
+                (frame.x * (p[0] / r) + frame.y * (p[1] / r)).into()
+            } else {
+                [0.0; 3]
+            },
         };
         spatial(h, jacobian, bias, geometry, seen, columns)
     }

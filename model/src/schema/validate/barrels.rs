@@ -15,6 +15,7 @@ use crate::schema::raw;
 use camchain_runtime::contact::{
     BARREL_CHECK_SAMPLES, ProfileSample, developed_groove_fits, groove_on_cylinder,
 };
+use camchain_runtime::kinds::FollowerKind;
 use std::f64::consts::TAU;
 
 /// The profile of a barrel cam (contact `i`, path `path`) followed by `follower`, with its
@@ -128,6 +129,41 @@ pub(super) fn barrel_profile(
         },
         design,
     ))
+}
+
+/// A barrel's `tapered: true`: the half-angle atan(ρ/R) of a roller whose apex lies on the
+/// cam's axis, fixed when the file is read (ρ and R must not be read at run time); 0 for a
+/// straight roller and every other cam.
+pub(super) fn taper(
+    cx: &Context,
+    path: &str,
+    c: &raw::Contact,
+    i: usize,
+    follower: &Follower,
+) -> Checked<f64> {
+    let Some(barrel) = c.barrel.as_ref().filter(|b| b.tapered) else {
+        return Ok(0.0);
+    };
+    let field = format!("{path}.barrel.tapered");
+    let Some(&rho) = follower
+        .radius()
+        .filter(|_| follower.kind() == FollowerKind::Roller)
+    else {
+        return Err(cx.at.error(
+            &field,
+            "a tapered groove takes a roller (`follower: Roller(radius: …)`): its apex on the \
+             cam's axis, its radius ρ at the pitch radius",
+        ));
+    };
+    if cx.table.is_runtime(Field::Radius(i)) {
+        return Err(cx.at.error(
+            &format!("{path}.follower.radius"),
+            "a tapered roller's half-angle atan(ρ/R) is fixed when the file is read: mark the \
+             parameters of its radius `constant: true`",
+        ));
+    }
+    let radius = cx.constant(&format!("{path}.barrel.radius"), &barrel.radius)?;
+    Ok((rho / radius).atan())
 }
 
 /// The groove's flanks, its half-width w (the roller's radius and half the backlash) below

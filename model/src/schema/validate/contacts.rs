@@ -143,6 +143,7 @@ fn contact(
     let follower = follower(cx, &path, &c.follower, i)?;
     let name = c.name.clone().unwrap_or_else(|| c.marker.clone());
     let backlash = super::faces::backlash(cx, &path, c)?;
+    let taper = super::barrels::taper(cx, &path, c, i, &follower)?;
     let Shaped {
         profile,
         covers,
@@ -166,6 +167,7 @@ fn contact(
         range,
         design,
         backlash,
+        taper,
     })
 }
 
