@@ -32,6 +32,7 @@
 use crate::dynamics::{
     ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo, VelocityTerms,
 };
+use crate::error::SimError;
 use std::cell::RefCell;
 
 /// A model whose grooves with backlash ([`crate::dynamics::ContactInfo::backlash`] > 0)
@@ -271,4 +272,56 @@ impl<D: Dynamics + ?Sized> Dynamics for Clearance<'_, D> {
         );
         self.transform(&s, None, None, Some(bias));
     }
+}
+
+/// A bilateral run holds every follower on its cam, which a groove with backlash cannot do:
+/// its roller moves freely between the flanks ([`crate::clearance`]).
+pub(crate) fn held_both_ways(model: &dyn Dynamics) -> Result<(), SimError> {
+    match model.info().contacts.iter().find(|c| c.backlash > 0.0) {
+        Some(c) => Err(SimError::InvalidSettings {
+            message: format!(
+                "the groove of {} has a backlash of {} m: its roller moves freely between the \
+                 flanks and lands on one or the other, which only a one-sided run follows (give \
+                 the flanks' coefficient of restitution: `restitution` in the model's \
+                 `simulation`, or --restitution)",
+                c.name, c.backlash
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// A tapered roller's flanks push it outward (N tan γ, [`ContactGeometry::flank_force`]),
+/// which the model leaves to the follower's guide: at the run's start no free coordinate may
+/// move a tapered roller towards or away from the cam's axis, ∂r/∂q = (X J1 + Y J2)/r = 0
+/// (to 1e-9 m per unit of the coordinate), or the push would do work the constraint misses.
+pub(crate) fn tapered_rollers_hold_their_radius(
+    model: &dyn Dynamics,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<(), SimError> {
+    let info = model.info();
+    for (k, contact) in info.contacts.iter().enumerate() {
+        if contact.taper == 0.0 {
+            continue;
+        }
+        let kinematics = model.contact_kinematics(q, qd, k);
+        let r = kinematics.x.hypot(kinematics.y);
+        let moving = info.coordinates.iter().enumerate().find_map(|(j, c)| {
+            let rate = (kinematics.x * kinematics.j1[j] + kinematics.y * kinematics.j2[j]) / r;
+            (!c.driven && rate.abs() > 1e-9).then_some((c.name.as_str(), rate))
+        });
+        if let Some((name, rate)) = moving {
+            return Err(SimError::InvalidSettings {
+                message: format!(
+                    "the tapered roller of {} is pushed outward by its flanks (N tan γ), which \
+                     its follower's guide must hold, but coordinate {name} moves it towards or \
+                     away from the cam's axis (∂r/∂{name} = {rate:.6e} at the start): guide the \
+                     follower so that the roller keeps its radius, or use a straight roller",
+                    contact.name
+                ),
+            });
+        }
+    }
+    Ok(())
 }

@@ -282,16 +282,20 @@ pub(crate) fn run_metrics(
         t_end: settings.t_end,
     };
     // A metrics run keeps no samples: held to the streamed runs' cap on its output times.
-    let outcome = validate_run(model, &state, settings, false).and_then(|()| {
-        if settings.integrator.is_adaptive() {
-            state.engine.stages.watch(model.info().n_contacts());
-            let outcome = adaptive_run(model, &mut state, settings, options, &mut acc, &mut pace);
-            state.engine.stages.watch(0);
-            outcome
-        } else {
-            fixed_run(model, &mut state, settings, &mut acc, &mut pace)
-        }
-    });
+    // A metrics run is bilateral: it cannot follow a groove with backlash.
+    let outcome = validate_run(model, &state, settings, false)
+        .and_then(|()| crate::clearance::held_both_ways(model))
+        .and_then(|()| {
+            if settings.integrator.is_adaptive() {
+                state.engine.stages.watch(model.info().n_contacts());
+                let outcome =
+                    adaptive_run(model, &mut state, settings, options, &mut acc, &mut pace);
+                state.engine.stages.watch(0);
+                outcome
+            } else {
+                fixed_run(model, &mut state, settings, &mut acc, &mut pace)
+            }
+        });
     let mut stats = Stats::default();
     add_counters_since(&mut stats, &state.engine, before);
     stats.repartitions = acc.metrics.stats.repartitions;

@@ -337,23 +337,6 @@ impl Simulate for dyn Dynamics + Send + Sync + '_ {
     }
 }
 
-/// A bilateral run holds every follower on its cam, which a groove with backlash cannot do:
-/// its roller moves freely between the flanks ([`crate::clearance`]).
-fn closed_grooves(model: &dyn Dynamics) -> Result<(), SimError> {
-    match model.info().contacts.iter().find(|c| c.backlash > 0.0) {
-        Some(c) => Err(SimError::InvalidSettings {
-            message: format!(
-                "the groove of {} has a backlash of {} m: its roller moves freely between the \
-                 flanks and lands on one or the other, which only a one-sided run follows (give \
-                 the flanks' coefficient of restitution: `restitution` in the model's \
-                 `simulation`, or --restitution)",
-                c.name, c.backlash
-            ),
-        }),
-        None => Ok(()),
-    }
-}
-
 /// The simulation loop of every run: samples at t0, then integrates; adaptive integrators
 /// step freely and interpolate the output times (dense output), RK4 lands on them; a
 /// one-sided law alternates phases in contact and in flight ([`crate::unilateral`]).
@@ -376,7 +359,7 @@ fn run(
         ContactLaw::Bilateral => {
             let mut state = state;
             let outcome = validate_run(model, &state, settings, keep)
-                .and_then(|()| closed_grooves(model))
+                .and_then(|()| crate::clearance::held_both_ways(model))
                 .and_then(|()| {
                     if settings.integrator.is_adaptive() {
                         run_dense(model, &mut state, settings, level, &mut record)

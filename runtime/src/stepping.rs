@@ -556,6 +556,9 @@ pub(crate) fn validate_run(
         .and_then(|()| check_finite_state(state))
         .and_then(|()| validate_integration(settings))
         .and_then(|()| validate_output(settings, state.t, keep))
+        .and_then(|()| {
+            crate::clearance::tapered_rollers_hold_their_radius(model, &state.q, &state.qd)
+        })
 }
 
 /// The counters of the three integrators of an engine.

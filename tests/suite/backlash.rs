@@ -324,3 +324,27 @@ fn the_clearance_gap_has_the_jacobian_and_convective_term_of_its_differences() {
         assert!((g(&q) - (0.001 - h[0].abs())).abs() < 1e-15);
     }
 }
+
+#[test]
+fn runs_that_hold_the_follower_on_its_cam_refuse_a_groove_with_backlash() {
+    // A bilateral run and a sweep's metrics run hold the roller on its centre line, which a
+    // groove with backlash does not: both refuse, naming the groove and the way out.
+    let m = model();
+    let state = || m.assemble(0.0).expect("assembles");
+    let settings = &m.info().defaults;
+    let bilateral = m
+        .simulate(state(), settings)
+        .map(|_| ())
+        .expect_err("bilateral");
+    let metrics = m
+        .simulate_metrics(state(), settings, Default::default())
+        .map(|_| ())
+        .expect_err("metrics");
+    for error in [bilateral.error.to_string(), metrics.error.to_string()] {
+        assert!(
+            error.contains("the groove of roller has a backlash of 0.002 m")
+                && error.contains("only a one-sided run follows"),
+            "{error}"
+        );
+    }
+}

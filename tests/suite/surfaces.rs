@@ -495,3 +495,42 @@ fn a_tapered_roller_moves_as_the_straight_one_and_leans_its_force_outward() {
     // ~1e-10 at rtol 1e-10 (as surface_models_run_alike…).
     assert!(apart < 1e-8, "generated vs numeric {apart:e}");
 }
+
+#[test]
+fn a_tapered_roller_that_could_move_radially_is_refused_at_the_start() {
+    // barrel_tapered with its follower's guide tilted in the plane of the axis and the roller,
+    // (0.6, 0, 0.8): the lift moves the roller outward at 0.6 m per m, which the flanks'
+    // outward push would drive.
+    let path = format!(
+        "{}/tests/contact_models/barrel_tapered.ron",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path)
+        .expect("the test model")
+        .replace(
+            "axis: (0.0, 0.0, 1.0),\n                anchor: (\"R\", 0.0, 0.0),",
+            "axis: (0.6, 0.0, 0.8),\n                anchor: (\"R\", 0.0, 0.0),",
+        );
+    assert!(
+        text.contains("axis: (0.6, 0.0, 0.8)"),
+        "the guide is tilted"
+    );
+    let m = NumericModel::from_source_with(
+        &text,
+        std::path::Path::new(&path),
+        &[],
+        camchain_codegen::ParameterMode::AsDeclared,
+    )
+    .expect("valid");
+    let error = m
+        .simulate(m.assemble(0.0).expect("assembles"), &m.info().defaults)
+        .map(|_| ())
+        .expect_err("refused")
+        .error
+        .to_string();
+    assert!(
+        error.contains("coordinate lift moves it towards or away from the cam's axis")
+            && error.contains("∂r/∂lift = 6.000000e-1"),
+        "{error}"
+    );
+}
