@@ -471,6 +471,21 @@ fn a_tapered_roller_moves_as_the_straight_one_and_leans_its_force_outward() {
             gamma.cos() * g0.normal[1],
             gamma.cos() * g0.normal[2],
         ];
+        // Independently of (T1): the cone's apex is on the camshaft's axis (the ground's z)
+        // at the roller centre's height, and its normal at the contact point (reported on
+        // the lower flank) is perpendicular to the generator from the apex, on the lower
+        // flank's side (N > 0).
+        if n0 > 0.0 {
+            let generator = [
+                g1.position[0],
+                g1.position[1],
+                g1.position[2] - g1.follower[2],
+            ];
+            let length = generator.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let cosine = (0..3).map(|k| generator[k] * g1.normal[k]).sum::<f64>() / length;
+            // Products of lengths of 0.06 m with unit vectors: rounding ~1e-17.
+            assert!(cosine.abs() < 1e-14, "normal off the cone's by {cosine:e}");
+        }
         for (k, e) in expected.iter().enumerate() {
             normal = normal.max((g1.normal[k] - e).abs());
             apart = apart.max((u.contacts[0].normal[k] - g1.normal[k]).abs());
