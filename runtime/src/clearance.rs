@@ -30,7 +30,7 @@
 //! centre line moved by ρ towards the inner or lower flank.
 
 use crate::dynamics::{
-    ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo, VelocityTerms,
+    ContactGeometry, ContactKinematics, Dynamics, Flank, ModelInfo, VelocityTerms,
 };
 use crate::error::SimError;
 use std::cell::RefCell;
@@ -151,18 +151,7 @@ impl<D: Dynamics + ?Sized> Dynamics for Clearance<'_, D> {
     fn info(&self) -> &ModelInfo {
         self.inner.info()
     }
-    fn parameter_values(&self) -> &[f64] {
-        self.inner.parameter_values()
-    }
-    fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
-        self.inner.mass_matrix(q, m);
-    }
-    fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
-        self.inner.inertial_forces(q, qd, f);
-    }
-    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.inner.applied_forces(t, q, qd, out);
-    }
+    crate::dynamics::forward_free_motion!(inner);
     fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
         self.inner.loop_points(q, out);
     }
@@ -218,32 +207,6 @@ impl<D: Dynamics + ?Sized> Dynamics for Clearance<'_, D> {
         } else {
             Flank::Outer
         })
-    }
-    fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
-        self.inner.prescribed(t, q, qd, qdd);
-    }
-    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy {
-        self.inner.energy(q, qd)
-    }
-    fn damper_power(&self, qd: &[f64]) -> f64 {
-        self.inner.damper_power(qd)
-    }
-    fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
-        self.inner.load_power(t, q, qd)
-    }
-    fn equations(
-        &self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        m: &mut [f64],
-        f: &mut [f64],
-        applied: &mut [f64],
-    ) {
-        self.inner.equations(t, q, qd, m, f, applied);
-    }
-    fn cache_len(&self) -> usize {
-        self.inner.cache_len()
     }
     fn position_terms(&self, q: &[f64], h: &mut [f64], j: &mut [f64], cache: &mut [f64]) {
         self.inner.position_terms(q, h, j, cache);

@@ -558,6 +558,53 @@ pub struct VelocityTerms<'a> {
     pub bias: &'a mut [f64],
 }
 
+/// The [`Dynamics`] methods of a view of a model that changes only its contacts (a flying
+/// follower's, a groove's clearance): the inner model's M, F, Q, drives, energies, powers
+/// and cache, forwarded to the field `$inner`. Written inside the view's `impl Dynamics`.
+macro_rules! forward_free_motion {
+    ($inner:ident) => {
+        fn parameter_values(&self) -> &[f64] {
+            self.$inner.parameter_values()
+        }
+        fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
+            self.$inner.mass_matrix(q, m);
+        }
+        fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
+            self.$inner.inertial_forces(q, qd, f);
+        }
+        fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+            self.$inner.applied_forces(t, q, qd, out);
+        }
+        fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
+            self.$inner.prescribed(t, q, qd, qdd);
+        }
+        fn energy(&self, q: &[f64], qd: &[f64]) -> $crate::dynamics::Energy {
+            self.$inner.energy(q, qd)
+        }
+        fn damper_power(&self, qd: &[f64]) -> f64 {
+            self.$inner.damper_power(qd)
+        }
+        fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
+            self.$inner.load_power(t, q, qd)
+        }
+        fn equations(
+            &self,
+            t: f64,
+            q: &[f64],
+            qd: &[f64],
+            m: &mut [f64],
+            f: &mut [f64],
+            applied: &mut [f64],
+        ) {
+            self.$inner.equations(t, q, qd, m, f, applied);
+        }
+        fn cache_len(&self) -> usize {
+            self.$inner.cache_len()
+        }
+    };
+}
+pub(crate) use forward_free_motion;
+
 /// sin and cos of `angle`, reusing `slot` = [angle, sin, cos] when it holds this very angle
 /// (bit for bit) from an earlier call, and storing them there otherwise.
 ///

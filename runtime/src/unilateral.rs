@@ -26,7 +26,7 @@ use crate::SimSettings;
 use crate::assembly::state_at;
 use crate::clearance::Clearance;
 use crate::dynamics::VelocityTerms;
-use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, Energy, ModelInfo};
+use crate::dynamics::{ContactGeometry, ContactKinematics, Dynamics, ModelInfo};
 use crate::error::SimError;
 use crate::events::{ContactEvent, EventKind};
 use crate::phase::{GapReading, Grid, Phase, Recorder, Stop, Watch, landing_tolerance};
@@ -82,18 +82,7 @@ impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
     fn info(&self) -> &ModelInfo {
         &self.info
     }
-    fn parameter_values(&self) -> &[f64] {
-        self.inner.parameter_values()
-    }
-    fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
-        self.inner.mass_matrix(q, m);
-    }
-    fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
-        self.inner.inertial_forces(q, qd, f);
-    }
-    fn applied_forces(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.inner.applied_forces(t, q, qd, out);
-    }
+    crate::dynamics::forward_free_motion!(inner);
     fn constraint(&self, _q: &[f64], _h: &mut [f64]) {}
     fn constraint_jacobian(&self, _q: &[f64], _j: &mut [f64]) {}
     fn constraint_bias(&self, _q: &[f64], _qd: &[f64], _c: &mut [f64]) {}
@@ -106,32 +95,6 @@ impl<D: Dynamics + ?Sized> Dynamics for Detached<'_, D> {
         out: &mut ContactKinematics,
     ) {
         self.inner.contact_kinematics_into(q, qd, k, out);
-    }
-    fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
-        self.inner.prescribed(t, q, qd, qdd);
-    }
-    fn energy(&self, q: &[f64], qd: &[f64]) -> Energy {
-        self.inner.energy(q, qd)
-    }
-    fn damper_power(&self, qd: &[f64]) -> f64 {
-        self.inner.damper_power(qd)
-    }
-    fn load_power(&self, t: f64, q: &[f64], qd: &[f64]) -> f64 {
-        self.inner.load_power(t, q, qd)
-    }
-    fn equations(
-        &self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        m: &mut [f64],
-        f: &mut [f64],
-        applied: &mut [f64],
-    ) {
-        self.inner.equations(t, q, qd, m, f, applied);
-    }
-    fn cache_len(&self) -> usize {
-        self.inner.cache_len()
     }
     fn position_terms(&self, q: &[f64], _h: &mut [f64], _j: &mut [f64], cache: &mut [f64]) {
         let mut scratch = self.scratch.borrow_mut();
