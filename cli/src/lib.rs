@@ -1,7 +1,8 @@
 //! camchain-cli: the `camchain` command line (its binary is `src/main.rs`), with every
 //! dependency only it needs (clap, plotters, png, dejavu, indicatif).
 //!
-//! Modules (private but for [`scenarios`], which the stress tests use):
+//! Modules (private but for [`scenarios`], which the stress tests use, and [`csv`] and
+//! [`summary`], which the Python package uses for the same columns and summaries):
 //! - `args`: the syntax (clap) and the settings it overrides;
 //! - `source`: which model a MODEL argument names, generated or numeric;
 //! - `plan`: what `simulate` checks before it runs or writes anything;
@@ -28,7 +29,7 @@
 mod args;
 mod bench;
 mod cam;
-mod csv;
+pub mod csv;
 mod figures;
 mod interrupt;
 mod kinematics;
@@ -42,7 +43,7 @@ pub mod scenarios;
 mod simulate;
 mod source;
 mod stress;
-mod summary;
+pub mod summary;
 mod sweep;
 
 use args::{Cli, Command};

@@ -126,12 +126,12 @@ struct EnergyBalance {
 
 /// A change of the dependent set between two consecutive samples in contact.
 #[derive(Debug, Clone)]
-pub(super) struct Repartition {
+pub struct Repartition {
     /// The two samples' times (s).
-    pub(super) between: (f64, f64),
+    pub between: (f64, f64),
     /// The dependent sets before and after.
-    pub(super) from: Arc<[usize]>,
-    pub(super) to: Arc<[usize]>,
+    pub from: Arc<[usize]>,
+    pub to: Arc<[usize]>,
 }
 
 #[derive(Debug, Clone)]
@@ -325,7 +325,7 @@ impl Digest {
     }
 
     /// The table's rows: (name with unit, min, max).
-    pub(super) fn rows(&self) -> Vec<(String, f64, f64)> {
+    pub fn rows(&self) -> Vec<(String, f64, f64)> {
         self.rows
             .iter()
             .filter(|r| r.taken > 0 || r.only_in_contact.is_none())
@@ -340,13 +340,13 @@ impl Digest {
     }
 
     /// Max |h| of contact k over the samples with a dependent coordinate (m).
-    pub(super) fn max_h(&self, k: usize) -> f64 {
+    pub fn max_h(&self, k: usize) -> f64 {
         self.max_h.get(k).copied().unwrap_or(0.0)
     }
 
     /// Max |h| of every loop (one value when they are too many to list, see
     /// [`LISTED_LOOPS`]).
-    pub(super) fn loop_h(&self) -> &[f64] {
+    pub fn loop_h(&self) -> &[f64] {
         &self.loop_h
     }
 
@@ -365,7 +365,7 @@ impl Digest {
 
     /// The first re-partitions between consecutive samples in contact, and how many there
     /// were in all.
-    pub(super) fn repartitions(&self) -> (&[Repartition], usize) {
+    pub fn repartitions(&self) -> (&[Repartition], usize) {
         (&self.repartitions, self.repartition_count)
     }
 
