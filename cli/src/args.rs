@@ -4,6 +4,9 @@
 //! Values are checked here, so a bad one is a usage error (exit code 2) before anything
 //! runs: times must be positive and finite, tolerances positive, the integrator one of the
 //! runtime's.
+// The doc comments below are also clap's help text, where `DIR/<model>_sweep.csv` is
+// literal text, not an HTML tag.
+#![allow(rustdoc::invalid_html_tags)]
 
 use camchain_runtime::{IntegratorKind, SimSettings};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};

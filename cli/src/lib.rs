@@ -1,8 +1,9 @@
 //! camchain-cli: the `camchain` command line (its binary is `src/main.rs`), with every
 //! dependency only it needs (clap, plotters, png, dejavu, indicatif).
 //!
-//! Modules (private but for [`scenarios`], which the stress tests use, and [`csv`] and
-//! [`summary`], which the Python package uses for the same columns and summaries):
+//! Modules (private but for [`scenarios`], which the stress tests use, and [`args`], [`csv`],
+//! [`summary`] and [`sweep`], which the Python package uses for the same settings, columns,
+//! summaries and sweeps):
 //! - `args`: the syntax (clap) and the settings it overrides;
 //! - `source`: which model a MODEL argument names, generated or numeric;
 //! - `plan`: what `simulate` checks before it runs or writes anything;
@@ -26,7 +27,7 @@
 //! and 1 for anything else (a model file missing or invalid, a failed run, a file that could
 //! not be written).
 
-mod args;
+pub mod args;
 mod bench;
 mod cam;
 pub mod csv;
@@ -44,7 +45,7 @@ mod simulate;
 mod source;
 mod stress;
 pub mod summary;
-mod sweep;
+pub mod sweep;
 
 use args::{Cli, Command};
 use clap::Parser;

@@ -12,11 +12,12 @@ model file on the numeric recursive reference with no compilation. See docs/pyth
 
 from ._camchain import Model, models, __version__
 from ._errors import CamchainError, ModelError, SimulationError
-from ._result import Result
+from ._result import Result, Sweep
 
 __all__ = [
     "Model",
     "Result",
+    "Sweep",
     "models",
     "CamchainError",
     "ModelError",

@@ -7,6 +7,7 @@
 //! - `model`: the `Model` class, what a model declares, `simulate`;
 //! - `run`: one run with the GIL released, its samples kept as columns, Ctrl-C;
 //! - `summary`: a run's summary as a dict;
+//! - `sweep`: `Model.sweep`, the command line's sweep with its rows as arrays;
 //! - `calls`: the generated functions one call each (`equations`, `jacobian`, `rhs`, …);
 //! - `errors`: the exceptions.
 
@@ -16,6 +17,7 @@ mod load;
 mod model;
 mod run;
 mod summary;
+mod sweep;
 
 use pyo3::prelude::*;
 

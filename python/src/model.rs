@@ -3,10 +3,11 @@
 use crate::errors::{Location, SimulationError, bad_option};
 use crate::load::{Engine, Origin};
 use crate::run::{self, Request, RunData, Stop};
+use camchain_cli::args::IntegrationArgs;
 use camchain_codegen::model::Model as Description;
 use camchain_runtime::events::{ContactEvent, EventKind};
 use camchain_runtime::kinds::IntegratorKind;
-use camchain_runtime::{ContactLaw, Flank, SimSettings};
+use camchain_runtime::{ContactLaw, Flank};
 use numpy::{IntoPyArray, PyArray1, PyArray2, ndarray::Array2};
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
@@ -110,6 +111,49 @@ pub(crate) type Equations<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
 );
+
+/// The integration options of `simulate` and `sweep` (None: the model's), checked as the
+/// command line's parser checks them: times positive and finite, a known method. The
+/// runtime's own checks (ranges, sample counts) follow when they are applied.
+pub(crate) fn integration_args(
+    t_end: Option<f64>,
+    dt_out: Option<f64>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    method: Option<&str>,
+    dt: Option<f64>,
+) -> PyResult<IntegrationArgs> {
+    for (option, value) in [("t_end", t_end), ("dt_out", dt_out), ("dt", dt)] {
+        if let Some(value) = value
+            && !(value.is_finite() && value > 0.0)
+        {
+            return Err(bad_option(
+                option,
+                format!("a time in seconds must be positive and finite, got {value}"),
+            ));
+        }
+    }
+    let integrator = match method {
+        None => None,
+        Some(name) => Some(IntegratorKind::parse(name).ok_or_else(|| {
+            bad_option(
+                "method",
+                format!(
+                    "unknown integrator `{name}`: one of {}",
+                    IntegratorKind::keywords().join(", ").to_lowercase()
+                ),
+            )
+        })?),
+    };
+    Ok(IntegrationArgs {
+        t_end,
+        dt_out,
+        integrator,
+        dt,
+        rtol,
+        atol,
+    })
+}
 
 /// Parameter values from a dict `{name: value}`.
 pub(crate) fn parameter_values(params: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, f64)>> {
@@ -331,39 +375,8 @@ impl Model {
             &varied
         };
         let info = model.engine.get().info();
-        let integrator = match method {
-            None => info.defaults.integrator,
-            Some(name) => IntegratorKind::parse(name).ok_or_else(|| {
-                bad_option(
-                    "method",
-                    format!(
-                        "unknown integrator `{name}`: one of {}",
-                        IntegratorKind::keywords().join(", ")
-                    ),
-                )
-            })?,
-        };
-        // As the command line's parser: times given must be positive and finite (the
-        // runtime's checks below then bound them and the tolerances).
-        for (option, value) in [("t_end", t_end), ("dt_out", dt_out), ("dt", dt)] {
-            if let Some(value) = value
-                && !(value.is_finite() && value > 0.0)
-            {
-                return Err(bad_option(
-                    option,
-                    format!("a time in seconds must be positive and finite, got {value}"),
-                ));
-            }
-        }
-        let d = &info.defaults;
-        let settings = SimSettings {
-            t_end: t_end.unwrap_or(d.t_end),
-            dt_out: dt_out.unwrap_or(d.dt_out),
-            integrator,
-            dt: dt.unwrap_or(d.dt),
-            rtol: rtol.unwrap_or(d.rtol),
-            atol: atol.unwrap_or(d.atol),
-        };
+        let settings =
+            integration_args(t_end, dt_out, rtol, atol, method, dt)?.settings(&info.defaults);
         // Every sample is kept (as columns): the runtime's cap on kept samples applies.
         settings
             .validate(0.0)
@@ -457,6 +470,66 @@ impl Model {
         y: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.rhs_of(py, t, y)
+    }
+
+    /// Runs the model over a grid or a Latin hypercube of its parameters, in parallel: the
+    /// command line's `camchain sweep`, one row per run, returned as a `camchain.Sweep`
+    /// whose columns are the sweep CSV's (`run`, the parameters, `status`, the metrics,
+    /// `error`).
+    ///
+    /// `params` maps each swept parameter to its values (a sequence or a numpy array; every
+    /// combination runs, the first parameter varying slowest), or with `samples=N` to an
+    /// interval `(a, b)` that a Latin hypercube of N runs samples (seeded by `seed`: the
+    /// same seed gives the same runs everywhere). `metrics` selects the metric columns
+    /// (default: all); `jobs` the workers (default: the cores); `grid=True` also evaluates
+    /// the metrics at every output time; the integration options are `simulate`'s.
+    #[pyo3(signature = (params, metrics = None, jobs = None, samples = None, seed = 1,
+        grid = false, t_end = None, dt_out = None, rtol = None, atol = None, method = None,
+        dt = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn sweep(
+        &self,
+        py: Python<'_>,
+        params: &Bound<'_, PyDict>,
+        metrics: Option<Vec<String>>,
+        jobs: Option<usize>,
+        samples: Option<usize>,
+        seed: u64,
+        grid: bool,
+        t_end: Option<f64>,
+        dt_out: Option<f64>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        method: Option<&str>,
+        dt: Option<f64>,
+    ) -> PyResult<Py<PyAny>> {
+        let metrics = crate::sweep::metric_names(metrics)?;
+        let ask = crate::sweep::Ask {
+            params,
+            samples,
+            seed,
+            jobs,
+            grid,
+            integration: integration_args(t_end, dt_out, rtol, atol, method, dt)?,
+        };
+        let plan = crate::sweep::plan(&self.origin, &self.values, &ask)?;
+        let (rows, raised) = crate::sweep::execute(py, &plan);
+        let columns = crate::sweep::columns(py, &plan, &rows, &metrics)?;
+        let result = py.import("camchain._result")?.getattr("Sweep")?.call1((
+            columns,
+            plan.runs.len(),
+            plan.label.clone(),
+        ))?;
+        match raised {
+            None => Ok(result.unbind()),
+            Some(error) => {
+                let value = error.value(py);
+                if value.is_instance_of::<PyKeyboardInterrupt>() {
+                    value.setattr("result", &result)?;
+                }
+                Err(error)
+            }
+        }
     }
 
     fn __repr__(&self) -> String {

@@ -326,10 +326,10 @@ pub fn render_repartitions(info: &ModelInfo, digest: &Digest) -> String {
 }
 
 /// Most loops whose reactions and residuals the summary lists one by one.
-const LISTED_LOOPS: usize = 6;
+pub const LISTED_LOOPS: usize = 6;
 
 /// Most events listed one by one in the summary.
-const LISTED_EVENTS: usize = 8;
+pub const LISTED_EVENTS: usize = 8;
 
 /// One line per contact event (the first [`LISTED_EVENTS`], then a count).
 fn render_events(info: &ModelInfo, events: &[ContactEvent]) -> String {

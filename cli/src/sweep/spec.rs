@@ -263,6 +263,11 @@ impl Runs {
         }
     }
 
+    /// True when there is no run (never, for runs [`Runs::new`] accepted).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// The parameter values of run `index` (in the order of [`Runs::swept`]).
     pub fn values(&self, index: usize) -> Vec<f64> {
         if let Design::LatinHypercube { .. } = self.design {
