@@ -2,8 +2,8 @@
 //! dependency only it needs (clap, plotters, png, dejavu, indicatif).
 //!
 //! Modules (private but for [`scenarios`], which the stress tests use, and [`args`], [`csv`],
-//! [`summary`] and [`sweep`], which the Python package uses for the same settings, columns,
-//! summaries and sweeps):
+//! [`summary`], [`sweep`] and [`cam`], which the Python package uses for the same settings,
+//! columns, summaries, sweeps and cam reports):
 //! - `args`: the syntax (clap) and the settings it overrides;
 //! - `source`: which model a MODEL argument names, generated or numeric;
 //! - `plan`: what `simulate` checks before it runs or writes anything;
@@ -29,7 +29,7 @@
 
 pub mod args;
 mod bench;
-mod cam;
+pub mod cam;
 pub mod csv;
 mod figures;
 mod interrupt;

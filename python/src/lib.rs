@@ -8,10 +8,12 @@
 //! - `run`: one run with the GIL released, its samples kept as columns, Ctrl-C;
 //! - `summary`: a run's summary as a dict;
 //! - `sweep`: `Model.sweep`, the command line's sweep with its rows as arrays;
+//! - `cam`: `Model.cam`, the cam designer's report as numbers and arrays;
 //! - `calls`: the generated functions one call each (`equations`, `jacobian`, `rhs`, …);
 //! - `errors`: the exceptions.
 
 mod calls;
+mod cam;
 mod errors;
 mod load;
 mod model;

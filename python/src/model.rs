@@ -532,6 +532,51 @@ impl Model {
         }
     }
 
+    /// The cam designer's report of a contact designed from a motion law (`law:`), as
+    /// `camchain cam` computes it, in numbers and arrays: a dict with `speed` (ω, rad/s),
+    /// `design` (`design.csv`'s columns: `cam_angle_deg`, `s`, `v`, `a`, `j`,
+    /// `pressure_angle_deg`, `radius_of_curvature`, `profile_x`, `profile_y`, `pitch_x`,
+    /// `pitch_y`, `normal_force` of the bilateral turn at ω), `peaks` (velocity, acceleration
+    /// and jerk: `max` and `min`, each a `value` and its `cam_angle` in rad),
+    /// `pressure_angle` (rad, likewise), `radius_of_curvature` (`convex`, `concave`: the
+    /// smallest, or None), `undercut_margin` (m, a roller's) or `face_offset` (a flat
+    /// face's), `jump` (`speed` and `cam_angle` where the least contact force reaches zero,
+    /// predicted from bilateral turns at ω/2, ω and 2ω; None for a mechanism with a degree
+    /// of freedom of its own), `lift_offs` of the one-sided run (each with its `landing`),
+    /// and `text`, the report as printed.
+    ///
+    /// `contact` picks the contact when several are designed; `speed` replaces the law's
+    /// ω; `samples` (per turn, 1 to 10⁶), `turns` (of the one-sided run) and `restitution`
+    /// (of the one-sided run; default the model's, else 0) are the command line's options.
+    #[pyo3(signature = (contact = None, speed = None, samples = 3600, turns = 3,
+        restitution = None))]
+    fn cam<'py>(
+        &self,
+        py: Python<'py>,
+        contact: Option<String>,
+        speed: Option<f64>,
+        samples: usize,
+        turns: usize,
+        restitution: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if !self.values.is_empty() {
+            return Err(bad_option(
+                "cam",
+                "studies the model file's parameter values; call it on the model without \
+                 with_params (the cam's speed is the `speed` argument)",
+            ));
+        }
+        let ask = crate::cam::Ask {
+            contact,
+            speed,
+            samples,
+            turns,
+            restitution,
+        };
+        let (study, speed) = crate::cam::study(py, &self.origin, &ask)?;
+        crate::cam::to_dict(py, &study, speed)
+    }
+
     fn __repr__(&self) -> String {
         let path = if self.origin.numeric() {
             "numeric"

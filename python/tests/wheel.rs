@@ -1,14 +1,17 @@
 //! The Python package's tests (`tests/test_*.py`), run by `cargo test` against the wheel,
-//! built and installed as a user installs it:
+//! installed as a user installs it:
 //!
-//! 1. a virtual environment for the build backend (maturin, `requirements-build.txt`);
-//! 2. `maturin build` of the wheel, in the dev profile, which is the test profile (see the
-//!    workspace's Cargo.toml): it links the crates `cargo test` has just compiled, with the
-//!    features that build gave them, so no crate of the workspace is compiled twice;
-//! 3. a fresh virtual environment with the wheel and `requirements-test.txt` (numpy,
+//! 1. the wheel: the extension module that this very build compiled (the package's library,
+//!    a dependency of this test, with the features the workspace's test build unifies) packed
+//!    with the Python sources by `tests/pack_wheel.py`, as maturin lays a wheel out. With
+//!    `CAMCHAIN_WHEEL=maturin` it is built by maturin (`requirements-build.txt`) in the dev
+//!    profile instead, which compiles the workspace's crates again with the package's own
+//!    features (minutes, not seconds): the path `pip install ./python` takes;
+//! 2. a fresh virtual environment with the wheel and `requirements-test.txt` (numpy,
 //!    pytest), and nothing of the source tree on its path;
-//! 4. pytest on `tests/`, told where the command line is (the tests compare the package's
-//!    results with the CLI's CSV) and where the repository's models are.
+//! 3. pytest on `tests/`, told where the command line is (the tests compare the package's
+//!    results with the CLI's CSV; `cargo test --workspace` builds it for the command line's
+//!    own tests) and where the repository's models are.
 //!
 //! Everything is made under a directory of this run's own (`target/python-tests/<pid>`),
 //! removed at the end, so that two runs at once do not meet. It needs `python3` (3.9 or
@@ -36,10 +39,6 @@ fn profile_dir() -> PathBuf {
         .map(Path::to_path_buf)
         .unwrap_or_default()
 }
-
-/// The features `cargo test --workspace` gives the models' crate (through its own tests'
-/// dev-dependency on itself).
-const MODEL_FEATURES: &str = "camchain-models/random-models,camchain-models/parameter-modes";
 
 fn run(what: &str, command: &mut Command) {
     eprintln!("python tests: {what}");
@@ -81,59 +80,25 @@ fn python_suite_against_the_installed_wheel() {
     );
     let _ = std::fs::remove_dir_all(&scratch.0);
     std::fs::create_dir_all(&scratch.0).expect("the run's directory");
-    let tools = scratch.0.join("tools");
     let env = scratch.0.join("env");
     let wheels = scratch.0.join("wheels");
     let bin = |venv: &Path, name: &str| venv.join("bin").join(name);
-
-    run(
-        "a virtual environment for maturin",
-        Command::new(&python).args(["-m", "venv"]).arg(&tools),
+    let cli = profile.join("camchain");
+    assert!(
+        cli.is_file(),
+        "{} is missing: the Python tests compare with the command line, which `cargo test \
+         --workspace` builds (or `cargo build -p camchain-cli`)",
+        cli.display()
     );
-    run(
-        "installing maturin",
-        Command::new(bin(&tools, "pip"))
-            .args(["install", "--quiet", "--disable-pip-version-check", "-r"])
-            .arg(package.join("requirements-build.txt")),
-    );
-    // The command line the tests compare with, built as `cargo test --workspace` built it
-    // (nothing to do after that command's build).
-    run(
-        "the command line",
-        Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
-            .current_dir(&repository)
-            .args([
-                "build",
-                "--quiet",
-                "-p",
-                "camchain-cli",
-                "--features",
-                MODEL_FEATURES,
-            ]),
-    );
-    // With the features the workspace's test build gave the models' crate: the same build,
-    // not a second one without them.
-    run(
-        "building the wheel",
-        Command::new(bin(&tools, "maturin"))
-            .current_dir(&package)
-            .args(["build", "--quiet", "--profile", "dev", "--features"])
-            .arg(MODEL_FEATURES)
-            .arg("--interpreter")
-            .arg(bin(&tools, "python"))
-            .arg("--out")
-            .arg(&wheels),
-    );
-    let wheel = std::fs::read_dir(&wheels)
-        .expect("maturin's output")
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .find(|p| p.extension().is_some_and(|e| e == "whl"))
-        .expect("maturin wrote a wheel");
     run(
         "a fresh virtual environment for the package",
         Command::new(&python).args(["-m", "venv"]).arg(&env),
     );
+    let wheel = if std::env::var_os("CAMCHAIN_WHEEL").is_some_and(|v| v == "maturin") {
+        maturin_wheel(&python, &package, &scratch.0, &wheels)
+    } else {
+        packed_wheel(&bin(&env, "python"), &package, &profile, &wheels)
+    };
     run(
         "installing the wheel",
         Command::new(bin(&env, "pip"))
@@ -157,8 +122,69 @@ fn python_suite_against_the_installed_wheel() {
                 "--import-mode=importlib",
             ])
             .arg(package.join("tests"))
-            .env("CAMCHAIN_CLI", profile.join("camchain"))
+            .env("CAMCHAIN_CLI", &cli)
             .env("CAMCHAIN_REPOSITORY", &repository)
             .env("CAMCHAIN_SCRATCH", &scratch.0),
     );
+}
+
+/// The extension module this build compiled, packed into a wheel.
+fn packed_wheel(python: &Path, package: &Path, profile: &Path, wheels: &Path) -> PathBuf {
+    // A cdylib needed by a test is built into deps/ (and copied up when built on its own).
+    let library = [profile.join("deps"), profile.to_path_buf()]
+        .iter()
+        .map(|dir| dir.join("lib_camchain.so"))
+        .filter(|p| p.is_file())
+        .max_by_key(|p| p.metadata().and_then(|m| m.modified()).ok())
+        .expect("the package's library (lib_camchain.so), built with this test");
+    let output = Command::new(python)
+        .arg(package.join("tests").join("pack_wheel.py"))
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(wheels)
+        .output()
+        .expect("pack_wheel.py runs");
+    assert!(
+        output.status.success(),
+        "pack_wheel.py failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    PathBuf::from(String::from_utf8_lossy(&output.stdout).trim())
+}
+
+/// The wheel built by maturin, as `pip install ./python` builds it (in the dev profile).
+fn maturin_wheel(
+    python: &std::ffi::OsStr,
+    package: &Path,
+    scratch: &Path,
+    wheels: &Path,
+) -> PathBuf {
+    let tools = scratch.join("tools");
+    let bin = |name: &str| tools.join("bin").join(name);
+    run(
+        "a virtual environment for maturin",
+        Command::new(python).args(["-m", "venv"]).arg(&tools),
+    );
+    run(
+        "installing maturin",
+        Command::new(bin("pip"))
+            .args(["install", "--quiet", "--disable-pip-version-check", "-r"])
+            .arg(package.join("requirements-build.txt")),
+    );
+    run(
+        "building the wheel with maturin",
+        Command::new(bin("maturin"))
+            .current_dir(package)
+            .args(["build", "--quiet", "--profile", "dev", "--interpreter"])
+            .arg(bin("python"))
+            .arg("--out")
+            .arg(wheels),
+    );
+    std::fs::read_dir(wheels)
+        .expect("maturin's output")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|e| e == "whl"))
+        .expect("maturin wrote a wheel")
 }
