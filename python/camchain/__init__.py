@@ -10,7 +10,7 @@ exactly.
 model file on the numeric recursive reference with no compilation. See docs/python.md.
 """
 
-from ._camchain import Model, models, __version__
+from ._camchain import Model, compile, models, __version__
 from ._errors import CamchainError, ModelError, SimulationError
 from ._result import Result, Sweep
 
@@ -18,6 +18,7 @@ __all__ = [
     "Model",
     "Result",
     "Sweep",
+    "compile",
     "models",
     "CamchainError",
     "ModelError",

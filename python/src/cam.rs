@@ -72,7 +72,8 @@ pub fn study(py: Python<'_>, origin: &Origin, ask: &Ask) -> PyResult<(Study, f64
     check(ask)?;
     let model = match origin {
         Origin::Builtin { name, .. } => name.clone(),
-        Origin::File(path) => path.display().to_string(),
+        // A compiled model's designer runs are the numeric reference's on its file.
+        Origin::File(path) | Origin::Compiled { path, .. } => path.display().to_string(),
     };
     let args = CamArgs {
         model,

@@ -76,7 +76,7 @@ impl Location {
     }
 
     /// `file:line:column: field: message`, as the build and the command line print it.
-    fn text(&self) -> String {
+    pub fn text(&self) -> String {
         let mut text = self.file.clone();
         if self.line > 0 {
             text.push_str(&format!(":{}:{}", self.line, self.column));

@@ -13,13 +13,14 @@
 //! value is a located error); on the numeric path the file is validated again with them, and
 //! every parameter, folded or not, can be set.
 
+use crate::build_model::library::Loaded;
 use crate::errors::Location;
 use camchain_codegen::ParameterMode;
 use camchain_codegen::model::Model;
 use camchain_codegen::schema::{Files, parse_model_from, read_text};
 use camchain_models as models;
 use camchain_reference::NumericModel;
-use camchain_runtime::Dynamics;
+use camchain_runtime::{Dynamics, ModelInfo};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -30,6 +31,13 @@ pub enum Origin {
     Builtin { name: String, numeric: bool },
     /// A model file, on the numeric reference.
     File(PathBuf),
+    /// A model file compiled by `camchain.compile`: its library, and its description
+    /// (the numeric reference's of the same file: the same derivation's).
+    Compiled {
+        path: PathBuf,
+        loaded: Arc<Loaded>,
+        info: Arc<ModelInfo>,
+    },
 }
 
 /// Dynamics a run can use from any thread.
@@ -56,7 +64,7 @@ impl Origin {
     pub fn describe(&self) -> String {
         match self {
             Origin::Builtin { name, .. } => name.clone(),
-            Origin::File(path) => path.display().to_string(),
+            Origin::File(path) | Origin::Compiled { path, .. } => path.display().to_string(),
         }
     }
 
@@ -77,7 +85,7 @@ impl Origin {
                 let file = Path::new("models").join(format!("{name}.ron"));
                 Ok((text.to_string(), file, Files::Embedded(models::files(name))))
             }
-            Origin::File(path) => {
+            Origin::File(path) | Origin::Compiled { path, .. } => {
                 if path.is_dir() {
                     let message = "it is a directory, not a .ron file".to_string();
                     return Err(Location::unlocated(&path.display().to_string(), message));
@@ -100,7 +108,9 @@ impl Origin {
                 parse_model_from(&source, &file, &[], ParameterMode::AsDeclared, files)?
             }
             // As the build checks it: the format, values, expressions and assembly.
-            Origin::File(_) => camchain_codegen::check_source(&source, &file)?,
+            Origin::File(_) | Origin::Compiled { .. } => {
+                camchain_codegen::check_source(&source, &file)?
+            }
         };
         let warnings = camchain_codegen::located_warnings(&model, &source, &file)
             .iter()
@@ -119,6 +129,9 @@ impl Origin {
                 let generated = models::by_name(name)
                     .ok_or_else(|| Location::unlocated(name, unknown(name)))?;
                 Ok(Engine::Static(generated))
+            }
+            Origin::Compiled { loaded, info, .. } => {
+                Ok(Engine::Shared(Arc::new(loaded.instance(info, &[])?)))
             }
             _ => Ok(Engine::Shared(Arc::new(NumericModel::new(model.clone())))),
         }
@@ -151,6 +164,9 @@ impl Origin {
                 location
             })?;
             return Ok(Engine::Shared(Arc::from(model)));
+        }
+        if let Origin::Compiled { loaded, info, .. } = self {
+            return Ok(Engine::Shared(Arc::new(loaded.instance(info, values)?)));
         }
         let (source, file, files) = self.source()?;
         let model = parse_model_from(&source, &file, values, ParameterMode::AllAtRunTime, files)?;

@@ -27,7 +27,7 @@ pub struct Model {
 }
 
 impl Model {
-    fn load(py: Python<'_>, origin: Origin) -> PyResult<Self> {
+    pub(crate) fn load(py: Python<'_>, origin: Origin) -> PyResult<Self> {
         let loaded = py.detach(|| {
             let (description, warnings) = origin.describe_model()?;
             let engine = origin.dynamics(&description)?;
@@ -72,7 +72,7 @@ impl Model {
                 numeric: true,
             } => format!("{name}_numeric"),
             Origin::Builtin { name, .. } => name.clone(),
-            Origin::File(path) => path
+            Origin::File(path) | Origin::Compiled { path, .. } => path
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .filter(|s| !s.is_empty())

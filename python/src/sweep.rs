@@ -13,9 +13,11 @@ use crate::load::Origin;
 use camchain_cli::CliError;
 use camchain_cli::args::{IntegrationArgs, SweepArgs};
 use camchain_cli::sweep::table::{METRICS, Row};
-use camchain_cli::sweep::{self, Plan};
+use camchain_cli::sweep::{self, Factory, Plan};
+use camchain_runtime::Dynamics;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
@@ -105,7 +107,7 @@ pub fn metric_names(given: Option<Vec<String>>) -> PyResult<Vec<String>> {
 pub fn plan(origin: &Origin, values: &[(String, f64)], ask: &Ask<'_>) -> PyResult<Plan> {
     let (arg, numeric) = match origin {
         Origin::Builtin { name, numeric } => (name.clone(), *numeric),
-        Origin::File(path) => (path.display().to_string(), false),
+        Origin::File(path) | Origin::Compiled { path, .. } => (path.display().to_string(), false),
     };
     let mut params = Vec::new();
     // Values set by `with_params` are swept at their one value (a column each).
@@ -137,7 +139,23 @@ pub fn plan(origin: &Origin, values: &[(String, f64)], ask: &Ask<'_>) -> PyResul
         no_plots: true,
         quiet: true,
     };
-    sweep::plan(&args).map_err(cli_error)
+    let mut plan = sweep::plan(&args).map_err(cli_error)?;
+    // A compiled model: planned and checked on its file, run on its library.
+    if let Origin::Compiled { loaded, info, .. } = origin {
+        let (loaded, info) = (Arc::clone(loaded), Arc::clone(info));
+        plan.factory = Factory::Custom {
+            build: Arc::new(move |values: &[(&str, f64)]| {
+                let owned: Vec<(String, f64)> =
+                    values.iter().map(|(n, v)| (n.to_string(), *v)).collect();
+                loaded
+                    .instance(&info, &owned)
+                    .map(|m| Box::new(m) as Box<dyn Dynamics + Send + Sync>)
+                    .map_err(|e| e.text())
+            }),
+            describe: "compiled code",
+        };
+    }
+    Ok(plan)
 }
 
 /// The completed rows, in run order, and whether Python raised (Ctrl-C) meanwhile.

@@ -11,7 +11,9 @@
 //!    pytest), and nothing of the source tree on its path;
 //! 3. pytest on `tests/`, told where the command line is (the tests compare the package's
 //!    results with the CLI's CSV; `cargo test --workspace` builds it for the command line's
-//!    own tests) and where the repository's models are.
+//!    own tests), where the repository's models are, and where `camchain.compile` builds
+//!    (this target directory, in the dev profile: only the runtime's copy and the models
+//!    compile, their dependencies are this build's).
 //!
 //! Everything is made under a directory of this run's own (`target/python-tests/<pid>`),
 //! removed at the end, so that two runs at once do not meet. It needs `python3` (3.9 or
@@ -124,7 +126,12 @@ fn python_suite_against_the_installed_wheel() {
             .arg(package.join("tests"))
             .env("CAMCHAIN_CLI", &cli)
             .env("CAMCHAIN_REPOSITORY", &repository)
-            .env("CAMCHAIN_SCRATCH", &scratch.0),
+            .env("CAMCHAIN_SCRATCH", &scratch.0)
+            // `camchain.compile` builds the test models in this target directory and its
+            // dev profile, where nalgebra and the other crates the runtime needs are
+            // already compiled (the model's crate repeats the workspace's dev profile).
+            .env("CAMCHAIN_COMPILE_TARGET", &target)
+            .env("CAMCHAIN_COMPILE_PROFILE", "dev"),
     );
 }
 

@@ -236,7 +236,11 @@ impl ModelInfo {
 }
 
 /// Where and how a contact touches: what every contact kind reports, at (q, q̇).
+///
+/// `#[repr(C)]` (every field an f64): a model compiled by the Python package's
+/// `camchain.compile` fills it across a C boundary.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct ContactGeometry {
     /// The contact point on the cam profile, ground coordinates.
     pub position: [f64; 3],

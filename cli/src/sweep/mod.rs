@@ -43,12 +43,25 @@ use table::{Preamble, Row};
 /// everything.
 pub const PLOTTED_RUNS: usize = 200_000;
 
+/// Builds a run's model from its parameter values ([`Factory::Custom`]).
+pub type Builder = std::sync::Arc<
+    dyn Fn(&[(&str, f64)]) -> Result<Box<dyn Dynamics + Send + Sync>, String> + Send + Sync,
+>;
+
 /// Where each run's model comes from.
 pub enum Factory {
     /// Generated code, built with other parameter values by its constructor.
     Generated {
         /// Its constructor (`camchain_models::WITH_PARAMETERS`).
         constructor: models::Constructor,
+    },
+    /// Any other way of building a run's model: a model file compiled by the Python
+    /// package's `camchain.compile` into a library of its own.
+    Custom {
+        /// The model with the run's values, or why the values are refused.
+        build: Builder,
+        /// How summaries name the path.
+        describe: &'static str,
     },
     /// The numeric reference, the model file validated again with the run's values.
     Numeric {
@@ -68,6 +81,7 @@ impl Factory {
             Factory::Generated { constructor, .. } => {
                 constructor(values).map_err(|e| e.to_string())
             }
+            Factory::Custom { build, .. } => build(values),
             Factory::Numeric {
                 source,
                 file,
@@ -88,6 +102,7 @@ impl Factory {
         match self {
             Factory::Generated { .. } => "generated code",
             Factory::Numeric { .. } => "numeric reference",
+            Factory::Custom { describe, .. } => describe,
         }
     }
 }
