@@ -204,8 +204,10 @@ pub fn compile(
         "[package]\nname = \"{name}\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n\
          # Written by camchain.compile for {shown}.\n[lib]\npath = \"src/lib.rs\"\ncrate-type = [\"cdylib\"]\n\n\
          [dependencies]\ncamchain-runtime = {{ path = \"{}\" }}\n\n\
-         # The dev profile as the camchain workspace's (CAMCHAIN_COMPILE_PROFILE=dev):\n\
-         [profile.dev]\nopt-level = 2\ndebug = false\n\n[workspace]\n",
+         # The dev profile as the camchain workspace's (CAMCHAIN_COMPILE_PROFILE=dev, for\n\
+         # its tests): its dependencies are that build's; the runtime's copy unoptimised.\n\
+         [profile.dev]\nopt-level = 2\ndebug = false\n\
+         [profile.dev.package.camchain-runtime]\nopt-level = 0\n\n[workspace]\n",
         runtime.display().to_string().replace('\\', "/")
     );
     let shim = SHIM.replace("@ABI@", &library::ABI.to_string());
