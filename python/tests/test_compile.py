@@ -38,9 +38,10 @@ def test_a_compiled_model_runs_as_the_built_in_one(paper):
         scale = max(1.0, float(np.max(np.abs(builtin[name]))))
         # The same generated code, built by another cargo invocation: equal to round-off.
         assert np.max(np.abs(ours[name] - builtin[name])) <= 1e-12 * scale, name
-        # The numeric reference evaluates the same equations by another route: round-off
-        # differences grow through the 2 s run, to well below 1e-9 of the scale.
-        assert np.max(np.abs(ours[name] - numeric[name])) <= 1e-9 * scale, name
+        # The numeric reference evaluates the same equations by another route; on this
+        # model the integrator takes the same steps on both, and the runs differ by
+        # round-off (1.0e-14 of the scale measured over 2 s, 5.5e-14 over 10 s).
+        assert np.max(np.abs(ours[name] - numeric[name])) <= 1e-12 * scale, name
 
 
 def test_its_terms_are_the_numeric_references(paper):
