@@ -31,6 +31,12 @@ fn vector(value: &Bound<'_, PyAny>, n: usize, name: &str) -> PyResult<Vec<f64>> 
             format!("has {} entries, the model {n}", values.len()),
         ));
     }
+    if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        return Err(bad_option(
+            name,
+            format!("entry {k} is {}, not a finite number", values[k]),
+        ));
+    }
     Ok(values)
 }
 
@@ -81,6 +87,13 @@ fn accelerations(model: &dyn Dynamics, t: f64, q: &[f64], qd: &[f64]) -> Result<
     for row in 0..m {
         b[free.len() + row] =
             -c[row] - driven.iter().map(|&d| j[row * n + d] * qdd[d]).sum::<f64>();
+    }
+    // Terms that are not finite (a singular position of the model) cannot be solved, and
+    // an SVD of them would not end.
+    if !(a.iter().all(|v| v.is_finite()) && b.iter().all(|v| v.is_finite())) {
+        return Err(format!(
+            "the equations are not finite at t = {t} s, q = {q:?}, q̇ = {qd:?}"
+        ));
     }
     let x = match a.clone().lu().solve(&b) {
         Some(x) if x.iter().all(|v| v.is_finite()) => x,

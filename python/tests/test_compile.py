@@ -1,9 +1,7 @@
 """camchain.compile: a model file as generated code, built with cargo, cached, loaded; it
 must run as the built-in model compiled from the same file and as the numeric reference."""
 
-import os
 import shutil
-import time
 
 import numpy as np
 import pytest
@@ -22,13 +20,12 @@ def paper(repository, cache, tmp_path_factory):
     model_dir = tmp_path_factory.mktemp("models")
     path = model_dir / "paper_concave.ron"
     shutil.copy(repository / "models" / "paper_concave.ron", path)
-    start = time.monotonic()
     model = camchain.compile(path, cache_dir=cache, quiet=True)
-    return model, path, time.monotonic() - start
+    return model, path
 
 
 def test_a_compiled_model_runs_as_the_built_in_one(paper):
-    compiled, path, _ = paper
+    compiled, path = paper
     assert not compiled.numeric and compiled.source == str(path)
     ours = compiled.simulate(t_end=2.0)
     builtin = camchain.Model("paper_concave").simulate(t_end=2.0)
@@ -45,7 +42,7 @@ def test_a_compiled_model_runs_as_the_built_in_one(paper):
 
 
 def test_its_terms_are_the_numeric_references(paper):
-    compiled, path, _ = paper
+    compiled, path = paper
     numeric = camchain.Model.from_file(path)
     rng = np.random.default_rng(7)
     for _ in range(10):
@@ -58,7 +55,7 @@ def test_its_terms_are_the_numeric_references(paper):
 
 
 def test_parameters_and_sweeps_run_on_the_library(paper, cli_csv):
-    compiled, path, _ = paper
+    compiled, path = paper
     changed = compiled.simulate(t_end=0.5, params={"k3": 60.0})
     header, table = cli_csv("paper_concave", "--t-end", 0.5, "--param", "k3=60")
     for k, name in enumerate(header):
@@ -74,18 +71,17 @@ def test_parameters_and_sweeps_run_on_the_library(paper, cli_csv):
         assert np.allclose(sweep[name], builtin[name], rtol=1e-12, atol=1e-15), name
 
 
-def test_a_second_compile_of_the_same_text_is_a_cache_hit(paper, cache):
-    _, path, first = paper
-    start = time.monotonic()
+def test_a_second_compile_of_the_same_text_is_a_cache_hit(paper, cache, tmp_path, monkeypatch):
+    _, path = paper
+    # A cache hit runs no cargo: with a cargo that does not exist it still loads (the time
+    # it takes is in BENCHMARKS.md, "Python").
+    monkeypatch.setenv("CARGO", str(tmp_path / "no-such-cargo"))
     again = camchain.compile(path, cache_dir=cache, quiet=True)
-    took = time.monotonic() - start
-    # No cargo: loading the library and checking the file (the goal is at most 1 s).
-    assert took < 1.0, took
     assert again.simulate(t_end=0.1)["q1"].shape == (11,)
 
 
 def test_a_changed_file_is_compiled_again_and_bad_files_are_located(paper, cache, tmp_path):
-    _, path, _ = paper
+    _, path = paper
     text = path.read_text()
     other = tmp_path / "paper_concave.ron"
     # m1 is a constant parameter: folded into the code, which must be built again.
@@ -106,7 +102,7 @@ def test_a_changed_file_is_compiled_again_and_bad_files_are_located(paper, cache
 
 
 def test_without_cargo_the_error_says_what_to_install(paper, tmp_path, monkeypatch):
-    _, path, _ = paper
+    _, path = paper
     other = tmp_path / "p.ron"
     other.write_text(path.read_text().replace('(name: "m1", value: 1.0', '(name: "m1", value: 1.25', 1))
     monkeypatch.setenv("CARGO", str(tmp_path / "no-such-cargo"))

@@ -100,3 +100,5 @@ def test_bad_vectors_are_refused_with_their_length():
         model.rhs(0.0, np.zeros(4))
     with pytest.raises(ValueError, match="qd: expected a sequence of numbers"):
         model.bias(np.zeros(4), "fast")
+    with pytest.raises(ValueError, match="y: entry 2 is NaN, not a finite number"):
+        model.rhs(0.0, [0.0, 0.0, float("nan"), 0.0, 0.0, 0.0, 0.0, 0.0])

@@ -132,6 +132,22 @@ fn write_atomically(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), Failu
     Ok(())
 }
 
+/// A TOML basic string: quotes, backslashes and control characters escaped (a cache
+/// directory may hold any of them).
+fn toml_string(text: &str) -> String {
+    let mut out = String::from('"');
+    for c in text.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
 /// The runtime's sources, once per version.
 fn runtime_dir(root: &Path) -> Result<PathBuf, Failure> {
     let dir = root.join("runtime");
@@ -202,13 +218,14 @@ pub fn compile(
     let name = format!("camchain_model_{key}");
     let manifest = format!(
         "[package]\nname = \"{name}\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n\
-         # Written by camchain.compile for {shown}.\n[lib]\npath = \"src/lib.rs\"\ncrate-type = [\"cdylib\"]\n\n\
-         [dependencies]\ncamchain-runtime = {{ path = \"{}\" }}\n\n\
+         # Written by camchain.compile for {comment}.\n[lib]\npath = \"src/lib.rs\"\ncrate-type = [\"cdylib\"]\n\n\
+         [dependencies]\ncamchain-runtime = {{ path = {} }}\n\n\
          # The dev profile as the camchain workspace's (CAMCHAIN_COMPILE_PROFILE=dev, for\n\
          # its tests): its dependencies are that build's; the runtime's copy unoptimised.\n\
          [profile.dev]\nopt-level = 2\ndebug = false\n\
          [profile.dev.package.camchain-runtime]\nopt-level = 0\n\n[workspace]\n",
-        runtime.display().to_string().replace('\\', "/")
+        toml_string(&runtime.display().to_string().replace('\\', "/")),
+        comment = shown.replace(['\n', '\r'], " "),
     );
     let shim = SHIM.replace("@ABI@", &library::ABI.to_string());
     write_atomically(
