@@ -9,7 +9,6 @@
 
 use crate::errors::bad_option;
 use crate::load::Origin;
-use camchain_cli::CliError;
 use camchain_cli::args::CamArgs;
 use camchain_cli::cam::analysis::{Extreme, Range};
 use camchain_cli::cam::dynamics::JumpSpeed;
@@ -54,19 +53,6 @@ fn check(ask: &Ask) -> PyResult<()> {
     Ok(())
 }
 
-fn cli_error(e: CliError) -> PyErr {
-    let text = e
-        .to_string()
-        .replace("--speed", "speed")
-        .replace("--contact", "contact")
-        .replace("--turns", "turns")
-        .replace("--samples", "samples");
-    match e {
-        CliError::Usage(_) => pyo3::exceptions::PyValueError::new_err(text),
-        _ => crate::errors::CamchainError::new_err(text),
-    }
-}
-
 /// Runs the study with the GIL released.
 pub fn study(py: Python<'_>, origin: &Origin, ask: &Ask) -> PyResult<(Study, f64)> {
     check(ask)?;
@@ -91,7 +77,7 @@ pub fn study(py: Python<'_>, origin: &Origin, ask: &Ask) -> PyResult<(Study, f64
         let study = cam::study(&prepared, &args, &mut |_| {})?;
         Ok((study, prepared.speed))
     })
-    .map_err(cli_error)
+    .map_err(crate::errors::cli_error)
 }
 
 fn extreme<'py>(py: Python<'py>, e: &Extreme) -> PyResult<Bound<'py, PyDict>> {

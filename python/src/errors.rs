@@ -75,17 +75,17 @@ impl Location {
         }
     }
 
-    /// `file:line:column: field: message`, as the build and the command line print it.
+    /// `file:line:column: field: message`, as the build and the command line print it (the
+    /// model error's own format), on one line.
     pub fn text(&self) -> String {
-        let mut text = self.file.clone();
-        if self.line > 0 {
-            text.push_str(&format!(":{}:{}", self.line, self.column));
+        Located {
+            file: self.file.clone().into(),
+            line: self.line,
+            column: self.column,
+            field: self.field.clone(),
+            message: self.message.replace('\n', " "),
         }
-        if !self.field.is_empty() {
-            text.push_str(&format!(": {}", self.field));
-        }
-        text.push_str(&format!(": {}", self.message.replace('\n', " ")));
-        text
+        .to_string()
     }
 
     /// The `camchain.ModelError` it raises (the class is defined in Python, `camchain/_errors.py`,
@@ -105,6 +105,20 @@ impl Location {
             Ok(PyErr::from_value(value))
         })();
         made.unwrap_or_else(|e| e)
+    }
+}
+
+/// The command line's errors in Python's terms: a usage error is a `ValueError`, any other
+/// failure a `CamchainError`; the CLI's option names become the method's arguments
+/// (`--speed` → `speed`).
+pub fn cli_error(e: camchain_cli::CliError) -> PyErr {
+    let mut text = e.to_string().replace("--param ", "params: ");
+    for option in ["jobs", "samples", "speed", "contact", "turns"] {
+        text = text.replace(&format!("--{option}"), option);
+    }
+    match e {
+        camchain_cli::CliError::Usage(_) => PyValueError::new_err(text),
+        _ => CamchainError::new_err(text),
     }
 }
 

@@ -88,20 +88,7 @@ impl Model {
         } else {
             "generated code"
         };
-        let dynamics = self.engine.get();
-        let changed: Vec<String> = dynamics
-            .info()
-            .parameters
-            .iter()
-            .zip(dynamics.parameter_values())
-            .filter(|(p, v)| p.default != **v)
-            .map(|(p, v)| format!("{} = {v}", p.name))
-            .collect();
-        if changed.is_empty() {
-            path.to_string()
-        } else {
-            format!("{path} with {}", changed.join(", "))
-        }
+        camchain_cli::summary::with_changed_parameters(path, self.engine.get())
     }
 }
 

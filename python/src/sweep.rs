@@ -10,7 +10,6 @@
 
 use crate::errors::bad_option;
 use crate::load::Origin;
-use camchain_cli::CliError;
 use camchain_cli::args::{IntegrationArgs, SweepArgs};
 use camchain_cli::sweep::table::{METRICS, Row};
 use camchain_cli::sweep::{self, Factory, Plan};
@@ -56,20 +55,6 @@ fn spec(name: &str, values: &Bound<'_, PyAny>) -> PyResult<String> {
     }
     let text: Vec<String> = list.iter().map(|v| format!("{v:?}")).collect();
     Ok(format!("{name}={}", text.join(",")))
-}
-
-/// The command line's usage errors as `ValueError`s, its other failures as
-/// `camchain.CamchainError`s; its option names become the method's arguments.
-fn cli_error(e: CliError) -> PyErr {
-    let text = e
-        .to_string()
-        .replace("--param ", "params: ")
-        .replace("--jobs", "jobs")
-        .replace("--samples", "samples");
-    match e {
-        CliError::Usage(_) => pyo3::exceptions::PyValueError::new_err(text),
-        _ => crate::errors::CamchainError::new_err(text),
-    }
 }
 
 /// What a sweep is asked, from the method's arguments.
@@ -139,7 +124,7 @@ pub fn plan(origin: &Origin, values: &[(String, f64)], ask: &Ask<'_>) -> PyResul
         no_plots: true,
         quiet: true,
     };
-    let mut plan = sweep::plan(&args).map_err(cli_error)?;
+    let mut plan = sweep::plan(&args).map_err(crate::errors::cli_error)?;
     // A compiled model: planned and checked on its file, run on its library.
     if let Origin::Compiled { loaded, info, .. } = origin {
         let (loaded, info) = (Arc::clone(loaded), Arc::clone(info));

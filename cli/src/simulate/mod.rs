@@ -113,24 +113,6 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     }
 }
 
-/// `generated code, k3 = 60, swing = 0.3`: the path and the run-time parameters whose values
-/// differ from the model file's.
-fn with_changed_parameters(path: &str, model: &dyn camchain_runtime::Dynamics) -> String {
-    let changed: Vec<String> = model
-        .info()
-        .parameters
-        .iter()
-        .zip(model.parameter_values())
-        .filter(|(p, v)| p.default != **v)
-        .map(|(p, v)| format!("{} = {v}", p.name))
-        .collect();
-    if changed.is_empty() {
-        path.to_string()
-    } else {
-        format!("{path} with {}", changed.join(", "))
-    }
-}
-
 /// Runs one job: assembly, simulation with the CSV streamed, then (complete runs) the
 /// figures and the summary. Problems are reported here.
 fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interrupt) -> Outcome {
@@ -231,7 +213,7 @@ fn run_job(job: &Job, args: &SimulateArgs, console: &Console, interrupt: &Interr
             }
         }
     }
-    let engine = with_changed_parameters(model.engine.describe(), dynamics);
+    let engine = summary::with_changed_parameters(model.engine.describe(), dynamics);
     console.say(&summary::render(&RunReport {
         label,
         engine: &engine,

@@ -167,6 +167,24 @@ fn contact_lines(info: &ModelInfo, digest: &Digest) -> Vec<String> {
     lines
 }
 
+/// `generated code, k3 = 60, swing = 0.3`: the path and the run-time parameters whose values
+/// differ from the model file's.
+pub fn with_changed_parameters(path: &str, model: &dyn camchain_runtime::Dynamics) -> String {
+    let changed: Vec<String> = model
+        .info()
+        .parameters
+        .iter()
+        .zip(model.parameter_values())
+        .filter(|(p, v)| p.default != **v)
+        .map(|(p, v)| format!("{} = {v}", p.name))
+        .collect();
+    if changed.is_empty() {
+        path.to_string()
+    } else {
+        format!("{path} with {}", changed.join(", "))
+    }
+}
+
 /// The summary text (several lines, each ending in a newline).
 pub fn render(report: &RunReport) -> String {
     let RunReport {
