@@ -12,11 +12,16 @@
 //! expressions without compiling them.
 
 use crate::profile::Func;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 mod calculus;
+mod count;
+mod interpret;
 pub mod scalar;
 mod tabulated;
+
+pub use count::OpCount;
+pub use interpret::{apply, method_name};
 
 /// Handle of a node in a [`Graph`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -69,56 +74,6 @@ pub type Table = std::sync::Arc<crate::profile::Tabulated>;
 /// A surface of the graph given on a grid, evaluated by the runtime
 /// ([`crate::profile::Gridded`]).
 pub type Grid = std::sync::Arc<crate::profile::Gridded>;
-
-/// Operation counts of a set of expressions, each shared node counted once.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct OpCount {
-    /// Additions and subtractions (and negations not absorbed into a subtraction).
-    pub add_sub: usize,
-    /// Multiplications.
-    pub mul: usize,
-    /// Divisions.
-    pub div: usize,
-    /// sin and cos.
-    pub sin_cos: usize,
-    /// Square roots.
-    pub sqrt: usize,
-    /// Everything else (powi, powf, tan, exp, ln, hyperbolic, atan).
-    pub other: usize,
-}
-
-impl OpCount {
-    /// Sum of all operations.
-    pub fn total(&self) -> usize {
-        self.add_sub + self.mul + self.div + self.sin_cos + self.sqrt + self.other
-    }
-
-    /// Adds the counts of `other` to these.
-    pub fn accumulate(&mut self, other: &OpCount) {
-        self.add_sub += other.add_sub;
-        self.mul += other.mul;
-        self.div += other.div;
-        self.sin_cos += other.sin_cos;
-        self.sqrt += other.sqrt;
-        self.other += other.other;
-    }
-}
-
-impl std::fmt::Display for OpCount {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} add/sub, {} mul, {} div, {} sin/cos, {} sqrt, {} other ({} total)",
-            self.add_sub,
-            self.mul,
-            self.div,
-            self.sin_cos,
-            self.sqrt,
-            self.other,
-            self.total()
-        )
-    }
-}
 
 /// A hash-consed expression DAG with named variables.
 #[derive(Debug, Default, Clone)]
@@ -708,86 +663,6 @@ impl Graph {
         }
     }
 
-    /// Evaluates the given roots with `vars[i]` the value of variable i (the interpreter).
-    ///
-    /// Only the nodes the roots depend on are computed, in id (= topological) order.
-    pub fn eval(&self, roots: &[Id], vars: &[f64]) -> Vec<f64> {
-        let last = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
-        // Only what the roots depend on: an implicit variable they do not need is not solved
-        // (its solve evaluates its own residual, which may hold earlier implicit variables).
-        let needed = self.reachable_until(roots, &HashSet::new());
-        let mut values: Vec<f64> = Vec::with_capacity(last);
-        for (index, node) in self.nodes[..last].iter().enumerate() {
-            if !needed[index] {
-                values.push(f64::NAN);
-                continue;
-            }
-            let v = |id: &Id| values[id.index()];
-            let value: f64 = match node {
-                Node::Const(bits) => f64::from_bits(*bits),
-                Node::Var(i) => match self.implicits.get(i) {
-                    Some(def) => self.solve_implicit(def, vars, &values),
-                    None => vars.get(*i as usize).copied().unwrap_or(f64::NAN),
-                },
-                Node::Add(a, b) => v(a) + v(b),
-                Node::Mul(a, b) => v(a) * v(b),
-                Node::Neg(a) => -v(a),
-                Node::Div(a, b) => v(a) / v(b),
-                Node::Powi(a, n) => v(a).powi(*n),
-                Node::Powf(a, b) => v(a).powf(v(b)),
-                Node::Call(f, a) => apply(*f, v(a)),
-                Node::Table(t, order, a) => self
-                    .tables
-                    .get(*t as usize)
-                    .map_or(f64::NAN, |table| table.derivative(*order, v(a))),
-                Node::Grid(k, order, a, b) => self
-                    .grids
-                    .get(*k as usize)
-                    .map_or(f64::NAN, |grid| grid.derivative(*order, v(a), v(b))),
-            };
-            values.push(value);
-        }
-        roots.iter().map(|r| values[r.index()]).collect()
-    }
-
-    /// The interpreter's value of an implicit variable: the same Newton solve as the
-    /// emitted code's, on the interpreted residual.
-    fn solve_implicit(&self, def: &Implicit, vars: &[f64], values: &[f64]) -> f64 {
-        let mut local = vars.to_vec();
-        let set = |local: &mut Vec<f64>, id: Id, value: f64| {
-            if let Node::Var(k) = self.node(id) {
-                if local.len() <= k as usize {
-                    local.resize(k as usize + 1, f64::NAN);
-                }
-                local[k as usize] = value;
-            }
-        };
-        let inputs: Vec<f64> = def.inputs.iter().map(|i| values[i.index()]).collect();
-        for (&p, &value) in def.placeholders.iter().zip(&inputs) {
-            set(&mut local, p, value);
-        }
-        let guess = match def.guess {
-            Guess::Input(i) => inputs[i],
-            Guess::Angle { x, y } => inputs[y].atan2(inputs[x]),
-            Guess::Scan => f64::NAN,
-        };
-        let local = std::cell::RefCell::new(local);
-        let eval_at = |s: f64, roots: &[Id]| {
-            let mut l = local.borrow_mut();
-            set(&mut l, def.unknown, s);
-            self.eval(roots, &l)
-        };
-        camchain_runtime::contact::solve(
-            guess,
-            def.range,
-            |s| {
-                let r = eval_at(s, &[def.residual, def.derivative]);
-                [r[0], r[1]]
-            },
-            |s| eval_at(s, &[def.objective])[0],
-        )
-    }
-
     /// Direct children of a node.
     pub fn children(&self, id: Id) -> Vec<Id> {
         match self.node(id) {
@@ -804,116 +679,6 @@ impl Graph {
             | Node::Grid(_, _, a, b) => vec![a, b],
             Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Table(_, _, a) => vec![a],
         }
-    }
-
-    /// Operation count of everything the roots need, shared nodes counted once.
-    pub fn op_count(&self, roots: &[Id]) -> OpCount {
-        self.op_count_until(roots, &HashSet::new())
-    }
-
-    /// Operation count of what the roots need when the nodes in `given` are inputs (their
-    /// own operations, and those only they need, are not counted).
-    pub fn op_count_until(&self, roots: &[Id], given: &HashSet<Id>) -> OpCount {
-        let reachable = self.reachable_until(roots, given);
-        // For every reachable node: is it used at all, and only by additions? (One pass, so
-        // the count stays linear in the graph's size.)
-        let mut used = vec![false; self.nodes.len()];
-        let mut only_by_add = vec![true; self.nodes.len()];
-        for (i, node) in self.nodes.iter().enumerate() {
-            if !reachable[i] || given.contains(&Id(i as u32)) {
-                continue;
-            }
-            let is_add = matches!(node, Node::Add(..));
-            for c in self.children(Id(i as u32)) {
-                used[c.index()] = true;
-                only_by_add[c.index()] &= is_add;
-            }
-        }
-        let mut count = OpCount::default();
-        for (i, node) in self.nodes.iter().enumerate() {
-            if !reachable[i] {
-                continue;
-            }
-            if given.contains(&Id(i as u32)) {
-                continue;
-            }
-            match node {
-                // A contact parameter's Newton solve counts as one operation here; its
-                // residual is counted as a function of its own.
-                Node::Var(k) if self.implicits.contains_key(k) => count.other += 1,
-                Node::Const(_) | Node::Var(_) => {}
-                Node::Add(..) => count.add_sub += 1,
-                Node::Neg(_) => {
-                    // Absorbed when every use is an addition (written as a subtraction).
-                    if !(used[i] && only_by_add[i]) {
-                        count.add_sub += 1
-                    }
-                }
-                Node::Mul(..) => count.mul += 1,
-                Node::Div(..) => count.div += 1,
-                Node::Call(Func::Sin | Func::Cos, _) => count.sin_cos += 1,
-                Node::Call(Func::Sqrt, _) => count.sqrt += 1,
-                Node::Powi(..)
-                | Node::Powf(..)
-                | Node::Call(..)
-                | Node::Table(..)
-                | Node::Grid(..) => count.other += 1,
-            }
-        }
-        count
-    }
-
-    /// Marks the nodes the roots depend on.
-    pub fn reachable(&self, roots: &[Id]) -> Vec<bool> {
-        self.reachable_until(roots, &HashSet::new())
-    }
-
-    /// [`Graph::reachable`] without descending below the nodes of `stop` (which are marked).
-    pub fn reachable_until(&self, roots: &[Id], stop: &HashSet<Id>) -> Vec<bool> {
-        let mut mark = vec![false; self.nodes.len()];
-        let mut stack: Vec<Id> = roots.to_vec();
-        while let Some(id) = stack.pop() {
-            if mark[id.index()] {
-                continue;
-            }
-            mark[id.index()] = true;
-            if !stop.contains(&id) {
-                stack.extend(self.children(id));
-            }
-        }
-        mark
-    }
-}
-
-/// Numeric value of an elementary function.
-pub fn apply(f: Func, x: f64) -> f64 {
-    match f {
-        Func::Sin => x.sin(),
-        Func::Cos => x.cos(),
-        Func::Tan => x.tan(),
-        Func::Exp => x.exp(),
-        Func::Ln => x.ln(),
-        Func::Sqrt => x.sqrt(),
-        Func::Sinh => x.sinh(),
-        Func::Cosh => x.cosh(),
-        Func::Tanh => x.tanh(),
-        Func::Atan => x.atan(),
-    }
-}
-
-/// Method name of an elementary function in Rust.
-pub fn method_name(f: Func) -> &'static str {
-    match f {
-        Func::Sin => "sin",
-        Func::Cos => "cos",
-        Func::Tan => "tan",
-        Func::Exp => "exp",
-        Func::Ln => "ln",
-        Func::Sqrt => "sqrt",
-        Func::Sinh => "sinh",
-        Func::Cosh => "cosh",
-        Func::Tanh => "tanh",
-        Func::Atan => "atan",
     }
 }
 
