@@ -51,8 +51,8 @@ fn main() {
         "/// The runtime's manifest, standalone.\npub const RUNTIME_MANIFEST: &str = {:?};",
         format!(
             "[package]\nname = \"camchain-runtime\"\nversion = \"{version}\"\nedition = \"2024\"\n\
-             publish = false\n\n[dependencies]\nnalgebra = {{ version = \"0.35\", \
-             default-features = false, features = [\"std\"] }}\nthiserror = \"2\"\n"
+             publish = false\n\n# The contract alone: a compiled model never runs the engine, the package \
+             does.\n[features]\nengine = []\n\n[dependencies]\nthiserror = \"2\"\n"
         )
     );
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap_or_default());

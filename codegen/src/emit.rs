@@ -122,6 +122,11 @@ pub struct EmitOptions {
     /// The longest generated module, in bytes before formatting ([`MAX_CODE_BYTES`] by
     /// default): a model whose code would be longer is refused with an error saying so.
     pub code_limit: usize,
+    /// Whether `Model` gets the inherent `assemble`, `step`, `sample`, `simulate` and
+    /// `simulate_metrics` (true by default). They call the runtime's `engine` feature; a crate
+    /// that links `camchain-runtime` with `default-features = false` (the contract alone, no
+    /// linear algebra, the fastest cold build) turns them off and simulates elsewhere.
+    pub simulation_methods: bool,
 }
 
 impl Default for EmitOptions {
@@ -134,6 +139,7 @@ impl Default for EmitOptions {
             files_dir: None,
             node_limit: crate::expr::NODE_LIMIT,
             code_limit: MAX_CODE_BYTES,
+            simulation_methods: true,
         }
     }
 }
@@ -263,7 +269,12 @@ pub fn generate_from(
          use {} as rt;",
         options.runtime_path
     );
-    file.push_str(&model_type(model, source, runtime.is_some()));
+    file.push_str(&model_type(
+        model,
+        source,
+        runtime.is_some(),
+        options.simulation_methods,
+    ));
     if let Some(rp) = &runtime {
         file.push_str(&rp.items(model, &d, source));
     }

@@ -565,6 +565,7 @@ pub struct VelocityTerms<'a> {
 /// The [`Dynamics`] methods of a view of a model that changes only its contacts (a flying
 /// follower's, a groove's clearance): the inner model's M, F, Q, drives, energies, powers
 /// and cache, forwarded to the field `$inner`. Written inside the view's `impl Dynamics`.
+#[cfg(feature = "engine")]
 macro_rules! forward_free_motion {
     ($inner:ident) => {
         fn parameter_values(&self) -> &[f64] {
@@ -607,6 +608,7 @@ macro_rules! forward_free_motion {
         }
     };
 }
+#[cfg(feature = "engine")]
 pub(crate) use forward_free_motion;
 
 /// sin and cos of `angle`, reusing `slot` = [angle, sin, cos] when it holds this very angle

@@ -5,6 +5,13 @@
 //! This is the crate a program that simulates links; its only dependencies are nalgebra and
 //! thiserror. Most programs reach it through the `camchain` facade as `camchain::runtime`.
 //!
+//! Its feature `engine` (on by default) holds everything that runs a model: assembly,
+//! partitioning, the integrators, events, sampling and the simulation loop, and brings
+//! nalgebra. Without it the crate is the contract alone (the [`Dynamics`] trait and its
+//! types, parameters and their checks, contact geometry, motion laws and splines), which is
+//! all that generated code emitted with `EmitOptions::simulation_methods` off calls: what a
+//! model compiled from Python links, so that its cold build does not wait for nalgebra.
+//!
 //! Module map:
 //! - [`assembly`]: a consistent initial state, and the report of what assembly changed.
 //! - [`dynamics`]: the [`Dynamics`] trait every model implements (eqs. 3–8, 13).
@@ -36,40 +43,58 @@
 //! - [`events`]: contact events (force sign changes, lift-off, impact) and their location.
 //! - [`error`]: simulation errors with time and state.
 
+#[cfg(feature = "engine")]
 pub mod assembly;
+#[cfg(feature = "engine")]
 pub mod clearance;
 pub mod contact;
+#[cfg(feature = "engine")]
 pub mod control;
 pub mod dynamics;
 pub mod error;
+#[cfg(feature = "engine")]
 pub mod events;
+#[cfg(feature = "engine")]
 pub mod integrators;
 pub mod kinds;
+#[cfg(feature = "engine")]
 pub mod metrics;
 pub mod motion_law;
 pub mod parameters;
+#[cfg(feature = "engine")]
 pub mod partition;
+#[cfg(feature = "engine")]
 pub(crate) mod phase;
+#[cfg(feature = "engine")]
 pub mod sample;
+#[cfg(feature = "engine")]
 pub(crate) mod scan;
 pub mod settings;
+#[cfg(feature = "engine")]
 pub mod simulate;
 pub mod spline;
+#[cfg(feature = "engine")]
 pub mod stepping;
 pub mod surface_spline;
+#[cfg(feature = "engine")]
 pub mod unilateral;
 
+#[cfg(feature = "engine")]
 pub use control::{Cancel, Monitor, Observed, Progress};
 pub use dynamics::*;
 pub use error::SimError;
+#[cfg(feature = "engine")]
 pub use metrics::{MetricsFailure, MetricsOptions, RunMetrics};
 pub use parameters::{ParameterError, ParameterInfo};
 pub use settings::InvalidSetting;
+#[cfg(feature = "engine")]
 pub use simulate::{Sample, SimFailure, Simulate, State, Stats, Trajectory};
+#[cfg(feature = "engine")]
 pub use unilateral::ContactLaw;
 
 // Beside the type's definition in `simulate.rs` when that file is next changed; here (the
 // crate's root) it adds no edge between the modules.
+#[cfg(feature = "engine")]
 impl std::fmt::Debug for SimFailure {
     /// The one-line message of `Display` (the samples reached and the error), not the
     /// partial trajectory: what a `main` returning `Result<(), Box<dyn std::error::Error>>`

@@ -49,11 +49,21 @@ fn tree(package: &str, edges: &str) -> BTreeSet<String> {
     tree_with(package, edges, &[])
 }
 
-/// [`tree`] with `features` of the package on.
+/// [`tree`] with `features` of the package on; `"-default"` among them turns the default
+/// features off.
 fn tree_with(package: &str, edges: &str, features: &[&str]) -> BTreeSet<String> {
+    let defaults_off = features.contains(&"-default");
+    let features: Vec<&str> = features
+        .iter()
+        .copied()
+        .filter(|f| *f != "-default")
+        .collect();
     let features = features.join(",");
     let mut command = Command::new(env!("CARGO"));
     command.args(["tree", "--offline", "-p", package, "-e", edges]);
+    if defaults_off {
+        command.arg("--no-default-features");
+    }
     if !features.is_empty() {
         command.args(["--features", &features]);
     }
@@ -86,6 +96,19 @@ fn expected(own: &[&str]) -> BTreeSet<String> {
 fn the_runtime_links_nalgebra_and_thiserror_only() {
     let linked = tree("camchain-runtime", "normal,no-proc-macro");
     assert_eq!(linked, expected(&["camchain-runtime"]));
+}
+
+/// Without its `engine` feature the runtime is the `Dynamics` contract and what generated code
+/// calls: no nalgebra, so that a model compiled from Python builds without waiting for it
+/// (with it, nalgebra's chain was most of a cold `camchain.compile`).
+#[test]
+fn the_contract_alone_links_thiserror_only() {
+    let linked = tree_with("camchain-runtime", "normal,no-proc-macro", &["-default"]);
+    let want: BTreeSet<String> = ["camchain-runtime", "thiserror"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    assert_eq!(linked, want);
 }
 
 #[test]

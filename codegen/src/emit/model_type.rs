@@ -6,12 +6,26 @@ use super::literals::{ALLOW_UNUSED, raw_string};
 use crate::model::Model;
 use std::fmt::Write;
 
-pub(super) fn model_type(model: &Model, source: &str, parametric: bool) -> String {
-    let mut doc = format!(
-        "/// The model `{}`, generated from `{source}`: implements [`rt::Dynamics`]; simulate it \
-         with\n/// [`Model::assemble`], [`Model::step`] and [`Model::simulate`].\n",
-        model.name
-    );
+/// `simulation_methods`: whether the inherent `assemble`, `step`, `sample`, `simulate` and
+/// `simulate_metrics` are emitted (they call the runtime's `engine` feature).
+pub(super) fn model_type(
+    model: &Model,
+    source: &str,
+    parametric: bool,
+    simulation_methods: bool,
+) -> String {
+    let mut doc = if simulation_methods {
+        format!(
+            "/// The model `{}`, generated from `{source}`: implements [`rt::Dynamics`]; simulate \
+             it with\n/// [`Model::assemble`], [`Model::step`] and [`Model::simulate`].\n",
+            model.name
+        )
+    } else {
+        format!(
+            "/// The model `{}`, generated from `{source}`: implements [`rt::Dynamics`].\n",
+            model.name
+        )
+    };
     if !model.description.is_empty() {
         doc.push_str("///\n");
         for line in model.description.lines() {
@@ -30,29 +44,16 @@ pub(super) fn model_type(model: &Model, source: &str, parametric: bool) -> Strin
             plain_constructors(model, source),
         )
     };
+    let simulation = if simulation_methods {
+        SIMULATION_METHODS
+    } else {
+        ""
+    };
     format!(
         "{definition}{ALLOW_UNUSED}\n\
          impl Model {{\n\
          {constructors}\
-         /// Assembles the initial state from the model file's guess: held coordinates keep\n\
-         /// their values, the dependent ones are solved so that every contact point is on its cam.\n\
-         pub fn assemble(&self) -> Result<rt::State, rt::SimError> {{\n\
-         rt::Simulate::assemble(self, 0.0)\n}}\n\
-         /// Advances `state` by `dt` seconds with the model's default integrator settings.\n\
-         pub fn step(&self, state: &mut rt::State, dt: f64) -> Result<rt::Stats, rt::SimError> {{\n\
-         rt::Simulate::step(self, state, dt)\n}}\n\
-         /// Everything at the state's instant: accelerations, contact points and normal forces,\n\
-         /// constraint residuals, drive loads, energies.\n\
-         pub fn sample(&self, state: &rt::State) -> Result<rt::Sample, rt::SimError> {{\n\
-         rt::Simulate::sample(self, state)\n}}\n\
-         /// Simulates from `state` with `settings`, sampling every `settings.dt_out`.\n\
-         pub fn simulate(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::Trajectory, Box<rt::SimFailure>> {{\n\
-         rt::Simulate::simulate(self, state, settings)\n}}\n\
-         /// Simulates from `state` with `settings`, keeping a summary instead of a trajectory\n\
-         /// (extreme normal forces, first lift-off, max |h|, energy drift): what a parameter\n\
-         /// sweep keeps of a run.\n\
-         pub fn simulate_metrics(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::RunMetrics, Box<rt::MetricsFailure>> {{\n\
-         rt::Simulate::simulate_metrics(self, state, settings, rt::MetricsOptions::default())\n}}\n\
+         {simulation}\
          /// The default settings from the model file.\n\
          pub fn default_settings(&self) -> rt::SimSettings {{\n\
          rt::Dynamics::info(self).defaults.clone()\n}}\n\
@@ -66,6 +67,28 @@ pub(super) fn model_type(model: &Model, source: &str, parametric: bool) -> Strin
          Ok(Box::new(Model::with(values)?))\n}}\n"
     )
 }
+
+/// The inherent methods that simulate the model (through `rt::Simulate`).
+const SIMULATION_METHODS: &str = "\
+         /// Assembles the initial state from the model file's guess: held coordinates keep\n\
+         /// their values, the dependent ones are solved so that every contact point is on its cam.\n\
+         pub fn assemble(&self) -> Result<rt::State, rt::SimError> {\n\
+         rt::Simulate::assemble(self, 0.0)\n}\n\
+         /// Advances `state` by `dt` seconds with the model's default integrator settings.\n\
+         pub fn step(&self, state: &mut rt::State, dt: f64) -> Result<rt::Stats, rt::SimError> {\n\
+         rt::Simulate::step(self, state, dt)\n}\n\
+         /// Everything at the state's instant: accelerations, contact points and normal forces,\n\
+         /// constraint residuals, drive loads, energies.\n\
+         pub fn sample(&self, state: &rt::State) -> Result<rt::Sample, rt::SimError> {\n\
+         rt::Simulate::sample(self, state)\n}\n\
+         /// Simulates from `state` with `settings`, sampling every `settings.dt_out`.\n\
+         pub fn simulate(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::Trajectory, Box<rt::SimFailure>> {\n\
+         rt::Simulate::simulate(self, state, settings)\n}\n\
+         /// Simulates from `state` with `settings`, keeping a summary instead of a trajectory\n\
+         /// (extreme normal forces, first lift-off, max |h|, energy drift): what a parameter\n\
+         /// sweep keeps of a run.\n\
+         pub fn simulate_metrics(&self, state: rt::State, settings: &rt::SimSettings) -> Result<rt::RunMetrics, Box<rt::MetricsFailure>> {\n\
+         rt::Simulate::simulate_metrics(self, state, settings, rt::MetricsOptions::default())\n}\n";
 
 /// The `Model` of a model with run-time parameters: the values, what derives from them, and
 /// the description (whose initial guess may depend on them).
@@ -173,7 +196,7 @@ mod tests {
 
     #[test]
     fn a_model_without_run_time_parameters_is_a_unit_struct() {
-        let text = model_type(&model("double_pendulum"), "p.ron", false);
+        let text = model_type(&model("double_pendulum"), "p.ron", false, true);
         assert!(text.starts_with("/// The model `double_pendulum`, generated from `p.ron`"));
         assert!(text.contains("pub struct Model;\n"));
         assert!(text.contains("None => Ok(Model),"));
@@ -182,7 +205,7 @@ mod tests {
 
     #[test]
     fn a_parametric_model_holds_its_values_and_what_derives_from_them() {
-        let text = model_type(&model("double_pendulum"), "p.ron", true);
+        let text = model_type(&model("double_pendulum"), "p.ron", true, true);
         assert!(text.contains(
             "pub struct Model {\nparameters: Parameters,\nvalues: [f64; 7],\nderived: Derived,"
         ));

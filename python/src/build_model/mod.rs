@@ -181,6 +181,9 @@ pub fn compile(
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let options = EmitOptions {
         runtime_path: "::camchain_runtime".into(),
+        // The package runs the model; the library only evaluates it, so it links the
+        // runtime's contract alone (no nalgebra: the cold build's longest path).
+        simulation_methods: false,
         files_dir: Some(if dir.as_os_str().is_empty() {
             PathBuf::from(".")
         } else {
