@@ -1,23 +1,7 @@
 //! The CSV of a trajectory: one row per output time, header first.
 //!
-//! Columns, in order: `t`; every coordinate by name; every velocity as `<name>_dot`; for
-//! each contact C: `C_x`, `C_y` (and `C_z` in a spatial model: the contact point in ground
-//! coordinates, m), `C_cam_x`, `C_cam_y` (the same point in the cam's frame, which turns with
-//! the cam's body, m), `C_cam_angle` (only when the cam's body turns on a revolute joint of
-//! its own: that joint's angle, rad), `C_normal_force` (N, positive when the cam pushes on
-//! the follower), `C_pressure_angle` (only when the cam moves, as it must to drive the
-//! follower: rad, between the contact normal and the direction in which the follower's own
-//! joint moves the follower point), `C_sliding_speed` (m/s, the
-//! follower's tangential speed over the cam at the contact point), `C_h` (the constraint
-//! residual, m; in flight the gap); for each equation E of each loop L, `L_E_h` (its
-//! residual: m for the gap's components `x`, `y`, `z` and `normal`, dimensionless for `turn`
-//! and `tilt`) and `L_E_reaction` (−λ: for `x`, `y`, `z` the force that B's body exerts on
-//! A's at the cut, ground axes, N; for `normal` the force across the line, N; for `turn`
-//! and `tilt` the moment that keeps the directions aligned, N m); for each driven coordinate, `<name>_drive` (the force or
-//! torque of its drive); then `energy` (kinetic + potential of gravity and springs),
-//! `dissipated` (work done by the dampers so far) and `driven_work` (work done by the drives
-//! and the applied joint loads so far), so that `energy + dissipated − driven_work` stays
-//! constant.
+//! The columns, their order and units are [`camchain_runtime::columns`]'s (an FMU's outputs
+//! and the Python package's result are the same columns).
 //!
 //! Numbers are written with Rust's shortest round-trip formatting (`{:?}`): parsing a value
 //! gives back exactly the `f64` the simulation computed.
@@ -25,92 +9,17 @@
 use camchain_runtime::{ModelInfo, Sample};
 use std::io::{self, Write};
 
-/// The header's column names.
+/// The header's column names ([`camchain_runtime::columns::columns`]).
 pub fn header(info: &ModelInfo) -> Vec<String> {
-    let mut columns = vec!["t".to_string()];
-    columns.extend(info.coordinates.iter().map(|c| c.name.clone()));
-    columns.extend(info.coordinates.iter().map(|c| format!("{}_dot", c.name)));
-    for (k, contact) in info.contacts.iter().map(|c| &c.name).enumerate() {
-        let axes: &[&str] = if info.spatial {
-            &["x", "y", "z"]
-        } else {
-            &["x", "y"]
-        };
-        let surface = info.contacts[k].profile.is_surface();
-        columns.extend(axes.iter().map(|a| format!("{contact}_{a}")));
-        columns.extend(["cam_x", "cam_y"].map(|a| format!("{contact}_{a}")));
-        if surface {
-            columns.push(format!("{contact}_cam_z"));
-        }
-        if info.contacts[k].cam_coordinate.is_some() {
-            columns.push(format!("{contact}_cam_angle"));
-        }
-        columns.push(format!("{contact}_normal_force"));
-        if surface {
-            // On a cam surface the normal's direction is not the cam plane's: its ground
-            // components.
-            columns.extend(["x", "y", "z"].map(|a| format!("{contact}_normal_{a}")));
-        }
-        if info.contacts[k].cam_moves {
-            columns.push(format!("{contact}_pressure_angle"));
-        }
-        columns.extend(["sliding_speed", "h"].map(|a| format!("{contact}_{a}")));
-    }
-    for (_, l) in info.loop_rows() {
-        for e in &l.equations {
-            columns.push(format!("{}_{e}_h", l.name));
-            columns.push(format!("{}_{e}_reaction", l.name));
-        }
-    }
-    columns.extend(
-        info.coordinates
-            .iter()
-            .filter(|c| c.driven)
-            .map(|c| format!("{}_drive", c.name)),
-    );
-    columns.extend(["energy", "dissipated", "driven_work"].map(String::from));
-    columns
+    camchain_runtime::columns::columns(info)
+        .into_iter()
+        .map(|c| c.name)
+        .collect()
 }
 
 /// The values of one row, in the order of [`header`].
 pub fn row(info: &ModelInfo, sample: &Sample) -> Vec<f64> {
-    let mut values = vec![sample.t];
-    values.extend(&sample.q);
-    values.extend(&sample.qd);
-    let dims = if info.spatial { 3 } else { 2 };
-    for (k, (contact, about)) in sample.contacts.iter().zip(&info.contacts).enumerate() {
-        let surface = about.profile.is_surface();
-        values.extend(&contact.position[..dims]);
-        values.extend([contact.x, contact.y]);
-        if surface {
-            values.push(contact.z);
-        }
-        if let Some(i) = about.cam_coordinate {
-            values.push(sample.q[i]);
-        }
-        values.push(sample.normal_force[k]);
-        if surface {
-            values.extend(contact.normal);
-        }
-        if about.cam_moves {
-            values.push(contact.pressure_angle());
-        }
-        values.extend([contact.sliding_speed, sample.h[k]]);
-    }
-    // Each loop equation's residual and its reaction −λ (docs/model-format.md, "Loops").
-    for k in info.n_contacts()..info.n_constraints() {
-        values.push(sample.h.get(k).copied().unwrap_or(f64::NAN));
-        values.push(-sample.lambda.get(k).copied().unwrap_or(f64::NAN));
-    }
-    values.extend(
-        info.coordinates
-            .iter()
-            .zip(&sample.drive)
-            .filter(|(c, _)| c.driven)
-            .map(|(_, tau)| *tau),
-    );
-    values.extend([sample.energy.total(), sample.dissipated, sample.driven_work]);
-    values
+    camchain_runtime::columns::values(info, sample)
 }
 
 /// Writes the header and every sample.

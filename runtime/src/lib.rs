@@ -26,6 +26,7 @@
 //! - `scan`: in-step scans of the watched forces and gaps (no event missed inside a
 //!   step).
 //! - [`sample`]: every output at one instant.
+//! - [`columns`]: those outputs as named columns with units (the CSV's, an FMU's).
 //! - [`control`]: what a run reports while it goes ([`control::Monitor`]), cancellation,
 //!   and the watchdog that stops a stalled run.
 //! - [`motion_law`]: follower motion laws (dwell, cycloidal, harmonic, polynomials,
@@ -47,6 +48,8 @@
 pub mod assembly;
 #[cfg(feature = "engine")]
 pub mod clearance;
+#[cfg(feature = "engine")]
+pub mod columns;
 pub mod contact;
 #[cfg(feature = "engine")]
 pub mod control;

@@ -1,0 +1,304 @@
+//! One FMU instance in safe Rust: its mode (FMI 3.0's state machine, Co-Simulation), its
+//! parameter values, the model built from them, the state and the outputs at the current
+//! time. The C functions of [`crate::export`] only convert arguments and call these methods;
+//! every failure comes back as a message that they log with the status.
+
+use crate::variables::{Role, Setting, Variable, variables};
+use camchain_runtime::parameters::checks::within_bounds;
+use camchain_runtime::{Dynamics, ModelInfo, ParameterError, SimSettings, Simulate, State};
+
+/// What builds the model from parameter values: a generated module's `boxed`.
+pub type Factory = fn(&[(&str, f64)]) -> Result<Box<dyn Dynamics + Send + Sync>, ParameterError>;
+
+/// FMI 3.0's modes of a Co-Simulation instance (the ones it can be in).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// After `fmi3InstantiateCoSimulation` or `fmi3Reset`: parameters may be set.
+    Instantiated,
+    /// Between `fmi3EnterInitializationMode` and `fmi3ExitInitializationMode`.
+    Initialization,
+    /// Stepping (`fmi3DoStep`).
+    Step,
+    /// After `fmi3Terminate`: values may be read, nothing else.
+    Terminated,
+    /// After a failed step: only reading, `fmi3Reset`, `fmi3Terminate` and freeing.
+    Failed,
+}
+
+/// One instance.
+pub struct Instance {
+    factory: Factory,
+    info: ModelInfo,
+    variables: Vec<Variable>,
+    mode: Mode,
+    parameters: Vec<f64>,
+    settings: SimSettings,
+    start_time: f64,
+    stop_time: Option<f64>,
+    /// The model and its state at the current time, once built (after every parameter
+    /// change the next read or step builds them again).
+    running: Option<(Box<dyn Dynamics + Send + Sync>, State)>,
+    /// The output columns at the current time (index as [`Role::Output`]).
+    outputs: Vec<f64>,
+}
+
+/// Whether two communication times are the same one (FMI's masters pass the sum of the
+/// steps they took; a few ulps of that sum).
+fn same_time(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0)
+}
+
+impl Instance {
+    /// A new instance of the model `factory` builds with the file's values; `Err` when even
+    /// those are refused (a model that cannot be built).
+    pub fn new(factory: Factory) -> Result<Self, String> {
+        let model = factory(&[]).map_err(|e| format!("the model cannot be built: {e}"))?;
+        let info = model.info().clone();
+        let parameters = info.parameters.iter().map(|p| p.default).collect();
+        Ok(Instance {
+            factory,
+            variables: variables(&info),
+            settings: info.defaults.clone(),
+            info,
+            mode: Mode::Instantiated,
+            parameters,
+            start_time: 0.0,
+            stop_time: None,
+            running: None,
+            outputs: Vec::new(),
+        })
+    }
+
+    /// The model's description.
+    pub fn info(&self) -> &ModelInfo {
+        &self.info
+    }
+
+    /// The current mode.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// `fmi3Reset`: back to the state after instantiation, the file's values again.
+    pub fn reset(&mut self) {
+        self.parameters = self.info.parameters.iter().map(|p| p.default).collect();
+        self.settings = self.info.defaults.clone();
+        self.mode = Mode::Instantiated;
+        self.running = None;
+        self.outputs.clear();
+        self.start_time = 0.0;
+        self.stop_time = None;
+    }
+
+    /// `fmi3EnterInitializationMode`.
+    pub fn enter_initialization(
+        &mut self,
+        tolerance: Option<f64>,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Result<(), String> {
+        self.expect(&[Mode::Instantiated], "fmi3EnterInitializationMode")?;
+        if !start_time.is_finite() {
+            return Err(format!(
+                "the start time {start_time} is not a finite number"
+            ));
+        }
+        if let Some(stop) = stop_time.filter(|&s| s.is_nan() || s < start_time) {
+            return Err(format!(
+                "the stop time {stop} is before the start time {start_time}"
+            ));
+        }
+        if let Some(rtol) = tolerance {
+            if !(rtol > 0.0 && rtol < 1.0) {
+                return Err(format!("the tolerance {rtol} is not in (0, 1)"));
+            }
+            self.settings.rtol = rtol;
+        }
+        self.start_time = start_time;
+        self.stop_time = stop_time;
+        self.running = None;
+        self.mode = Mode::Initialization;
+        Ok(())
+    }
+
+    /// `fmi3ExitInitializationMode`: the model built and assembled at the start time.
+    pub fn exit_initialization(&mut self) -> Result<(), String> {
+        self.expect(&[Mode::Initialization], "fmi3ExitInitializationMode")?;
+        self.build()?;
+        self.mode = Mode::Step;
+        Ok(())
+    }
+
+    /// `fmi3Terminate`.
+    pub fn terminate(&mut self) -> Result<(), String> {
+        self.expect(&[Mode::Step, Mode::Failed], "fmi3Terminate")?;
+        self.mode = Mode::Terminated;
+        Ok(())
+    }
+
+    fn expect(&self, allowed: &[Mode], call: &str) -> Result<(), String> {
+        if allowed.contains(&self.mode) {
+            Ok(())
+        } else {
+            Err(format!(
+                "{call} is not allowed in mode {:?} (allowed in {allowed:?})",
+                self.mode
+            ))
+        }
+    }
+
+    /// The model with the current parameter values, assembled at the start time, and its
+    /// outputs; kept until a parameter changes.
+    fn build(&mut self) -> Result<(), String> {
+        if self.running.is_some() {
+            return Ok(());
+        }
+        let values: Vec<(&str, f64)> = self
+            .info
+            .parameters
+            .iter()
+            .zip(&self.parameters)
+            .map(|(p, &v)| (p.name.as_str(), v))
+            .collect();
+        let model = (self.factory)(&values).map_err(|e| e.to_string())?;
+        let state = model
+            .assemble(self.start_time)
+            .map_err(|e| format!("assembly at t = {} s failed: {e}", self.start_time))?;
+        self.running = Some((model, state));
+        self.refresh()
+    }
+
+    /// The outputs at the current state.
+    fn refresh(&mut self) -> Result<(), String> {
+        let Some((model, state)) = &self.running else {
+            return Err("the model is not built".into());
+        };
+        let sample = model
+            .sample(state)
+            .map_err(|e| format!("at t = {} s the outputs failed: {e}", state.t))?;
+        self.outputs = camchain_runtime::columns::values(&self.info, &sample);
+        Ok(())
+    }
+
+    fn variable(&self, reference: u32) -> Result<&Variable, String> {
+        self.variables.get(reference as usize).ok_or_else(|| {
+            format!(
+                "value reference {reference} is not a variable of {} (0 to {})",
+                self.info.name,
+                self.variables.len().saturating_sub(1)
+            )
+        })
+    }
+
+    /// `fmi3GetFloat64` of one variable.
+    pub fn get(&mut self, reference: u32) -> Result<f64, String> {
+        let role = self.variable(reference)?.role;
+        match role {
+            Role::Parameter(i) => Ok(self.parameters[i]),
+            Role::Setting(s) => Ok(self.setting(s)),
+            Role::Time => Ok(self
+                .running
+                .as_ref()
+                .map_or(self.start_time, |(_, state)| state.t)),
+            Role::Output(i) => {
+                if self.mode == Mode::Instantiated {
+                    return Err(format!(
+                        "the output `{}` has no value before initialization mode",
+                        self.variables[reference as usize].name
+                    ));
+                }
+                self.build()?;
+                Ok(self.outputs.get(i).copied().unwrap_or(f64::NAN))
+            }
+        }
+    }
+
+    fn setting(&self, s: Setting) -> f64 {
+        match s {
+            Setting::Rtol => self.settings.rtol,
+            Setting::Atol => self.settings.atol,
+            Setting::Dt => self.settings.dt,
+        }
+    }
+
+    /// `fmi3SetFloat64` of one variable: parameters and settings before the end of
+    /// initialization mode, each checked against its declared bounds.
+    pub fn set(&mut self, reference: u32, value: f64) -> Result<(), String> {
+        let variable = self.variable(reference)?;
+        let name = variable.name.clone();
+        let role = variable.role;
+        let what = format!("{name} = {value}");
+        match role {
+            Role::Time => return Err("`time` is the independent variable: not settable".into()),
+            Role::Output(_) => return Err(format!("`{name}` is an output: not settable")),
+            Role::Parameter(_) | Role::Setting(_) => {}
+        }
+        self.expect(
+            &[Mode::Instantiated, Mode::Initialization],
+            &format!("setting the fixed parameter `{name}`"),
+        )?;
+        match role {
+            Role::Parameter(i) => {
+                let p = &self.info.parameters[i];
+                let value =
+                    within_bounds(&p.name, value, (p.min, p.max), &what).map_err(|(_, m)| m)?;
+                self.parameters[i] = value;
+            }
+            Role::Setting(s) => {
+                if !(value > 0.0 && value.is_finite()) {
+                    return Err(format!("{what}: must be positive and finite"));
+                }
+                match s {
+                    Setting::Rtol => self.settings.rtol = value,
+                    Setting::Atol => self.settings.atol = value,
+                    Setting::Dt => self.settings.dt = value,
+                }
+            }
+            Role::Time | Role::Output(_) => {}
+        }
+        self.running = None;
+        Ok(())
+    }
+
+    /// `fmi3DoStep`: from `current` (the instance's time) by `step`, with the integrator and
+    /// tolerances of the settings; the outputs are those at the new time. A failed step
+    /// leaves the instance in [`Mode::Failed`] at the last time reached.
+    pub fn do_step(&mut self, current: f64, step: f64) -> Result<f64, String> {
+        self.expect(&[Mode::Step], "fmi3DoStep")?;
+        if !(step > 0.0 && step.is_finite()) {
+            return Err(format!(
+                "the communication step {step} is not positive and finite"
+            ));
+        }
+        let settings = self.settings.clone();
+        let Some((model, state)) = &mut self.running else {
+            return Err("the model is not built".into());
+        };
+        if !same_time(current, state.t) {
+            return Err(format!(
+                "fmi3DoStep from t = {current} s, but the instance is at t = {} s",
+                state.t
+            ));
+        }
+        if let Some(stop) = self
+            .stop_time
+            .filter(|&s| current + step > s + 1e-9 * s.abs().max(1.0))
+        {
+            return Err(format!(
+                "a step to t = {} s goes past the stop time {stop} s",
+                current + step
+            ));
+        }
+        let target = current + step;
+        if let Err(e) = model.step_with(state, target - state.t, &settings) {
+            let reached = state.t;
+            self.mode = Mode::Failed;
+            let _ = self.refresh();
+            return Err(format!(
+                "the step from t = {current} s to {target} s failed at t = {reached} s: {e}"
+            ));
+        }
+        self.refresh()?;
+        Ok(target)
+    }
+}
