@@ -7,14 +7,14 @@
 //!    model file's text, the texts of the tables it names and the package's version:
 //!    `Cargo.toml`, the generated `src/model.rs`, `src/lib.rs` (`shim.rs.in`: the C
 //!    functions the package calls), and `Cargo.lock`, the workspace's pinned versions. It
-//!    depends on a copy of the runtime's sources carried by the package (`runtime/`, written
-//!    once per version), so nothing but crates.io's nalgebra and thiserror is fetched.
-//! 3. `cargo build --release` builds it, with a target directory shared by every compiled
-//!    model of this version (the runtime and its dependencies compile once); cargo's own
+//!    depends on the copy of the runtime's sources that `camchain_compile` carries, without
+//!    the runtime's engine: the library evaluates the model, the package runs it, so
+//!    nothing but crates.io's thiserror is fetched and nalgebra is not built.
+//! 3. `camchain_compile::build` runs `cargo build --release`, with a target directory shared
+//!    by every compiled model of this version (the runtime compiles once); cargo's own
 //!    progress is shown on standard error. The library is copied into the model's directory.
 //!    `CAMCHAIN_COMPILE_TARGET` and `CAMCHAIN_COMPILE_PROFILE=dev` build elsewhere and in
-//!    the dev profile (the package's tests: in the workspace's target directory, whose dev
-//!    profile this crate's manifest repeats, so that nalgebra and the others are reused).
+//!    the dev profile (the package's tests: in the workspace's target directory).
 //! 4. The library is loaded (`library::Loaded`) and checked for the ABI this package speaks.
 //!
 //! A later `compile` of the same text finds the library and loads it: no cargo. Each step
@@ -31,11 +31,9 @@ use camchain_runtime::Dynamics;
 use library::Loaded;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::sync::Arc;
-use std::time::Duration;
 
-include!(concat!(env!("OUT_DIR"), "/runtime_sources.rs"));
+use camchain_compile as compile;
 
 /// The functions the package calls, as Rust source (`@ABI@` replaced by the version).
 const SHIM: &str = include_str!("shim.rs.in");
@@ -56,6 +54,17 @@ pub enum Failure {
     Interrupted(pyo3::PyErr),
 }
 
+impl From<compile::Failure> for Failure {
+    fn from(e: compile::Failure) -> Self {
+        match e {
+            compile::Failure::NoCargo(m) => Failure::NoCargo(m),
+            compile::Failure::Build(m) => Failure::Build(m),
+            compile::Failure::Cache(m) => Failure::Cache(m),
+            compile::Failure::Interrupted => Failure::Build("interrupted".into()),
+        }
+    }
+}
+
 /// What `compile` produced.
 pub struct Compiled {
     /// The model's description (the numeric reference's `ModelInfo` is the library's).
@@ -66,98 +75,6 @@ pub struct Compiled {
     pub library: PathBuf,
     /// True when it came from the cache (no cargo).
     pub cached: bool,
-}
-
-/// 64-bit FNV-1a: a stable hash for the cache's directory names (the stored text is
-/// compared on every hit, so a collision costs a rebuild, never a wrong model).
-fn fnv(parts: &[&[u8]]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for part in parts {
-        for byte in part.iter().chain(&[0xff]) {
-            h ^= u64::from(*byte);
-            h = h.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    h
-}
-
-/// The cache directory: `cache`, else `$CAMCHAIN_CACHE`, else `$XDG_CACHE_HOME/camchain`,
-/// else `~/.cache/camchain`; one subdirectory per package version.
-pub fn cache_root(cache: Option<PathBuf>) -> Result<PathBuf, Failure> {
-    let base = cache
-        .or_else(|| std::env::var_os("CAMCHAIN_CACHE").map(PathBuf::from))
-        .or_else(|| std::env::var_os("XDG_CACHE_HOME").map(|d| PathBuf::from(d).join("camchain")))
-        .or_else(|| {
-            std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache").join("camchain"))
-        })
-        .ok_or_else(|| {
-            Failure::Cache("no cache directory: set CAMCHAIN_CACHE or give cache_dir=".into())
-        })?;
-    Ok(base.join(env!("CARGO_PKG_VERSION")))
-}
-
-/// Writes `files` into `dir` through a directory of this process's own, renamed into place;
-/// when another process put `dir` there first, its copy is kept.
-fn write_atomically(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), Failure> {
-    if dir.join(".complete").is_file() {
-        return Ok(());
-    }
-    let fail = |e: std::io::Error, what: &Path| Failure::Cache(format!("{}: {e}", what.display()));
-    let parent = dir.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| fail(e, parent))?;
-    let name = dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let temp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&temp);
-    for (path, bytes) in files {
-        let path = temp.join(path);
-        if let Some(p) = path.parent() {
-            std::fs::create_dir_all(p).map_err(|e| fail(e, p))?;
-        }
-        std::fs::write(&path, bytes).map_err(|e| fail(e, &path))?;
-    }
-    std::fs::write(temp.join(".complete"), b"").map_err(|e| fail(e, &temp))?;
-    if std::fs::rename(&temp, dir).is_err() {
-        // Another process's copy is in place (or an incomplete one from a crash: replace
-        // that, which no process can be reading, as it has no `.complete`).
-        if dir.join(".complete").is_file() {
-            let _ = std::fs::remove_dir_all(&temp);
-        } else {
-            let _ = std::fs::remove_dir_all(dir);
-            std::fs::rename(&temp, dir).map_err(|e| fail(e, dir))?;
-        }
-    }
-    Ok(())
-}
-
-/// A TOML basic string: quotes, backslashes and control characters escaped (a cache
-/// directory may hold any of them).
-fn toml_string(text: &str) -> String {
-    let mut out = String::from('"');
-    for c in text.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
-}
-
-/// The runtime's sources, once per version.
-fn runtime_dir(root: &Path) -> Result<PathBuf, Failure> {
-    let dir = root.join("runtime");
-    let mut files: Vec<(String, Vec<u8>)> = RUNTIME_FILES
-        .iter()
-        .map(|(path, text)| (format!("src/{path}"), text.as_bytes().to_vec()))
-        .collect();
-    files.push(("Cargo.toml".into(), RUNTIME_MANIFEST.as_bytes().to_vec()));
-    write_atomically(&dir, &files)?;
-    Ok(dir)
 }
 
 /// Compiles the model file at `path` (or finds it compiled) and loads it; `say` shows
@@ -203,8 +120,8 @@ pub fn compile(
         parts.push(file.written.as_bytes());
         parts.push(file.text.as_bytes());
     }
-    let key = format!("{:016x}", fnv(&parts));
-    let root = cache_root(cache)?;
+    let key = format!("{:016x}", compile::fnv(&parts));
+    let root = compile::cache_root(cache)?;
     let crate_dir = root.join("models").join(&key);
     let library = crate_dir.join("libmodel.so");
     let stored = crate_dir.join("model.ron");
@@ -217,86 +134,42 @@ pub fn compile(
             cached: true,
         });
     }
-    let runtime = runtime_dir(&root)?;
+    let sources = compile::sources(&root)?;
     let name = format!("camchain_model_{key}");
-    let manifest = format!(
-        "[package]\nname = \"{name}\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n\
-         # Written by camchain.compile for {comment}.\n[lib]\npath = \"src/lib.rs\"\ncrate-type = [\"cdylib\"]\n\n\
-         [dependencies]\ncamchain-runtime = {{ path = {} }}\n\n\
-         # The dev profile as the camchain workspace's (CAMCHAIN_COMPILE_PROFILE=dev, for\n\
-         # its tests): its dependencies are that build's; the runtime's copy unoptimised.\n\
-         [profile.dev]\nopt-level = 2\ndebug = false\n\
-         [profile.dev.package.camchain-runtime]\nopt-level = 0\n\n[workspace]\n",
-        toml_string(&runtime.display().to_string().replace('\\', "/")),
-        comment = shown.replace(['\n', '\r'], " "),
-    );
+    let comment = format!("camchain.compile of {shown}");
+    let manifest = compile::manifest(&name, &comment, compile::Links::Contract, &sources);
     let shim = SHIM.replace("@ABI@", &library::ABI.to_string());
-    write_atomically(
+    compile::write_atomically(
         &crate_dir,
         &[
             ("Cargo.toml".into(), manifest.into_bytes()),
-            ("Cargo.lock".into(), LOCKFILE.as_bytes().to_vec()),
+            ("Cargo.lock".into(), compile::LOCKFILE.as_bytes().to_vec()),
             ("src/lib.rs".into(), shim.into_bytes()),
             ("src/model.rs".into(), generated.code.into_bytes()),
             ("model.ron".into(), text.clone().into_bytes()),
         ],
     )?;
-    // The build's target directory and profile: the cache's own and release, unless the
-    // environment says otherwise (the package's tests build in the workspace's target
-    // directory and dev profile, where nalgebra and the rest are already compiled).
-    let target = std::env::var_os("CAMCHAIN_COMPILE_TARGET")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("target"));
-    let profile = std::env::var("CAMCHAIN_COMPILE_PROFILE").unwrap_or_else(|_| "release".into());
-    if !["release", "dev"].contains(&profile.as_str()) {
-        return Err(Failure::Build(format!(
-            "CAMCHAIN_COMPILE_PROFILE={profile}: release or dev"
-        )));
-    }
     say(&format!(
         "camchain: compiling {shown} with cargo (the first model of this version also builds \
          the runtime; later ones reuse it)\n"
     ));
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let mut child = Command::new(&cargo)
-        .args(["build", "--profile", &profile, "--manifest-path"])
-        .arg(crate_dir.join("Cargo.toml"))
-        .arg("--target-dir")
-        .arg(&target)
-        .args(quiet.then_some("--quiet"))
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .spawn()
-        .map_err(|e| {
-            Failure::NoCargo(format!(
-                "camchain.compile needs cargo (a Rust toolchain: https://rustup.rs), and `{}` \
-                 could not be started: {e}; Model.from_file runs the model on the numeric \
-                 reference without it",
-                cargo.to_string_lossy()
-            ))
-        })?;
-    let status = loop {
-        match child.try_wait() {
-            Ok(Some(status)) => break status,
-            Ok(None) => {}
-            Err(e) => return Err(Failure::Build(format!("waiting for cargo: {e}"))),
-        }
-        if let Some(e) = interrupted() {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(Failure::Interrupted(e));
-        }
-        std::thread::sleep(Duration::from_millis(50));
+    let mut raised = None;
+    let mut stop = || {
+        raised = interrupted();
+        raised.is_some()
     };
-    if !status.success() {
-        return Err(Failure::Build(format!(
-            "cargo build of {} failed ({status}); its messages are above",
-            crate_dir.display()
-        )));
-    }
-    let built = target
-        .join(if profile == "dev" { "debug" } else { "release" })
-        .join(format!("lib{name}.so"));
+    let built =
+        compile::build(&crate_dir, &name, quiet, &root, &mut stop).map_err(|e| match e {
+            compile::Failure::Interrupted => match raised.take() {
+                Some(e) => Failure::Interrupted(e),
+                None => Failure::Build("interrupted".into()),
+            },
+            compile::Failure::NoCargo(m) => Failure::NoCargo(format!(
+                "camchain.compile: {m}; Model.from_file runs the model on the numeric reference \
+             without it"
+            )),
+            other => other.into(),
+        })?;
     // Into the model's directory under a name of this process's own, then renamed: a loaded
     // library is never overwritten in place.
     let temp = crate_dir.join(format!(".libmodel.so.tmp-{}", std::process::id()));
