@@ -130,6 +130,25 @@ pub enum Command {
                       camchain merge shards/*.csv --out results\n  \
                       camchain merge part-*.csv --csv sweep.csv --no-plots")]
     Merge(MergeArgs),
+    /// Export a model as an FMU (FMI 3.0 Co-Simulation) for system-simulation tools.
+    #[command(
+        long_about = "Export a model as an FMU (FMI 3.0 Co-Simulation) for system-simulation \
+                      tools (FMPy, Modelica tools, Simulink).\n\n\
+                      The model's code is generated, built with your cargo into a library that \
+                      links the runtime and the FMI functions (never the code generator), and \
+                      packed with its modelDescription.xml: the run-time parameters as \
+                      parameters with their units and bounds, the integrator's tolerances and \
+                      step (solver.rtol, solver.atol, solver.dt), and every column of \
+                      `camchain simulate --csv` as an output under the same name. Built \
+                      libraries are cached (--cache) by the model's text and the version, so \
+                      a second export of the same model runs no cargo. See docs/fmu.md.\n\n\
+                      Exit codes: 0 written, 1 the model, the build or the file failed, 2 a \
+                      usage error, 130 interrupted by Ctrl-C.",
+        after_help = "Examples:\n  \
+                      camchain fmu cycloidal_roller                # cycloidal_roller.fmu here\n  \
+                      camchain fmu my_cam.ron --out fmus/my_cam.fmu"
+    )]
+    Fmu(FmuArgs),
     /// Analyse a cam designed from its follower's motion law (`law:` in a contact): the
     /// design's peaks, pressure angle, curvature and joints; figures, a CSV and the profile
     /// as a table; the jump speed the dynamics predict, checked by a one-sided run.
@@ -413,6 +432,27 @@ impl SweepArgs {
     pub fn settings(&self, defaults: &SimSettings) -> SimSettings {
         self.integration.settings(defaults)
     }
+}
+
+/// Options of `fmu`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct FmuArgs {
+    /// Built-in model name or path to a .ron model file
+    #[arg(value_name = "MODEL")]
+    pub model: String,
+
+    /// The FMU's path [default: <model>.fmu in the current directory]
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+
+    /// Where built libraries are kept [default: $CAMCHAIN_CACHE, else
+    /// $XDG_CACHE_HOME/camchain, else ~/.cache/camchain]
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+
+    /// Print nothing but errors (cargo's progress included)
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 /// Options of `merge`.

@@ -19,7 +19,8 @@
 //! - `sweep`: the `sweep` and `merge` commands (parameter studies, in parallel and in
 //!   shards);
 //! - `cam`: the `cam` command (a cam designed from a motion law: its design's checks and
-//!   figures, the jump speed its dynamics predict, a one-sided run).
+//!   figures, the jump speed its dynamics predict, a one-sided run);
+//! - `fmu`: the `fmu` command (the model as an FMI 3.0 Co-Simulation FMU).
 //!
 //! Every problem is reported as one line on standard error, `error: …`, with exit code 2
 //! for a usage error (bad option or value, unknown model name), 130 for a run interrupted
@@ -32,6 +33,7 @@ mod bench;
 pub mod cam;
 pub mod csv;
 mod figures;
+mod fmu;
 mod interrupt;
 mod kinematics;
 mod list;
@@ -126,6 +128,7 @@ pub fn main() -> ExitCode {
         Some(Command::Sweep(args)) => sweep::run(&args),
         Some(Command::Merge(args)) => sweep::merge(&args),
         Some(Command::Cam(args)) => cam::run(&args),
+        Some(Command::Fmu(args)) => fmu::run(&args, &interrupt::Interrupt::install()),
         Some(Command::List) => {
             // A closed pipe (`camchain list | head`) is not an error worth a panic.
             let _ = std::io::stdout().write_all(list::render().as_bytes());

@@ -345,6 +345,37 @@ pub unsafe fn do_step(
     }
 }
 
+/// `camchain_fmu_model_description`: the `modelDescription.xml` of the model `factory`
+/// builds, for a library whose identifier is `identifier`, as a string the caller frees with
+/// [`free_text`]; null when the model cannot be built. What `camchain fmu` packs beside the
+/// library, from the library itself, so that the two describe the same model.
+///
+/// # Safety
+/// `identifier` is NUL-terminated.
+pub unsafe fn model_description(factory: Factory, identifier: *const c_char) -> *mut c_char {
+    catch_unwind(|| {
+        // SAFETY: per the contract.
+        let identifier = unsafe { text(identifier) }.unwrap_or("model");
+        let model = factory(&[]).ok()?;
+        let xml = crate::description::model_description(model.info(), identifier);
+        CString::new(xml).ok().map(CString::into_raw)
+    })
+    .ok()
+    .flatten()
+    .unwrap_or(std::ptr::null_mut())
+}
+
+/// Frees a string of [`model_description`].
+///
+/// # Safety
+/// A pointer [`model_description`] returned, not freed before, or null.
+pub unsafe fn free_text(text: *mut c_char) {
+    if !text.is_null() {
+        // SAFETY: per the contract: from `CString::into_raw`.
+        drop(unsafe { CString::from_raw(text) });
+    }
+}
+
 /// A function this FMU does not provide: `fmi3Error`, and a log message saying so.
 ///
 /// # Safety

@@ -194,6 +194,30 @@ macro_rules! export {
                 }
             }
 
+            /// The model's `modelDescription.xml` for the library `identifier` (not an FMI
+            /// function: what `camchain fmu` asks the library it built).
+            ///
+            /// # Safety
+            /// `identifier` is NUL-terminated; the result is freed with
+            /// `camchain_fmu_free_text`.
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn camchain_fmu_model_description(
+                identifier: *const c_char,
+            ) -> *mut c_char {
+                // SAFETY: per the contract.
+                unsafe { ffi::model_description($factory, identifier) }
+            }
+
+            /// Frees a string of `camchain_fmu_model_description`.
+            ///
+            /// # Safety
+            /// A pointer it returned, freed once.
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn camchain_fmu_free_text(text: *mut c_char) {
+                // SAFETY: per the contract.
+                unsafe { ffi::free_text(text) }
+            }
+
             /// # Safety
             /// The importer's arguments: none is read.
             #[unsafe(no_mangle)]
