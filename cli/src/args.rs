@@ -453,6 +453,11 @@ pub struct FmuArgs {
     /// Print nothing but errors (cargo's progress included)
     #[arg(long, short)]
     pub quiet: bool,
+
+    /// Print the FMU's modelDescription.xml on standard output and write no FMU (a
+    /// built-in model's needs no build; a model file's is read from its built library)
+    #[arg(long)]
+    pub describe: bool,
 }
 
 /// Options of `merge`.

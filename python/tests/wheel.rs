@@ -109,6 +109,18 @@ fn python_suite_against_the_installed_wheel() {
             .arg("-r")
             .arg(package.join("requirements-test.txt")),
     );
+    run(
+        "installing FMPy for the FMU tests",
+        Command::new(bin(&env, "pip"))
+            .args([
+                "install",
+                "--quiet",
+                "--disable-pip-version-check",
+                "--no-deps",
+                "-r",
+            ])
+            .arg(package.join("requirements-fmu.txt")),
+    );
     // Run from the scratch directory, so that `import camchain` finds the installed package
     // and not the source tree's `python/camchain`.
     run(

@@ -99,13 +99,22 @@ pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
     let model = camchain_codegen::check_source_in(&source.text, &source.shown, source.files)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let id = identifier(&model.name);
+    if let Some(builtin) = camchain_models::by_name(&args.model).filter(|_| args.describe) {
+        let xml = camchain_fmu::description::model_description(builtin.info(), &id);
+        print!("{xml}");
+        return Ok(());
+    }
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("{id}.fmu")));
     // The destination is checked (and locked) before the build, so that a build is not
     // wasted on a path that cannot be written.
-    let _lock = super::output::claim(&out).map_err(CliError::Failed)?;
+    let _lock = if args.describe {
+        None
+    } else {
+        super::output::claim(&out).map_err(CliError::Failed)?
+    };
     let options = EmitOptions {
         runtime_path: "::camchain_runtime".into(),
         files_dir: source.files_dir.clone(),
@@ -142,6 +151,10 @@ pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
         )?;
     }
     let xml = describe(&library, &id)?;
+    if args.describe {
+        print!("{xml}");
+        return Ok(());
+    }
     let binary = std::fs::read(&library)
         .map_err(|e| CliError::Failed(format!("{}: {e}", library.display())))?;
     let entries = [
