@@ -76,7 +76,7 @@ unsafe fn handle<'a>(instance: *mut c_void) -> Option<&'a mut Handle> {
 /// `fmi3Error`, a panic as `fmi3Fatal`.
 ///
 /// # Safety
-/// As [`handle`].
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed.
 pub unsafe fn with(
     instance: *mut c_void,
     call: &str,
@@ -187,7 +187,7 @@ pub unsafe fn instantiate_co_simulation(
 /// `fmi3FreeInstance`.
 ///
 /// # Safety
-/// As [`handle`]; the pointer is not used again.
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed; the pointer is not used again.
 pub unsafe fn free_instance(instance: *mut c_void) {
     if !instance.is_null() {
         // SAFETY: a pointer from `Box::into_raw` in `instantiate_co_simulation`.
@@ -199,7 +199,7 @@ pub unsafe fn free_instance(instance: *mut c_void) {
 /// errors always and its events when logging is on).
 ///
 /// # Safety
-/// As [`handle`].
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed.
 pub unsafe fn set_debug_logging(instance: *mut c_void, on: bool) -> Status {
     // SAFETY: per the contract.
     unsafe {
@@ -213,7 +213,7 @@ pub unsafe fn set_debug_logging(instance: *mut c_void, on: bool) -> Status {
 /// `fmi3EnterInitializationMode`.
 ///
 /// # Safety
-/// As [`handle`].
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed.
 pub unsafe fn enter_initialization_mode(
     instance: *mut c_void,
     tolerance: Option<f64>,
@@ -233,7 +233,7 @@ pub unsafe fn enter_initialization_mode(
 /// `fmi3ExitInitializationMode`, `fmi3Terminate`, `fmi3Reset`.
 ///
 /// # Safety
-/// As [`handle`].
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed.
 pub unsafe fn transition(instance: *mut c_void, call: &str) -> Status {
     // SAFETY: per the contract.
     unsafe {
@@ -251,7 +251,7 @@ pub unsafe fn transition(instance: *mut c_void, call: &str) -> Status {
 /// `fmi3GetFloat64`.
 ///
 /// # Safety
-/// As [`handle`]; `references` holds `n_references` values, `values` room for `n_values`.
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed; `references` holds `n_references` values, `values` room for `n_values`.
 pub unsafe fn get_float64(
     instance: *mut c_void,
     references: *const u32,
@@ -312,7 +312,7 @@ pub unsafe fn set_float64(
 /// `fmi3DoStep`.
 ///
 /// # Safety
-/// As [`handle`]; the out-pointers are null or writable.
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed; the out-pointers are null or writable.
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn do_step(
     instance: *mut c_void,
@@ -379,7 +379,7 @@ pub unsafe fn free_text(text: *mut c_char) {
 /// A function this FMU does not provide: `fmi3Error`, and a log message saying so.
 ///
 /// # Safety
-/// As [`handle`].
+/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed.
 pub unsafe fn unsupported(instance: *mut c_void, call: &str, why: &str) -> Status {
     // SAFETY: per the contract.
     unsafe {
