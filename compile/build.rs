@@ -20,13 +20,23 @@ fn files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// 64-bit FNV-1a, fed with every embedded file's path and text.
+fn feed(hash: &mut u64, bytes: &[u8]) {
+    for &b in bytes.iter().chain(&[0xff]) {
+        *hash ^= u64::from(b);
+        *hash = hash.wrapping_mul(0x0100_0000_01b3);
+    }
+}
+
 /// `pub const NAME: &[(&str, &str)]`: (path under `src/`, text) of every `.rs` file.
-fn embed(code: &mut String, name: &str, source: &Path) {
+fn embed(code: &mut String, name: &str, source: &Path, hash: &mut u64) {
     let mut found = Vec::new();
     files(source, &mut found);
     let _ = writeln!(code, "pub const {name}: &[(&str, &str)] = &[");
     for path in &found {
         let relative = path.strip_prefix(source).unwrap_or(path);
+        feed(hash, relative.to_string_lossy().as_bytes());
+        feed(hash, &std::fs::read(path).unwrap_or_default());
         let _ = writeln!(
             code,
             "    ({:?}, include_str!({:?})),",
@@ -41,14 +51,27 @@ fn embed(code: &mut String, name: &str, source: &Path) {
 fn main() {
     let package = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap_or_default());
     let root = package.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
     let mut code = String::from("/// The runtime's source files: (path under `src/`, text).\n");
+    let runtime = root.join("runtime").join("src");
+    embed(&mut code, "RUNTIME_FILES", &runtime, &mut hash);
+    code.push_str("/// The FMU crate's source files: (path under `src/`, text).\n");
     embed(
         &mut code,
-        "RUNTIME_FILES",
-        &root.join("runtime").join("src"),
+        "FMU_FILES",
+        &root.join("fmu").join("src"),
+        &mut hash,
     );
-    code.push_str("/// The FMU crate's source files: (path under `src/`, text).\n");
-    embed(&mut code, "FMU_FILES", &root.join("fmu").join("src"));
+    feed(
+        &mut hash,
+        &std::fs::read(root.join("Cargo.lock")).unwrap_or_default(),
+    );
+    let _ = writeln!(
+        code,
+        "/// A hash of every carried file and the lock file: the cache's directory changes with\n\
+         /// them, so a build never links copies or libraries of other sources.\n\
+         pub const SOURCES_HASH: &str = \"{hash:016x}\";"
+    );
     let _ = writeln!(
         code,
         "/// The workspace's lock file: the pinned versions.\npub const LOCKFILE: &str = include_str!({:?});",

@@ -55,7 +55,8 @@ pub fn fnv(parts: &[&[u8]]) -> u64 {
 }
 
 /// The cache directory: `cache`, else `$CAMCHAIN_CACHE`, else `$XDG_CACHE_HOME/camchain`,
-/// else `~/.cache/camchain`; one subdirectory per version.
+/// else `~/.cache/camchain`; one subdirectory per version and [`SOURCES_HASH`] (the carried
+/// sources: two builds of one version with other sources never share copies or libraries).
 pub fn cache_root(cache: Option<PathBuf>) -> Result<PathBuf, Failure> {
     let base = cache
         .or_else(|| std::env::var_os("CAMCHAIN_CACHE").map(PathBuf::from))
@@ -64,7 +65,11 @@ pub fn cache_root(cache: Option<PathBuf>) -> Result<PathBuf, Failure> {
             std::env::var_os("HOME").map(|d| PathBuf::from(d).join(".cache").join("camchain"))
         })
         .ok_or_else(|| Failure::Cache("no cache directory: set CAMCHAIN_CACHE (or HOME)".into()))?;
-    Ok(base.join(env!("CARGO_PKG_VERSION")))
+    Ok(base.join(format!(
+        "{}-{}",
+        env!("CARGO_PKG_VERSION"),
+        &SOURCES_HASH[..8]
+    )))
 }
 
 /// Writes `files` into `dir` through a directory of this process's own, renamed into place;

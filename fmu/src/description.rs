@@ -5,7 +5,7 @@
 //! recomputes from its own model when it is instantiated and compares.
 
 use crate::variables::{Role, Variable, variables};
-use camchain_runtime::ModelInfo;
+use camchain_runtime::Dynamics;
 use std::collections::BTreeSet;
 use std::fmt::Write;
 
@@ -14,7 +14,8 @@ pub const FMI_VERSION: &str = "3.0";
 
 /// The instantiation token of a model's FMU: `{camchain-<64-bit FNV-1a of the package
 /// version, the model's name and every variable's name, role and start>}`.
-pub fn token(info: &ModelInfo) -> String {
+pub fn token(model: &dyn Dynamics) -> String {
+    let info = model.info();
     let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
     let mut feed = |bytes: &[u8]| {
         for &b in bytes {
@@ -26,7 +27,7 @@ pub fn token(info: &ModelInfo) -> String {
     };
     feed(env!("CARGO_PKG_VERSION").as_bytes());
     feed(info.name.as_bytes());
-    for v in variables(info) {
+    for v in variables(model) {
         feed(v.name.as_bytes());
         feed(format!("{:?}{:?}", v.role, v.start.map(f64::to_bits)).as_bytes());
     }
@@ -87,6 +88,7 @@ fn element(v: &Variable) -> String {
     let (causality, variability) = match v.role {
         Role::Time => ("independent", "continuous"),
         Role::Parameter(_) | Role::Setting(_) => ("parameter", "fixed"),
+        Role::Input(_) => ("input", "continuous"),
         Role::Output(_) => ("output", "continuous"),
     };
     let mut e = format!(
@@ -115,14 +117,15 @@ fn element(v: &Variable) -> String {
 
 /// The whole `modelDescription.xml` of a model whose library is `identifier` (the file
 /// `binaries/<platform>/<identifier>.so`).
-pub fn model_description(info: &ModelInfo, identifier: &str) -> String {
-    let all = variables(info);
+pub fn model_description(model: &dyn Dynamics, identifier: &str) -> String {
+    let info = model.info();
+    let all = variables(model);
     let mut xml = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         xml,
         r#"<fmiModelDescription fmiVersion="{FMI_VERSION}" modelName="{}" instantiationToken="{}" description="{}" generationTool="camchain {}" variableNamingConvention="flat">"#,
         escape(&info.name),
-        token(info),
+        token(model),
         escape(info.description.lines().next().unwrap_or("")),
         env!("CARGO_PKG_VERSION"),
     );
@@ -195,9 +198,8 @@ mod tests {
     #[test]
     fn the_description_declares_every_variable_once_with_its_reference() {
         let model = camchain_models::by_name("paper_concave").expect("built in");
-        let info = model.info();
-        let xml = model_description(info, "paper_concave");
-        for v in variables(info) {
+        let xml = model_description(model, "paper_concave");
+        for v in variables(model) {
             let needle = format!(
                 "name=\"{}\" valueReference=\"{}\"",
                 escape(&v.name),
@@ -205,7 +207,7 @@ mod tests {
             );
             assert_eq!(xml.matches(&needle).count(), 1, "{needle}");
         }
-        assert!(xml.contains(&format!("instantiationToken=\"{}\"", token(info))));
+        assert!(xml.contains(&format!("instantiationToken=\"{}\"", token(model))));
         assert!(xml.contains("<CoSimulation modelIdentifier=\"paper_concave\""));
     }
 

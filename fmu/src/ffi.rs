@@ -148,7 +148,7 @@ pub unsafe fn instantiate_co_simulation(
         // SAFETY: the importer's strings.
         let name = unsafe { text(instance_name) }.unwrap_or("");
         let instance = Instance::new(factory)?;
-        let expected = crate::description::token(instance.info());
+        let expected = instance.token().to_string();
         // SAFETY: as above.
         let given = unsafe { text(token) };
         if given != Some(expected.as_str()) {
@@ -357,7 +357,7 @@ pub unsafe fn model_description(factory: Factory, identifier: *const c_char) -> 
         // SAFETY: per the contract.
         let identifier = unsafe { text(identifier) }.unwrap_or("model");
         let model = factory(&[]).ok()?;
-        let xml = crate::description::model_description(model.info(), identifier);
+        let xml = crate::description::model_description(model.as_ref(), identifier);
         CString::new(xml).ok().map(CString::into_raw)
     })
     .ok()

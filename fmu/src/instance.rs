@@ -3,6 +3,7 @@
 //! time. The C functions of [`crate::export`] only convert arguments and call these methods;
 //! every failure comes back as a message that they log with the status.
 
+use crate::drive::Driven;
 use crate::variables::{Role, Setting, Variable, variables};
 use camchain_runtime::parameters::checks::within_bounds;
 use camchain_runtime::{Dynamics, ModelInfo, ParameterError, SimSettings, Simulate, State};
@@ -29,15 +30,19 @@ pub enum Mode {
 pub struct Instance {
     factory: Factory,
     info: ModelInfo,
+    token: String,
     variables: Vec<Variable>,
     mode: Mode,
     parameters: Vec<f64>,
     settings: SimSettings,
     start_time: f64,
     stop_time: Option<f64>,
+    /// The speeds the master set for the drives that are inputs, by coordinate (`None`:
+    /// the model's own law).
+    speeds: Vec<(usize, Option<f64>)>,
     /// The model and its state at the current time, once built (after every parameter
     /// change the next read or step builds them again).
-    running: Option<(Box<dyn Dynamics + Send + Sync>, State)>,
+    running: Option<(Driven, State)>,
     /// The output columns at the current time (index as [`Role::Output`]).
     outputs: Vec<f64>,
 }
@@ -55,9 +60,19 @@ impl Instance {
         let model = factory(&[]).map_err(|e| format!("the model cannot be built: {e}"))?;
         let info = model.info().clone();
         let parameters = info.parameters.iter().map(|p| p.default).collect();
+        let variables = variables(model.as_ref());
+        let speeds = variables
+            .iter()
+            .filter_map(|v| match v.role {
+                Role::Input(i) => Some((i, None)),
+                _ => None,
+            })
+            .collect();
         Ok(Instance {
             factory,
-            variables: variables(&info),
+            token: crate::description::token(model.as_ref()),
+            speeds,
+            variables,
             settings: info.defaults.clone(),
             info,
             mode: Mode::Instantiated,
@@ -74,6 +89,11 @@ impl Instance {
         &self.info
     }
 
+    /// The instantiation token of its model (as its `modelDescription.xml` declares it).
+    pub fn token(&self) -> &str {
+        &self.token
+    }
+
     /// The current mode.
     pub fn mode(&self) -> Mode {
         self.mode
@@ -83,6 +103,9 @@ impl Instance {
     pub fn reset(&mut self) {
         self.parameters = self.info.parameters.iter().map(|p| p.default).collect();
         self.settings = self.info.defaults.clone();
+        for (_, speed) in &mut self.speeds {
+            *speed = None;
+        }
         self.mode = Mode::Instantiated;
         self.running = None;
         self.outputs.clear();
@@ -160,7 +183,12 @@ impl Instance {
             .zip(&self.parameters)
             .map(|(p, &v)| (p.name.as_str(), v))
             .collect();
-        let model = (self.factory)(&values).map_err(|e| e.to_string())?;
+        let mut model = Driven::new((self.factory)(&values).map_err(|e| e.to_string())?);
+        for &(i, speed) in &self.speeds {
+            if let Some(speed) = speed {
+                model.set_speed(i, speed, self.start_time);
+            }
+        }
         let state = model
             .assemble(self.start_time)
             .map_err(|e| format!("assembly at t = {} s failed: {e}", self.start_time))?;
@@ -196,6 +224,7 @@ impl Instance {
         match role {
             Role::Parameter(i) => Ok(self.parameters[i]),
             Role::Setting(s) => Ok(self.setting(s)),
+            Role::Input(i) => Ok(self.speed(i, reference)),
             Role::Time => Ok(self
                 .running
                 .as_ref()
@@ -209,6 +238,44 @@ impl Instance {
                 }
                 self.build()?;
                 Ok(self.outputs.get(i).copied().unwrap_or(f64::NAN))
+            }
+        }
+    }
+
+    /// The speed of the drive of coordinate `i`: the master's, else the model's own.
+    fn speed(&self, i: usize, reference: u32) -> f64 {
+        self.speeds
+            .iter()
+            .find(|(c, _)| *c == i)
+            .and_then(|(_, s)| *s)
+            .or(self.variables[reference as usize].start)
+            .unwrap_or(f64::NAN)
+    }
+
+    /// `fmi3SetFloat64` of an input: the drive of coordinate `i` at `speed` from now on (in
+    /// step mode, from the current time; before, from the start time).
+    fn set_speed(&mut self, i: usize, speed: f64, name: &str) -> Result<(), String> {
+        if !speed.is_finite() {
+            return Err(format!("{name} = {speed}: must be a finite number"));
+        }
+        self.expect(
+            &[Mode::Instantiated, Mode::Initialization, Mode::Step],
+            &format!("setting the input `{name}`"),
+        )?;
+        if let Some((_, s)) = self.speeds.iter_mut().find(|(c, _)| *c == i) {
+            *s = Some(speed);
+        }
+        match (&mut self.running, self.mode) {
+            (Some((model, state)), Mode::Step) => {
+                model.set_speed(i, speed, state.t);
+                if let Some(qd) = state.qd.get_mut(i) {
+                    *qd = speed;
+                }
+                self.refresh()
+            }
+            _ => {
+                self.running = None;
+                Ok(())
             }
         }
     }
@@ -231,6 +298,7 @@ impl Instance {
         match role {
             Role::Time => return Err("`time` is the independent variable: not settable".into()),
             Role::Output(_) => return Err(format!("`{name}` is an output: not settable")),
+            Role::Input(i) => return self.set_speed(i, value, &name),
             Role::Parameter(_) | Role::Setting(_) => {}
         }
         self.expect(
@@ -254,7 +322,7 @@ impl Instance {
                     Setting::Dt => self.settings.dt = value,
                 }
             }
-            Role::Time | Role::Output(_) => {}
+            Role::Time | Role::Output(_) | Role::Input(_) => {}
         }
         self.running = None;
         Ok(())

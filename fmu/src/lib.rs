@@ -7,12 +7,14 @@
 //! [`description::model_description`] of the same model. Neither holds the code generator.
 //!
 //! - [`variables`]: the variables and their value references (time, run-time parameters,
-//!   the integrator's settings, the CSV's output columns).
+//!   the integrator's settings, the drives' speeds as inputs, the CSV's output columns).
+//! - [`drive`]: the model with the drive speeds its master set.
 //! - [`description`]: `modelDescription.xml` and the instantiation token.
 //! - [`instance`]: one instance in safe Rust: modes, values, `fmi3DoStep`.
 //! - [`ffi`]: the C side: arguments, statuses, the importer's logger, panics kept out of C.
 
 pub mod description;
+pub mod drive;
 pub mod ffi;
 pub mod instance;
 pub mod variables;

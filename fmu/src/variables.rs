@@ -4,11 +4,13 @@
 //!
 //! Value references, in order: 0 `time`; then the model's run-time parameters in file
 //! order; then the integrator's settings (`solver.rtol`, `solver.atol`, `solver.dt`); then
-//! every output column of [`camchain_runtime::columns`] but `t`, in the CSV's order and
-//! under the CSV's names.
+//! the speed of every coordinate driven at a constant speed, as an input
+//! (`<coordinate>_speed`, [`crate::drive`]); then every output column of
+//! [`camchain_runtime::columns`] but `t`, in the CSV's order and under the CSV's names.
 
-use camchain_runtime::ModelInfo;
+use crate::drive::constant_speed_drives;
 use camchain_runtime::columns::columns;
+use camchain_runtime::{Dynamics, JointKind};
 
 /// What a variable is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -19,6 +21,8 @@ pub enum Role {
     Parameter(usize),
     /// One of the integrator's settings.
     Setting(Setting),
+    /// The speed of the drive of this coordinate (an input).
+    Input(usize),
     /// The output column of this index in [`camchain_runtime::columns::columns`] (≥ 1).
     Output(usize),
 }
@@ -82,7 +86,8 @@ pub struct Variable {
 }
 
 /// Every variable of a model's FMU, in value-reference order (the reference is the index).
-pub fn variables(info: &ModelInfo) -> Vec<Variable> {
+pub fn variables(model: &dyn Dynamics) -> Vec<Variable> {
+    let info = model.info();
     let mut out = Vec::new();
     let mut push = |name: String, role, unit: &str, description: String, bounds| {
         let (start, min, max) = bounds;
@@ -128,6 +133,23 @@ pub fn variables(info: &ModelInfo) -> Vec<Variable> {
             (Some(start), None, None),
         );
     }
+    for (i, speed) in constant_speed_drives(model) {
+        let c = &info.coordinates[i];
+        let unit = match c.kind {
+            JointKind::Revolute => "rad/s",
+            JointKind::Prismatic => "m/s",
+        };
+        push(
+            format!("{}_speed", c.name),
+            Role::Input(i),
+            unit,
+            format!(
+                "speed of the drive of {} (its own law, {speed} {unit}, until set)",
+                c.name
+            ),
+            (Some(speed), None, None),
+        );
+    }
     for (i, column) in columns(info).into_iter().enumerate().skip(1) {
         push(
             column.name,
@@ -148,7 +170,7 @@ mod tests {
     fn references_are_indices_and_outputs_are_the_csv_columns() {
         let model = camchain_models::by_name("cycloidal_roller").expect("built in");
         let info = model.info();
-        let all = variables(info);
+        let all = variables(model);
         for (i, v) in all.iter().enumerate() {
             assert_eq!(v.reference as usize, i);
         }
@@ -165,5 +187,12 @@ mod tests {
             .filter(|v| matches!(v.role, Role::Parameter(_)))
             .count();
         assert_eq!(parameters, info.parameters.len());
+        // The camshaft turns at `omega*t`: its speed is an input, starting at omega.
+        let input = all
+            .iter()
+            .find(|v| v.role == Role::Input(0))
+            .expect("an input");
+        assert_eq!(input.name, "cam_angle_speed");
+        assert_eq!(input.start, Some(50.0));
     }
 }

@@ -108,7 +108,7 @@ fn instantiate(token: &str) -> *mut c_void {
 }
 
 fn reference(name: &str) -> u32 {
-    variables(model().info())
+    variables(model())
         .into_iter()
         .find(|v| v.name == name)
         .unwrap_or_else(|| panic!("no variable {name}"))
@@ -131,8 +131,7 @@ fn set(instance: *mut c_void, r: u32, value: f64) -> i32 {
 /// Steps `instance` from 0 to `t_end` by `h`, returning every output column at every
 /// communication point (index as the columns').
 fn run(instance: *mut c_void, t_end: f64, h: f64) -> Vec<Vec<f64>> {
-    let info = model().info();
-    let outputs: Vec<(usize, u32)> = variables(info)
+    let outputs: Vec<(usize, u32)> = variables(model())
         .into_iter()
         .filter_map(|v| match v.role {
             Role::Output(i) => Some((i, v.reference)),
@@ -184,7 +183,7 @@ fn run(instance: *mut c_void, t_end: f64, h: f64) -> Vec<Vec<f64>> {
 #[test]
 fn steps_match_the_runtimes_own_run() {
     let info = model().info();
-    let instance = instantiate(&token(info));
+    let instance = instantiate(&token(model()));
     assert!(!instance.is_null());
     let t_end = 0.5;
     let h = 1e-3;
@@ -236,7 +235,7 @@ fn a_parameter_changes_the_run_as_the_models_own_value_does() {
         (_, Some(max)) => 0.5 * (p.default + max),
         _ => p.default * 1.1,
     };
-    let instance = instantiate(&token(info));
+    let instance = instantiate(&token(model()));
     assert_eq!(set(instance, reference(&p.name), value), 0);
     assert_eq!(get(instance, reference(&p.name)), value);
     let rows = run(instance, 0.05, 1e-3);
@@ -280,7 +279,7 @@ fn bad_values_and_calls_give_an_error_status_and_a_message() {
     );
     assert!(instantiate("{not-this-model}").is_null());
     assert!(logged("is not this model's"));
-    let instance = instantiate(&token(info));
+    let instance = instantiate(&token(model()));
     if let Some(p) = info.parameters.iter().find(|p| p.min.is_some()) {
         let below = p.min.unwrap_or(0.0) - 1.0;
         assert_eq!(set(instance, reference(&p.name), below), 3);
@@ -302,6 +301,82 @@ fn bad_values_and_calls_give_an_error_status_and_a_message() {
         unsafe { fmi3DoStep(instance, 0.0, 1e-3, true, &mut a, &mut b, &mut c, &mut last) };
     assert_eq!(status, 3, "a step before initialization");
     assert!(logged("fmi3DoStep is not allowed in mode Instantiated"));
+    // SAFETY: freed once.
+    unsafe { fmi3FreeInstance(instance) };
+}
+
+/// A speed step through the camshaft's input. cycloidal_roller has no freedom of its own:
+/// every output but the work quadratures is a function of the cam's angle, speed and
+/// acceleration. So after the step to 60 rad/s at t = 0.1 s (angle 5 rad), the FMU must give
+/// at t the outputs that the model built with omega = 60 gives at the instant it has the same
+/// angle, t − 0.1 + 5/60 s: an independent run (the model's own law, not the input's), to
+/// round-off of the kinematics (1e-9 of each column's scale: Newton's tolerance on the
+/// follower's position is far below it; measured gap printed).
+#[test]
+fn a_speed_step_through_the_input_drives_the_cam_as_that_speed_does() {
+    let instance = instantiate(&token(model()));
+    let speed = reference("cam_angle_speed");
+    assert_eq!(
+        get(instance, speed),
+        50.0,
+        "the model's own speed before it is set"
+    );
+    let h = 1e-3;
+    // SAFETY: an instance of this binary.
+    unsafe {
+        assert_eq!(
+            fmi3EnterInitializationMode(instance, false, 0.0, 0.0, false, 0.0),
+            0
+        );
+        assert_eq!(fmi3ExitInitializationMode(instance), 0);
+    }
+    let step = |t: f64| {
+        let (mut a, mut b, mut c, mut last) = (false, false, false, 0.0);
+        // SAFETY: as above.
+        let status = unsafe { fmi3DoStep(instance, t, h, true, &mut a, &mut b, &mut c, &mut last) };
+        assert_eq!(status, 0, "step at {t}");
+    };
+    for k in 0..100 {
+        step(k as f64 * h);
+    }
+    assert!((get(instance, reference("cam_angle")) - 5.0).abs() < 1e-9);
+    assert_eq!(set(instance, speed, 60.0), 0);
+    assert_eq!(get(instance, reference("cam_angle_dot")), 60.0);
+    let faster = camchain_models::cycloidal_roller::Model::with(&[("omega", 60.0)]).expect("omega");
+    let mut state = Simulate::assemble(&faster, 0.0).expect("assembles");
+    faster
+        .step_with(&mut state, 5.0 / 60.0, &faster.info().defaults)
+        .expect("steps");
+    let info = model().info();
+    let kinematic: Vec<(usize, u32)> = variables(model())
+        .into_iter()
+        .filter_map(|v| match v.role {
+            Role::Output(i) if !["dissipated", "driven_work"].contains(&v.name.as_str()) => {
+                Some((i, v.reference))
+            }
+            _ => None,
+        })
+        .collect();
+    let mut worst: f64 = 0.0;
+    for k in 100..300 {
+        step(k as f64 * h);
+        faster
+            .step_with(&mut state, h, &faster.info().defaults)
+            .expect("steps");
+        let sample = faster.sample(&state).expect("sample");
+        let want = camchain_runtime::columns::values(info, &sample);
+        for &(i, r) in &kinematic {
+            let scale = want[i].abs().max(1.0);
+            let gap = (get(instance, r) - want[i]).abs() / scale;
+            worst = worst.max(gap);
+            assert!(
+                gap <= 1e-9,
+                "column {i} at t = {}: {gap:e}",
+                (k + 1) as f64 * h
+            );
+        }
+    }
+    println!("largest gap after the speed step: {worst:e}");
     // SAFETY: freed once.
     unsafe { fmi3FreeInstance(instance) };
 }

@@ -100,7 +100,7 @@ pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let id = identifier(&model.name);
     if let Some(builtin) = camchain_models::by_name(&args.model).filter(|_| args.describe) {
-        let xml = camchain_fmu::description::model_description(builtin.info(), &id);
+        let xml = camchain_fmu::description::model_description(builtin, &id);
         print!("{xml}");
         return Ok(());
     }
