@@ -332,6 +332,9 @@ pub unsafe fn do_step(
         }
         with(instance, "fmi3DoStep", |h| {
             let result = h.instance.do_step(current, step);
+            for event in h.instance.take_events() {
+                h.log(OK, "logEvents", &event);
+            }
             if let Some(last) = last_successful_time.as_mut() {
                 *last = h.instance.get(0).unwrap_or(current);
             }

@@ -5,7 +5,9 @@
 
 use crate::drive::Driven;
 use crate::variables::{Role, Setting, Variable, variables};
+use camchain_runtime::events::EventKind;
 use camchain_runtime::parameters::checks::within_bounds;
+use camchain_runtime::unilateral::OneSidedRun;
 use camchain_runtime::{Dynamics, ModelInfo, ParameterError, SimSettings, Simulate, State};
 
 /// What builds the model from parameter values: a generated module's `boxed`.
@@ -40,11 +42,37 @@ pub struct Instance {
     /// The speeds the master set for the drives that are inputs, by coordinate (`None`:
     /// the model's own law).
     speeds: Vec<(usize, Option<f64>)>,
-    /// The model and its state at the current time, once built (after every parameter
-    /// change the next read or step builds them again).
-    running: Option<(Driven, State)>,
+    /// The model and where its run is, once built (after every parameter change the next
+    /// read or step builds them again).
+    running: Option<Running>,
+    /// What happened inside the last steps (lift-offs, impacts), for the log.
+    happened: Vec<String>,
     /// The output columns at the current time (index as [`Role::Output`]).
     outputs: Vec<f64>,
+}
+
+/// How a run advances.
+enum Progress {
+    /// Bilateral contact (the model file's default): the state, stepped.
+    Bilateral(Box<State>),
+    /// One-sided contact with the file's restitution: lift-offs and impacts located inside
+    /// every step, as `camchain simulate` locates them.
+    OneSided(Box<OneSidedRun>),
+}
+
+/// A built model and its run.
+struct Running {
+    model: Driven,
+    progress: Progress,
+}
+
+impl Running {
+    fn time(&self) -> f64 {
+        match &self.progress {
+            Progress::Bilateral(state) => state.t,
+            Progress::OneSided(run) => run.time(),
+        }
+    }
 }
 
 /// Whether two communication times are the same one (FMI's masters pass the sum of the
@@ -80,6 +108,7 @@ impl Instance {
             start_time: 0.0,
             stop_time: None,
             running: None,
+            happened: Vec::new(),
             outputs: Vec::new(),
         })
     }
@@ -192,20 +221,41 @@ impl Instance {
         let state = model
             .assemble(self.start_time)
             .map_err(|e| format!("assembly at t = {} s failed: {e}", self.start_time))?;
-        self.running = Some((model, state));
-        self.refresh()
+        let sample = model
+            .sample(&state)
+            .map_err(|e| format!("at t = {} s the outputs failed: {e}", state.t))?;
+        self.outputs = camchain_runtime::columns::values(&self.info, &sample);
+        let progress = match self.info.restitution {
+            Some(e) => {
+                let run = OneSidedRun::start(&model, state, &self.settings, e)
+                    .map_err(|e| format!("the one-sided run cannot start: {e}"))?;
+                Progress::OneSided(Box::new(run))
+            }
+            None => Progress::Bilateral(Box::new(state)),
+        };
+        self.running = Some(Running { model, progress });
+        Ok(())
     }
 
-    /// The outputs at the current state.
+    /// The outputs at the current state of a bilateral run.
     fn refresh(&mut self) -> Result<(), String> {
-        let Some((model, state)) = &self.running else {
-            return Err("the model is not built".into());
+        let Some(Running {
+            model,
+            progress: Progress::Bilateral(state),
+        }) = &self.running
+        else {
+            return Ok(());
         };
         let sample = model
             .sample(state)
             .map_err(|e| format!("at t = {} s the outputs failed: {e}", state.t))?;
         self.outputs = camchain_runtime::columns::values(&self.info, &sample);
         Ok(())
+    }
+
+    /// The lift-offs and impacts of the steps since the last call, one line each.
+    pub fn take_events(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.happened)
     }
 
     fn variable(&self, reference: u32) -> Result<&Variable, String> {
@@ -225,10 +275,7 @@ impl Instance {
             Role::Parameter(i) => Ok(self.parameters[i]),
             Role::Setting(s) => Ok(self.setting(s)),
             Role::Input(i) => Ok(self.speed(i, reference)),
-            Role::Time => Ok(self
-                .running
-                .as_ref()
-                .map_or(self.start_time, |(_, state)| state.t)),
+            Role::Time => Ok(self.running.as_ref().map_or(self.start_time, Running::time)),
             Role::Output(i) => {
                 if self.mode == Mode::Instantiated {
                     return Err(format!(
@@ -266,10 +313,13 @@ impl Instance {
             *s = Some(speed);
         }
         match (&mut self.running, self.mode) {
-            (Some((model, state)), Mode::Step) => {
-                model.set_speed(i, speed, state.t);
-                if let Some(qd) = state.qd.get_mut(i) {
-                    *qd = speed;
+            (Some(running), Mode::Step) => {
+                let t = running.time();
+                running.model.set_speed(i, speed, t);
+                if let Progress::Bilateral(state) = &mut running.progress {
+                    if let Some(qd) = state.qd.get_mut(i) {
+                        *qd = speed;
+                    }
                 }
                 self.refresh()
             }
@@ -339,13 +389,13 @@ impl Instance {
             ));
         }
         let settings = self.settings.clone();
-        let Some((model, state)) = &mut self.running else {
+        let Some(running) = &mut self.running else {
             return Err("the model is not built".into());
         };
-        if !same_time(current, state.t) {
+        let now = running.time();
+        if !same_time(current, now) {
             return Err(format!(
-                "fmi3DoStep from t = {current} s, but the instance is at t = {} s",
-                state.t
+                "fmi3DoStep from t = {current} s, but the instance is at t = {now} s"
             ));
         }
         if let Some(stop) = self
@@ -358,15 +408,47 @@ impl Instance {
             ));
         }
         let target = current + step;
-        if let Err(e) = model.step_with(state, target - state.t, &settings) {
-            let reached = state.t;
-            self.mode = Mode::Failed;
-            let _ = self.refresh();
-            return Err(format!(
-                "the step from t = {current} s to {target} s failed at t = {reached} s: {e}"
-            ));
+        let outcome = match &mut running.progress {
+            Progress::Bilateral(state) => running
+                .model
+                .step_with(state, target - now, &settings)
+                .map(|_| None),
+            Progress::OneSided(run) => {
+                let seen = run.events().len();
+                let outcome = run.advance(&running.model, target, &settings).map(Some);
+                for event in &run.events()[seen..] {
+                    let what = match event.kind {
+                        EventKind::LiftOff => "lift-off".to_string(),
+                        EventKind::Impact {
+                            normal_velocity,
+                            stays,
+                            ..
+                        } => format!(
+                            "impact at {:.6} m/s{}",
+                            normal_velocity.abs(),
+                            if stays { ", stays on the cam" } else { "" }
+                        ),
+                        _ => format!("{:?}", event.kind),
+                    };
+                    self.happened.push(format!("t = {:.9} s: {what}", event.t));
+                }
+                outcome
+            }
+        };
+        match outcome {
+            Ok(Some(sample)) => {
+                self.outputs = camchain_runtime::columns::values(&self.info, &sample);
+            }
+            Ok(None) => self.refresh()?,
+            Err(e) => {
+                let reached = running.time();
+                self.mode = Mode::Failed;
+                let _ = self.refresh();
+                return Err(format!(
+                    "the step from t = {current} s to {target} s failed at t = {reached} s: {e}"
+                ));
+            }
         }
-        self.refresh()?;
         Ok(target)
     }
 }

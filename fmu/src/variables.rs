@@ -17,7 +17,8 @@ use camchain_runtime::{Dynamics, JointKind};
 pub enum Role {
     /// The independent variable, time (s).
     Time,
-    /// The run-time parameter of this index in [`ModelInfo::parameters`].
+    /// The run-time parameter of this index in
+    /// [`ModelInfo::parameters`](camchain_runtime::ModelInfo::parameters).
     Parameter(usize),
     /// One of the integrator's settings.
     Setting(Setting),

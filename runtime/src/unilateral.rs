@@ -203,10 +203,38 @@ fn complete_flight_sample(model: &dyn Dynamics, sample: &mut Sample) {
     sample.in_contact = vec![false; nc];
 }
 
-/// What the follower is doing.
-enum Mode<'a, D: ?Sized> {
-    Contact(State),
-    Flight(State, &'a Detached<'a, D>),
+/// Where a one-sided run is: its state, of the model while the follower is on the cam and
+/// of the model seen through [`Detached`] while it flies, and the landing tolerance fixed at
+/// the start.
+struct Progress {
+    state: State,
+    flying: bool,
+    tolerance: f64,
+}
+
+impl Progress {
+    /// The start of a run from `state`: in contact, unless a roller in a groove with backlash
+    /// starts between the flanks ([`crate::clearance`]): in flight unless it touches one.
+    fn start(model: &dyn Dynamics, state: State, settings: &SimSettings) -> Result<Self, SimError> {
+        let tolerance = landing_tolerance(settings, state.length_scale());
+        let n = model.info().n();
+        let start = gap_reading(model, n, &state.q, &state.qd).g;
+        if Clearance::applies_to(model) && start > tolerance {
+            let detached = Detached::new(model);
+            let mut flying = state_at(&detached, state.t, (&state.q, &state.qd))?;
+            flying.set_quadratures((state.dissipated, state.driven_work));
+            return Ok(Progress {
+                state: flying,
+                flying: true,
+                tolerance,
+            });
+        }
+        Ok(Progress {
+            state,
+            flying: false,
+            tolerance,
+        })
+    }
 }
 
 fn validate_unilateral(
@@ -258,24 +286,36 @@ pub(crate) fn run_phases(
 ) -> Result<(), SimError> {
     let keep = record.keeps_samples();
     validate_unilateral(model, &state, settings, (restitution, keep))?;
+    let mut grid = Grid::new(state.t, settings);
+    let mut progress = Progress::start(model, state, settings)?;
+    phases(
+        model,
+        &mut progress,
+        (settings, restitution),
+        &mut grid,
+        record,
+        0,
+    )
+}
+
+/// The phases of a one-sided run from where `progress` is to the end of `grid`: contact
+/// until lift-off, flight until landing, the impact law, and again; `earlier` events were
+/// recorded before (for the chattering limit).
+fn phases(
+    model: &dyn Dynamics,
+    progress: &mut Progress,
+    (settings, restitution): (&SimSettings, f64),
+    grid: &mut Grid,
+    record: &mut Recorder,
+    earlier: usize,
+) -> Result<(), SimError> {
     let detached = Detached::new(model);
-    let tolerance = landing_tolerance(settings, state.length_scale());
+    let tolerance = progress.tolerance;
     let n = model.info().n();
     let gap = |q: &[f64], qd: &[f64]| gap_reading(model, n, q, qd);
     let complete = |sample: &mut Sample| complete_flight_sample(model, sample);
-    let mut grid = Grid::new(state.t, settings);
-    // A roller in a groove with backlash starts where it was put, usually between the flanks
-    // ([`crate::clearance`]): in flight unless it touches one.
-    let start = gap(&state.q, &state.qd).g;
-    let mut mode = if Clearance::applies_to(model) && start > tolerance {
-        let mut flying = state_at(&detached, state.t, (&state.q, &state.qd))?;
-        flying.set_quadratures((state.dissipated, state.driven_work));
-        Mode::Flight(flying, &detached)
-    } else {
-        Mode::Contact(state)
-    };
     loop {
-        if record.events.len() > MAX_EVENTS {
+        if earlier + record.events.len() > MAX_EVENTS {
             return Err(SimError::InvalidSettings {
                 message: format!(
                     "more than {MAX_EVENTS} contact events before t_end: the follower \
@@ -283,34 +323,39 @@ pub(crate) fn run_phases(
                 ),
             });
         }
-        let (stop, flying) = match &mut mode {
-            Mode::Contact(state) => {
-                let watch = Watch::Forces { stop: true };
-                let stop = run_phase(model, state, settings, &watch, &mut grid, record, None)?;
-                (stop, false)
-            }
-            Mode::Flight(state, detached) => {
-                let watch = Watch::Gap {
-                    gap: &gap,
-                    tolerance,
-                };
-                let stop = run_phase(
-                    *detached,
-                    state,
-                    settings,
-                    &watch,
-                    &mut grid,
-                    record,
-                    Some(&complete),
-                )?;
-                (stop, true)
-            }
+        let flying = progress.flying;
+        let stop = if flying {
+            let watch = Watch::Gap {
+                gap: &gap,
+                tolerance,
+            };
+            let state = &mut progress.state;
+            run_phase(
+                &detached,
+                state,
+                settings,
+                &watch,
+                grid,
+                record,
+                Some(&complete),
+            )?
+        } else {
+            let watch = Watch::Forces { stop: true };
+            run_phase(
+                model,
+                &mut progress.state,
+                settings,
+                &watch,
+                grid,
+                record,
+                None,
+            )?
         };
         let Some(stop) = stop else {
             return Ok(());
         };
         let (dissipated, driven_work) = stop.quadratures;
-        mode = if flying {
+        let (next, in_flight) = if flying {
             let hit = impact(
                 model,
                 stop.t,
@@ -332,15 +377,13 @@ pub(crate) fn run_phases(
                 flank: model.groove_flank(&stop.q, stop.contact),
             });
             let quadratures = (dissipated + hit.loss, driven_work + hit.drive_work);
-            if hit.stays {
-                let mut next = state_at(model, stop.t, (&stop.q, &hit.qd))?;
-                next.set_quadratures(quadratures);
-                Mode::Contact(next)
+            let mut next = if hit.stays {
+                state_at(model, stop.t, (&stop.q, &hit.qd))?
             } else {
-                let mut next = state_at(&detached, stop.t, (&stop.q, &hit.qd))?;
-                next.set_quadratures(quadratures);
-                Mode::Flight(next, &detached)
-            }
+                state_at(&detached, stop.t, (&stop.q, &hit.qd))?
+            };
+            next.set_quadratures(quadratures);
+            (next, !hit.stays)
         } else {
             record.events.push(ContactEvent {
                 t: stop.t,
@@ -352,8 +395,119 @@ pub(crate) fn run_phases(
             });
             let mut next = state_at(&detached, stop.t, (&stop.q, &stop.qd))?;
             next.set_quadratures((dissipated, driven_work));
-            Mode::Flight(next, &detached)
+            (next, true)
         };
+        progress.state = next;
+        progress.flying = in_flight;
+    }
+}
+
+/// A one-sided run advanced piece by piece, to one target time after another (what an
+/// FMU's `fmi3DoStep` does): the phases, events and impact law of
+/// [`crate::Simulate::simulate_unilateral`], resumed where the last piece ended, in contact
+/// or in flight. The model is passed to each call (the same one every time).
+pub struct OneSidedRun {
+    progress: Progress,
+    restitution: f64,
+    events: Vec<ContactEvent>,
+}
+
+impl OneSidedRun {
+    /// The run from `state` (assembled on `model`) with restitution `restitution`; the checks
+    /// of `simulate_unilateral` (one contact, no loops, an adaptive integrator).
+    pub fn start(
+        model: &dyn Dynamics,
+        state: State,
+        settings: &SimSettings,
+        restitution: f64,
+    ) -> Result<Self, SimError> {
+        let check = SimSettings {
+            t_end: f64::MAX,
+            dt_out: f64::MAX,
+            ..settings.clone()
+        };
+        let progress = if Clearance::applies_to(model) {
+            let clearance = Clearance::new(model);
+            validate_unilateral(&clearance, &state, &check, (restitution, false))?;
+            Progress::start(&clearance, state, settings)?
+        } else {
+            validate_unilateral(model, &state, &check, (restitution, false))?;
+            Progress::start(model, state, settings)?
+        };
+        Ok(OneSidedRun {
+            progress,
+            restitution,
+            events: Vec::new(),
+        })
+    }
+
+    /// Advances to `target` (after the current time) and returns the sample there; the
+    /// events on the way are appended to [`OneSidedRun::events`].
+    pub fn advance(
+        &mut self,
+        model: &dyn Dynamics,
+        target: f64,
+        settings: &SimSettings,
+    ) -> Result<Sample, SimError> {
+        let t0 = self.progress.state.t;
+        if !(target > t0 && target.is_finite()) {
+            return Err(SimError::InvalidSettings {
+                message: format!("a step to t = {target} s from t = {t0} s"),
+            });
+        }
+        let piece = SimSettings {
+            t_end: target,
+            dt_out: target - t0,
+            ..settings.clone()
+        };
+        let mut monitor = crate::control::Unmonitored;
+        let mut record = Recorder::new(&mut monitor, &piece, t0);
+        let mut grid = Grid::new(t0, &piece);
+        let earlier = self.events.len();
+        let law = (&piece, self.restitution);
+        let outcome = if Clearance::applies_to(model) {
+            let clearance = Clearance::new(model);
+            phases(
+                &clearance,
+                &mut self.progress,
+                law,
+                &mut grid,
+                &mut record,
+                earlier,
+            )
+        } else {
+            phases(
+                model,
+                &mut self.progress,
+                law,
+                &mut grid,
+                &mut record,
+                earlier,
+            )
+        };
+        self.events.append(&mut record.events);
+        outcome?;
+        record
+            .samples
+            .pop()
+            .ok_or_else(|| SimError::InvalidSettings {
+                message: format!("no sample at t = {target} s"),
+            })
+    }
+
+    /// The lift-offs and impacts so far, in time order.
+    pub fn events(&self) -> &[ContactEvent] {
+        &self.events
+    }
+
+    /// The current time.
+    pub fn time(&self) -> f64 {
+        self.progress.state.t
+    }
+
+    /// Whether the follower is on its cam now.
+    pub fn in_contact(&self) -> bool {
+        !self.progress.flying
     }
 }
 
