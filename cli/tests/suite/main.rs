@@ -11,6 +11,7 @@ mod destinations;
 mod merge;
 mod repartition;
 mod signals;
+mod slurm;
 mod special_files;
 mod streaming;
 mod stress;
