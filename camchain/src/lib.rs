@@ -140,6 +140,12 @@ pub mod prelude {
 #[cfg(feature = "reference")]
 pub use camchain_reference as reference;
 
+/// The FMI 3.0 Co-Simulation functions over a model (feature `fmu`): a `cdylib` crate whose
+/// root holds `camchain::fmu::export!(my_model::boxed);` is an FMU's library, which
+/// `camchain fmu --library` packs with its `modelDescription.xml` (docs/fmu.md).
+#[cfg(feature = "fmu")]
+pub use camchain_fmu as fmu;
+
 /// Includes the module that `camchain_build::compile_models` generated for a model, by its
 /// module name (the model's `name:`, or its file stem): the `Model` type, which implements
 /// [`runtime::Dynamics`], its `INFO` and its `OP_COUNTS`.

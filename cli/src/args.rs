@@ -438,8 +438,14 @@ impl SweepArgs {
 #[derive(Debug, Clone, Default, Args)]
 pub struct FmuArgs {
     /// Built-in model name or path to a .ron model file
-    #[arg(value_name = "MODEL")]
-    pub model: String,
+    #[arg(value_name = "MODEL", required_unless_present = "library")]
+    pub model: Option<String>,
+
+    /// Pack this library instead of building one: a cdylib of your crate whose root calls
+    /// `camchain::fmu::export!` (its modelIdentifier is the file's name without `lib` and
+    /// `.so`)
+    #[arg(long, value_name = "FILE", conflicts_with = "model")]
+    pub library: Option<PathBuf>,
 
     /// The FMU's path [default: <model>.fmu in the current directory]
     #[arg(long, value_name = "FILE")]

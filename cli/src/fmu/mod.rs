@@ -95,11 +95,19 @@ fn source(model: &str) -> Result<Source, CliError> {
 /// Runs the command.
 pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
     let platform = platform()?;
-    let source = source(&args.model)?;
+    if let Some(library) = &args.library {
+        return pack_library(args, library, &platform);
+    }
+    let Some(model_arg) = args.model.as_deref() else {
+        return Err(CliError::Usage(
+            "give a MODEL (a built-in name or a .ron file) or --library FILE".into(),
+        ));
+    };
+    let source = source(model_arg)?;
     let model = camchain_codegen::check_source_in(&source.text, &source.shown, source.files)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let id = identifier(&model.name);
-    if let Some(builtin) = camchain_models::by_name(&args.model).filter(|_| args.describe) {
+    if let Some(builtin) = camchain_models::by_name(model_arg).filter(|_| args.describe) {
         let xml = camchain_fmu::description::model_description(builtin, &id);
         print!("{xml}");
         return Ok(());
@@ -155,23 +163,72 @@ pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
         print!("{xml}");
         return Ok(());
     }
-    let binary = std::fs::read(&library)
+    pack(&out, &xml, &library, (&id, &platform))?;
+    if !args.quiet {
+        let from = if cached {
+            ", library from the cache"
+        } else {
+            ""
+        };
+        eprintln!(
+            "camchain fmu: wrote {} ({} for {platform}{from})",
+            out.display(),
+            model.name
+        );
+    }
+    Ok(())
+}
+
+/// Writes the FMU: the description and the library as `binaries/<platform>/<id>.so`.
+fn pack(
+    out: &Path,
+    xml: &str,
+    library: &Path,
+    (id, platform): (&str, &str),
+) -> Result<(), CliError> {
+    let binary = std::fs::read(library)
         .map_err(|e| CliError::Failed(format!("{}: {e}", library.display())))?;
     let entries = [
-        ("modelDescription.xml".to_string(), xml.into_bytes()),
+        ("modelDescription.xml".to_string(), xml.as_bytes().to_vec()),
         (format!("binaries/{platform}/{id}.so"), binary),
     ];
-    super::output::write_file(&out, |w| zip::write(w, &entries)).map_err(CliError::Failed)?;
+    super::output::write_file(out, |w| zip::write(w, &entries)).map_err(CliError::Failed)
+}
+
+/// `--library FILE`: a library a user's crate built (a cdylib calling `camchain::fmu::export!`),
+/// checked and packed.
+fn pack_library(args: &FmuArgs, library: &Path, platform: &str) -> Result<(), CliError> {
+    if !library.is_file() {
+        return Err(CliError::Failed(format!(
+            "{}: no such library (build your crate's cdylib first: cargo build --release --lib)",
+            library.display()
+        )));
+    }
+    let stem = library
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let id = identifier(stem.strip_prefix("lib").unwrap_or(&stem));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{id}.fmu")));
+    let _lock = if args.describe {
+        None
+    } else {
+        super::output::claim(&out).map_err(CliError::Failed)?
+    };
+    let xml = describe(library, &id)?;
+    if args.describe {
+        print!("{xml}");
+        return Ok(());
+    }
+    pack(&out, &xml, library, (&id, platform))?;
     if !args.quiet {
         eprintln!(
-            "camchain fmu: wrote {} ({} for {platform}{})",
+            "camchain fmu: wrote {} ({id} from {}, for {platform})",
             out.display(),
-            model.name,
-            if cached {
-                ", library from the cache"
-            } else {
-                ""
-            }
+            library.display()
         );
     }
     Ok(())
@@ -234,7 +291,7 @@ fn build(
         })
 }
 
-/// The library's own `modelDescription.xml`.
+/// The library's own `modelDescription.xml`, once every FMI 3.0 function is found in it.
 fn describe(library: &Path, id: &str) -> Result<String, CliError> {
     type Describe = unsafe extern "C" fn(*const c_char) -> *mut c_char;
     type Free = unsafe extern "C" fn(*mut c_char);
@@ -243,9 +300,29 @@ fn describe(library: &Path, id: &str) -> Result<String, CliError> {
     // functions have these signatures.
     unsafe {
         let lib = libloading::Library::new(library).map_err(|e| fail(e.to_string()))?;
-        let describe: libloading::Symbol<Describe> = lib
-            .get(b"camchain_fmu_model_description\0")
-            .map_err(|e| fail(e.to_string()))?;
+        let missing: Vec<&str> = camchain_fmu::FMI3_FUNCTIONS
+            .iter()
+            .copied()
+            .filter(|name| lib.get::<*const ()>(name.as_bytes()).is_err())
+            .collect();
+        if !missing.is_empty() {
+            let more = missing.len().saturating_sub(4);
+            let more = if more > 0 {
+                format!(" and {more} more")
+            } else {
+                String::new()
+            };
+            return Err(fail(format!(
+                "{} of the {} FMI 3.0 functions are missing ({}{more}): is it a library whose \
+                 root calls camchain::fmu::export!?",
+                missing.len(),
+                camchain_fmu::FMI3_FUNCTIONS.len(),
+                missing[..missing.len().min(4)].join(", ")
+            )));
+        }
+        let describe: libloading::Symbol<Describe> =
+            lib.get(b"camchain_fmu_model_description\0")
+                .map_err(|e| fail(format!("{e}: not a library of camchain::fmu::export!")))?;
         let free: libloading::Symbol<Free> = lib
             .get(b"camchain_fmu_free_text\0")
             .map_err(|e| fail(e.to_string()))?;

@@ -8,6 +8,7 @@ mod cli;
 #[path = "../common/mod.rs"]
 mod common;
 mod destinations;
+mod fmu;
 mod merge;
 mod repartition;
 mod signals;
