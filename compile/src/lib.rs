@@ -205,10 +205,12 @@ pub fn manifest(name: &str, comment: &str, links: Links, sources: &Sources) -> S
          # Written by camchain for {comment}.\n[lib]\npath = \"src/lib.rs\"\ncrate-type = [\"cdylib\"]\n\n\
          [dependencies]\n{dependencies}\n\
          # The dev profile as the camchain workspace's (CAMCHAIN_COMPILE_PROFILE=dev, for\n\
-         # its tests): its dependencies are that build's; the copies unoptimised.\n\
+         # its tests, which build many models and run each briefly): its dependencies are\n\
+         # that build's; the copies and the model itself unoptimised.\n\
          [profile.dev]\nopt-level = 2\ndebug = false\n\
          [profile.dev.package.camchain-runtime]\nopt-level = 0\n\
-         [profile.dev.package.camchain-fmu]\nopt-level = 0\n\n[workspace]\n",
+         [profile.dev.package.camchain-fmu]\nopt-level = 0\n\
+         [profile.dev.package.{name}]\nopt-level = 0\n\n[workspace]\n",
         comment = comment.replace(['\n', '\r'], " "),
     )
 }
