@@ -5,7 +5,7 @@
 //! recomputes from its own model when it is instantiated and compares.
 
 use crate::variables::{Role, Variable, variables};
-use camchain_runtime::Dynamics;
+use camchain_runtime::{Dynamics, IntegratorKind};
 use std::collections::BTreeSet;
 use std::fmt::Write;
 
@@ -83,8 +83,38 @@ fn base_unit(name: &str) -> Option<&'static str> {
     })
 }
 
-/// The `<Float64 …/>` element of one variable.
+/// The `<Enumeration …/>` of the integrator, its type declared in `TypeDefinitions`.
+fn integrator_element(v: &Variable) -> String {
+    format!(
+        r#"    <Enumeration name="{}" valueReference="{}" causality="parameter" variability="fixed" declaredType="Integrator" description="{}" start="{}"/>"#,
+        escape(&v.name),
+        v.reference,
+        escape(&v.description),
+        v.start.unwrap_or(1.0) as i64
+    ) + "\n"
+}
+
+/// `TypeDefinitions`: the integrators as an Enumeration.
+fn type_definitions() -> String {
+    let mut xml = String::from("  <TypeDefinitions>\n    <EnumerationType name=\"Integrator\">\n");
+    for &kind in IntegratorKind::ALL {
+        let _ = writeln!(
+            xml,
+            r#"      <Item name="{}" value="{}" description="{}"/>"#,
+            kind.name(),
+            crate::variables::integrator_value(kind),
+            escape(kind.spec().about)
+        );
+    }
+    xml.push_str("    </EnumerationType>\n  </TypeDefinitions>\n");
+    xml
+}
+
+/// The element of one variable.
 fn element(v: &Variable) -> String {
+    if v.role == Role::Setting(crate::variables::Setting::Integrator) {
+        return integrator_element(v);
+    }
     let (causality, variability) = match v.role {
         Role::Time => ("independent", "continuous"),
         Role::Parameter(_) | Role::Setting(_) => ("parameter", "fixed"),
@@ -157,6 +187,7 @@ pub fn model_description(model: &dyn Dynamics, identifier: &str) -> String {
         }
         xml.push_str("  </UnitDefinitions>\n");
     }
+    xml.push_str(&type_definitions());
     xml.push_str(
         "  <LogCategories>\n    <Category name=\"logStatusError\" description=\"why a call \
          failed: bad values, a failed step, a call out of order\"/>\n    <Category \

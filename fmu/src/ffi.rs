@@ -309,6 +309,66 @@ pub unsafe fn set_float64(
     }
 }
 
+/// `fmi3GetInt64`.
+///
+/// # Safety
+/// As [`get_float64`].
+pub unsafe fn get_int64(
+    instance: *mut c_void,
+    references: *const u32,
+    n_references: usize,
+    values: *mut i64,
+    n_values: usize,
+) -> Status {
+    // SAFETY: per the contract.
+    unsafe {
+        with(instance, "fmi3GetInt64", |h| {
+            let references = slice(references, n_references).ok_or("null value references")?;
+            if n_values != n_references {
+                return Err(format!(
+                    "{n_values} values for {n_references} scalar variables"
+                ));
+            }
+            if n_values > 0 && values.is_null() {
+                return Err("null values".into());
+            }
+            for (k, &r) in references.iter().enumerate() {
+                values.add(k).write(h.instance.get_int64(r)?);
+            }
+            Ok(OK)
+        })
+    }
+}
+
+/// `fmi3SetInt64`.
+///
+/// # Safety
+/// As [`get_float64`].
+pub unsafe fn set_int64(
+    instance: *mut c_void,
+    references: *const u32,
+    n_references: usize,
+    values: *const i64,
+    n_values: usize,
+) -> Status {
+    // SAFETY: per the contract.
+    unsafe {
+        with(instance, "fmi3SetInt64", |h| {
+            let references = slice(references, n_references).ok_or("null value references")?;
+            let values = slice(values, n_values).ok_or("null values")?;
+            if n_values != n_references {
+                return Err(format!(
+                    "{n_values} values for {n_references} scalar variables"
+                ));
+            }
+            for (&r, &v) in references.iter().zip(values) {
+                h.instance.set_int64(r, v)?;
+            }
+            Ok(OK)
+        })
+    }
+}
+
 /// `fmi3DoStep`.
 ///
 /// # Safety

@@ -51,6 +51,10 @@ pub struct Instance {
     outputs: Vec<f64>,
 }
 
+/// Why a Float64 call on the integrator fails.
+const ENUMERATION: &str =
+    "`solver.integrator` is an Enumeration: use fmi3GetInt64 and fmi3SetInt64";
+
 /// How a run advances.
 enum Progress {
     /// Bilateral contact (the model file's default): the state, stepped.
@@ -273,6 +277,7 @@ impl Instance {
         let role = self.variable(reference)?.role;
         match role {
             Role::Parameter(i) => Ok(self.parameters[i]),
+            Role::Setting(Setting::Integrator) => Err(ENUMERATION.into()),
             Role::Setting(s) => Ok(self.setting(s)),
             Role::Input(i) => Ok(self.speed(i, reference)),
             Role::Time => Ok(self.running.as_ref().map_or(self.start_time, Running::time)),
@@ -332,10 +337,47 @@ impl Instance {
 
     fn setting(&self, s: Setting) -> f64 {
         match s {
+            Setting::Integrator => {
+                crate::variables::integrator_value(self.settings.integrator) as f64
+            }
             Setting::Rtol => self.settings.rtol,
             Setting::Atol => self.settings.atol,
             Setting::Dt => self.settings.dt,
         }
+    }
+
+    /// `fmi3GetInt64` of one variable: the integrator, the only Enumeration.
+    pub fn get_int64(&self, reference: u32) -> Result<i64, String> {
+        match self.variable(reference)?.role {
+            Role::Setting(Setting::Integrator) => {
+                Ok(crate::variables::integrator_value(self.settings.integrator))
+            }
+            _ => Err(format!(
+                "value reference {reference} is a Float64: read it with fmi3GetFloat64"
+            )),
+        }
+    }
+
+    /// `fmi3SetInt64`: the integrator, before the end of initialization mode.
+    pub fn set_int64(&mut self, reference: u32, value: i64) -> Result<(), String> {
+        if self.variable(reference)?.role != Role::Setting(Setting::Integrator) {
+            return Err(format!(
+                "value reference {reference} is a Float64: set it with fmi3SetFloat64"
+            ));
+        }
+        self.expect(
+            &[Mode::Instantiated, Mode::Initialization],
+            "setting the fixed parameter `solver.integrator`",
+        )?;
+        let kind = crate::variables::integrator_of(value).ok_or_else(|| {
+            format!(
+                "solver.integrator = {value}: not an item of Integrator (1 to {})",
+                camchain_runtime::IntegratorKind::ALL.len()
+            )
+        })?;
+        self.settings.integrator = kind;
+        self.running = None;
+        Ok(())
     }
 
     /// `fmi3SetFloat64` of one variable: parameters and settings before the end of
@@ -349,6 +391,7 @@ impl Instance {
             Role::Time => return Err("`time` is the independent variable: not settable".into()),
             Role::Output(_) => return Err(format!("`{name}` is an output: not settable")),
             Role::Input(i) => return self.set_speed(i, value, &name),
+            Role::Setting(Setting::Integrator) => return Err(ENUMERATION.into()),
             Role::Parameter(_) | Role::Setting(_) => {}
         }
         self.expect(
@@ -367,6 +410,7 @@ impl Instance {
                     return Err(format!("{what}: must be positive and finite"));
                 }
                 match s {
+                    Setting::Integrator => {}
                     Setting::Rtol => self.settings.rtol = value,
                     Setting::Atol => self.settings.atol = value,
                     Setting::Dt => self.settings.dt = value,

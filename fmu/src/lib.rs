@@ -169,6 +169,34 @@ macro_rules! export {
             }
 
             /// # Safety
+            /// An instance of this library; arrays of the lengths given.
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi3GetInt64(
+                instance: *mut c_void,
+                references: *const u32,
+                n_references: usize,
+                values: *mut i64,
+                n_values: usize,
+            ) -> Status {
+                // SAFETY: per the contract.
+                unsafe { ffi::get_int64(instance, references, n_references, values, n_values) }
+            }
+
+            /// # Safety
+            /// An instance of this library; arrays of the lengths given.
+            #[unsafe(no_mangle)]
+            pub unsafe extern "C" fn fmi3SetInt64(
+                instance: *mut c_void,
+                references: *const u32,
+                n_references: usize,
+                values: *const i64,
+                n_values: usize,
+            ) -> Status {
+                // SAFETY: per the contract.
+                unsafe { ffi::set_int64(instance, references, n_references, values, n_values) }
+            }
+
+            /// # Safety
             /// An instance of this library; the out-pointers null or writable.
             #[unsafe(no_mangle)]
             #[allow(clippy::too_many_arguments)]
@@ -257,10 +285,10 @@ macro_rules! export {
                     fmi3GetNumberOfVariableDependencies, fmi3GetVariableDependencies;
                 "it has no structural parameters" => fmi3EnterConfigurationMode,
                     fmi3ExitConfigurationMode;
-                "its variables are all Float64" => fmi3GetFloat32, fmi3SetFloat32,
-                    fmi3GetInt8, fmi3SetInt8, fmi3GetUInt8, fmi3SetUInt8, fmi3GetInt16,
-                    fmi3SetInt16, fmi3GetUInt16, fmi3SetUInt16, fmi3GetInt32, fmi3SetInt32,
-                    fmi3GetUInt32, fmi3SetUInt32, fmi3GetInt64, fmi3SetInt64, fmi3GetUInt64,
+                "its variables are Float64 but for the integrator, an Enumeration (Int64)" =>
+                    fmi3GetFloat32, fmi3SetFloat32, fmi3GetInt8, fmi3SetInt8, fmi3GetUInt8,
+                    fmi3SetUInt8, fmi3GetInt16, fmi3SetInt16, fmi3GetUInt16, fmi3SetUInt16,
+                    fmi3GetInt32, fmi3SetInt32, fmi3GetUInt32, fmi3SetUInt32, fmi3GetUInt64,
                     fmi3SetUInt64, fmi3GetBoolean, fmi3SetBoolean, fmi3GetString,
                     fmi3SetString, fmi3GetBinary, fmi3SetBinary;
             }

@@ -10,7 +10,22 @@
 
 use crate::drive::constant_speed_drives;
 use camchain_runtime::columns::columns;
-use camchain_runtime::{Dynamics, JointKind};
+use camchain_runtime::{Dynamics, IntegratorKind, JointKind};
+
+/// The Enumeration value of an integrator: its place in [`IntegratorKind::ALL`], from 1.
+pub fn integrator_value(kind: IntegratorKind) -> i64 {
+    IntegratorKind::ALL
+        .iter()
+        .position(|&k| k == kind)
+        .map_or(0, |i| i as i64 + 1)
+}
+
+/// The integrator of an Enumeration value, `None` outside the items.
+pub fn integrator_of(value: i64) -> Option<IntegratorKind> {
+    usize::try_from(value - 1)
+        .ok()
+        .and_then(|i| IntegratorKind::ALL.get(i).copied())
+}
 
 /// What a variable is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,6 +46,9 @@ pub enum Role {
 /// The integrator's settings an FMU exposes as parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Setting {
+    /// The integrator: an Enumeration (`Integrator`) whose items are the runtime's
+    /// integrators, numbered from 1 in [`IntegratorKind::ALL`]'s order.
+    Integrator,
     /// Relative tolerance of the adaptive integrators.
     Rtol,
     /// Absolute tolerance of the adaptive integrators.
@@ -41,11 +59,17 @@ pub enum Setting {
 
 impl Setting {
     /// Every setting, in value-reference order.
-    pub const ALL: [Setting; 3] = [Setting::Rtol, Setting::Atol, Setting::Dt];
+    pub const ALL: [Setting; 4] = [
+        Setting::Integrator,
+        Setting::Rtol,
+        Setting::Atol,
+        Setting::Dt,
+    ];
 
     /// The variable's name.
     pub fn name(self) -> &'static str {
         match self {
+            Setting::Integrator => "solver.integrator",
             Setting::Rtol => "solver.rtol",
             Setting::Atol => "solver.atol",
             Setting::Dt => "solver.dt",
@@ -55,6 +79,7 @@ impl Setting {
     /// Its unit and description.
     fn about(self) -> (&'static str, &'static str) {
         match self {
+            Setting::Integrator => ("", "the integrator (rk4, dopri5, dop853)"),
             Setting::Rtol => ("", "relative tolerance of the adaptive integrators"),
             Setting::Atol => ("", "absolute tolerance of the adaptive integrators"),
             Setting::Dt => (
@@ -122,6 +147,7 @@ pub fn variables(model: &dyn Dynamics) -> Vec<Variable> {
     for setting in Setting::ALL {
         let (unit, description) = setting.about();
         let start = match setting {
+            Setting::Integrator => integrator_value(info.defaults.integrator) as f64,
             Setting::Rtol => info.defaults.rtol,
             Setting::Atol => info.defaults.atol,
             Setting::Dt => info.defaults.dt,

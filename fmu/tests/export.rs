@@ -4,7 +4,7 @@
 
 use camchain_fmu::description::token;
 use camchain_fmu::variables::{Role, variables};
-use camchain_runtime::{Dynamics, SimSettings, Simulate};
+use camchain_runtime::{Dynamics, IntegratorKind, SimSettings, Simulate};
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::sync::Mutex;
 
@@ -64,6 +64,15 @@ unsafe extern "C" {
         last: *mut f64,
     ) -> i32;
     fn fmi3GetFMUState(instance: *mut c_void, state: *mut *mut c_void) -> i32;
+    fn fmi3GetInt64(instance: *mut c_void, r: *const u32, nr: usize, v: *mut i64, nv: usize)
+    -> i32;
+    fn fmi3SetInt64(
+        instance: *mut c_void,
+        r: *const u32,
+        nr: usize,
+        v: *const i64,
+        nv: usize,
+    ) -> i32;
 }
 
 /// The messages the FMU logged, across the tests of this binary (each test looks for its own).
@@ -379,4 +388,62 @@ fn a_speed_step_through_the_input_drives_the_cam_as_that_speed_does() {
     println!("largest gap after the speed step: {worst:e}");
     // SAFETY: freed once.
     unsafe { fmi3FreeInstance(instance) };
+}
+
+/// The integrator is an Enumeration parameter: RK4 chosen through fmi3SetInt64, with its step
+/// through solver.dt, lands on every communication point as the runtime's own RK4 run lands
+/// on every output time, so the two take the same steps: equal to round-off (1e-12 of each
+/// column's scale; measured gap printed).
+#[test]
+fn the_integrator_is_a_parameter() {
+    let info = model().info();
+    let instance = instantiate(&token(model()));
+    let integrator = reference("solver.integrator");
+    let mut value = 0i64;
+    // SAFETY: one reference, one value.
+    assert_eq!(
+        unsafe { fmi3GetInt64(instance, &integrator, 1, &mut value, 1) },
+        0
+    );
+    assert_eq!(
+        camchain_fmu::variables::integrator_of(value),
+        Some(info.defaults.integrator)
+    );
+    let rk4 = camchain_fmu::variables::integrator_value(IntegratorKind::Rk4);
+    let bad = 99i64;
+    // SAFETY: as above.
+    unsafe {
+        assert_eq!(fmi3SetInt64(instance, &integrator, 1, &bad, 1), 3);
+        assert_eq!(fmi3SetInt64(instance, &integrator, 1, &rk4, 1), 0);
+    }
+    assert!(logged("solver.integrator = 99: not an item of Integrator"));
+    let mut x = 0.0;
+    // SAFETY: as above.
+    assert_eq!(
+        unsafe { fmi3GetFloat64(instance, &integrator, 1, &mut x, 1) },
+        3
+    );
+    assert_eq!(set(instance, reference("solver.dt"), 2.5e-4), 0);
+    let rows = run(instance, 0.2, 1e-3);
+    // SAFETY: freed once.
+    unsafe { fmi3FreeInstance(instance) };
+    let settings = SimSettings {
+        t_end: 0.2,
+        dt_out: 1e-3,
+        integrator: IntegratorKind::Rk4,
+        dt: 2.5e-4,
+        ..info.defaults.clone()
+    };
+    let state = model().assemble(0.0).expect("assembles");
+    let trajectory = model().simulate(state, &settings).expect("runs");
+    let mut worst: f64 = 0.0;
+    for (got, sample) in rows.iter().zip(&trajectory.samples) {
+        let want = camchain_runtime::columns::values(info, sample);
+        for (a, b) in got.iter().zip(&want) {
+            let gap = (a - b).abs() / b.abs().max(1.0);
+            worst = worst.max(gap);
+            assert!(gap <= 1e-12, "{a} against {b} at t = {}", want[0]);
+        }
+    }
+    println!("RK4 through the FMU against the runtime's RK4: {worst:e}");
 }

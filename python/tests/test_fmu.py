@@ -255,3 +255,25 @@ def test_every_builtin_model_exports_an_fmu_that_fmpy_validates(cli, cache, expo
             failed[name] = problems
     assert failed == {}
     assert len(list(tmp_path.glob("*.fmu"))) == len(camchain.models())
+
+
+def test_the_integrator_is_an_enumeration_parameter(exported, cli_csv):
+    # RK4 chosen through FMPy (the Enumeration's item 1, set with fmi3SetInt64) with its step:
+    # it lands on every communication point as the command line's RK4 lands on every output
+    # time, so the two take the same steps (1e-12 of each column's scale).
+    fmu = str(exported["cycloidal_roller"])
+    md = read_model_description(fmu)
+    integrator = next(v for v in md.modelVariables if v.name == "solver.integrator")
+    assert integrator.type == "Enumeration"
+    items = {item.name: int(item.value) for item in integrator.declaredType.items}
+    assert items == {"rk4": 1, "dopri5": 2, "dop853": 3}
+    result = simulate_fmu(
+        fmu,
+        stop_time=0.2,
+        output_interval=1e-3,
+        start_values={"solver.integrator": items["rk4"], "solver.dt": 2.5e-4},
+    )
+    header, rows = cli_csv(
+        "cycloidal_roller", "--t-end", "0.2", "--dt-out", "0.001", "--integrator", "rk4", "--dt", "2.5e-4"
+    )
+    columns_match(result, header, rows, 1e-12)
