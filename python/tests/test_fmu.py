@@ -288,12 +288,13 @@ def test_the_integrator_is_an_enumeration_parameter(exported, cli_csv):
 
 def test_a_model_file_exports_with_its_tables(cli, cache, repository, tmp_path, cli_csv):
     # A model file (not a built-in name) whose profile is a table of points beside it: the
-    # export reads the table as the build does, and the FMU runs as the command line runs the
-    # file (on its numeric reference: the two routes agree to the integration error).
+    # export reads the table as the build does, and the FMU runs as the built-in model made
+    # from the same file does (the command line's run of the file itself is its numeric
+    # reference, which scans the table at every call: 18 s for these 0.2 s).
     model = repository / "models" / "table_cam.ron"
     fmu = tmp_path / "table_cam.fmu"
     cli("fmu", model, "--out", fmu, "--cache", cache, "--quiet")
     assert validate_fmu(str(fmu)) == []
-    header, rows = cli_csv(model, "--t-end", "0.2", "--dt-out", "0.001")
+    header, rows = cli_csv("table_cam", "--t-end", "0.2", "--dt-out", "0.001")
     result = simulate_fmu(str(fmu), stop_time=0.2, output_interval=1e-3)
     columns_match(result, header, rows, 1e-6)
