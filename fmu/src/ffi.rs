@@ -248,20 +248,21 @@ pub unsafe fn transition(instance: *mut c_void, call: &str) -> Status {
     }
 }
 
-/// `fmi3GetFloat64`.
+/// `fmi3Get<Type>` of scalar variables: `read` gives each reference's value, written into
+/// `values` in order.
 ///
 /// # Safety
-/// `instance` is null or a pointer `instantiate_co_simulation` returned, not yet freed; `references` holds `n_references` values, `values` room for `n_values`.
-pub unsafe fn get_float64(
+/// As [`with`]; `references` holds `n_references` values, `values` room for `n_values`.
+unsafe fn get_values<T>(
     instance: *mut c_void,
-    references: *const u32,
-    n_references: usize,
-    values: *mut f64,
-    n_values: usize,
+    call: &str,
+    (references, n_references): (*const u32, usize),
+    (values, n_values): (*mut T, usize),
+    read: impl Fn(&mut Instance, u32) -> Result<T, String>,
 ) -> Status {
     // SAFETY: per the contract.
     unsafe {
-        with(instance, "fmi3GetFloat64", |h| {
+        with(instance, call, |h| {
             let references = slice(references, n_references).ok_or("null value references")?;
             if n_values != n_references {
                 return Err(format!(
@@ -272,28 +273,27 @@ pub unsafe fn get_float64(
                 return Err("null values".into());
             }
             for (k, &r) in references.iter().enumerate() {
-                let value = h.instance.get(r)?;
-                values.add(k).write(value);
+                values.add(k).write(read(&mut h.instance, r)?);
             }
             Ok(OK)
         })
     }
 }
 
-/// `fmi3SetFloat64`.
+/// `fmi3Set<Type>` of scalar variables: `write` takes each reference's value, in order.
 ///
 /// # Safety
-/// As [`get_float64`].
-pub unsafe fn set_float64(
+/// As [`get_values`], `values` holding `n_values` values.
+unsafe fn set_values<T: Copy>(
     instance: *mut c_void,
-    references: *const u32,
-    n_references: usize,
-    values: *const f64,
-    n_values: usize,
+    call: &str,
+    (references, n_references): (*const u32, usize),
+    (values, n_values): (*const T, usize),
+    write: impl Fn(&mut Instance, u32, T) -> Result<(), String>,
 ) -> Status {
     // SAFETY: per the contract.
     unsafe {
-        with(instance, "fmi3SetFloat64", |h| {
+        with(instance, call, |h| {
             let references = slice(references, n_references).ok_or("null value references")?;
             let values = slice(values, n_values).ok_or("null values")?;
             if n_values != n_references {
@@ -302,11 +302,44 @@ pub unsafe fn set_float64(
                 ));
             }
             for (&r, &v) in references.iter().zip(values) {
-                h.instance.set(r, v)?;
+                write(&mut h.instance, r, v)?;
             }
             Ok(OK)
         })
     }
+}
+
+/// `fmi3GetFloat64`.
+///
+/// # Safety
+/// `instance` as for [`with`]; `references` holds `n_references` values, `values` room for
+/// `n_values`.
+pub unsafe fn get_float64(
+    instance: *mut c_void,
+    references: *const u32,
+    n_references: usize,
+    values: *mut f64,
+    n_values: usize,
+) -> Status {
+    let (refs, out) = ((references, n_references), (values, n_values));
+    // SAFETY: per the contract.
+    unsafe { get_values(instance, "fmi3GetFloat64", refs, out, Instance::get) }
+}
+
+/// `fmi3SetFloat64`.
+///
+/// # Safety
+/// As [`get_float64`], `values` holding `n_values` values.
+pub unsafe fn set_float64(
+    instance: *mut c_void,
+    references: *const u32,
+    n_references: usize,
+    values: *const f64,
+    n_values: usize,
+) -> Status {
+    let (refs, given) = ((references, n_references), (values, n_values));
+    // SAFETY: per the contract.
+    unsafe { set_values(instance, "fmi3SetFloat64", refs, given, Instance::set) }
 }
 
 /// `fmi3GetInt64`.
@@ -320,30 +353,15 @@ pub unsafe fn get_int64(
     values: *mut i64,
     n_values: usize,
 ) -> Status {
+    let (refs, out) = ((references, n_references), (values, n_values));
     // SAFETY: per the contract.
-    unsafe {
-        with(instance, "fmi3GetInt64", |h| {
-            let references = slice(references, n_references).ok_or("null value references")?;
-            if n_values != n_references {
-                return Err(format!(
-                    "{n_values} values for {n_references} scalar variables"
-                ));
-            }
-            if n_values > 0 && values.is_null() {
-                return Err("null values".into());
-            }
-            for (k, &r) in references.iter().enumerate() {
-                values.add(k).write(h.instance.get_int64(r)?);
-            }
-            Ok(OK)
-        })
-    }
+    unsafe { get_values(instance, "fmi3GetInt64", refs, out, |i, r| i.get_int64(r)) }
 }
 
 /// `fmi3SetInt64`.
 ///
 /// # Safety
-/// As [`get_float64`].
+/// As [`set_float64`].
 pub unsafe fn set_int64(
     instance: *mut c_void,
     references: *const u32,
@@ -351,22 +369,9 @@ pub unsafe fn set_int64(
     values: *const i64,
     n_values: usize,
 ) -> Status {
+    let (refs, given) = ((references, n_references), (values, n_values));
     // SAFETY: per the contract.
-    unsafe {
-        with(instance, "fmi3SetInt64", |h| {
-            let references = slice(references, n_references).ok_or("null value references")?;
-            let values = slice(values, n_values).ok_or("null values")?;
-            if n_values != n_references {
-                return Err(format!(
-                    "{n_values} values for {n_references} scalar variables"
-                ));
-            }
-            for (&r, &v) in references.iter().zip(values) {
-                h.instance.set_int64(r, v)?;
-            }
-            Ok(OK)
-        })
-    }
+    unsafe { set_values(instance, "fmi3SetInt64", refs, given, Instance::set_int64) }
 }
 
 /// `fmi3DoStep`.

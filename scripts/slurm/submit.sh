@@ -11,7 +11,7 @@
 # be met) or the merge refused the shards. Prints the two job ids.
 set -euo pipefail
 if [[ $# -lt 5 ]]; then
-    sed -n '2,12p' "$0" >&2
+    sed -n '2,11p' "$0" >&2
     exit 2
 fi
 dir=$1 model=$2 shards=$3 at_once=$4 params=$5 wait=${6:-}

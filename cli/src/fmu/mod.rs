@@ -112,17 +112,7 @@ pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
         print!("{xml}");
         return Ok(());
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{id}.fmu")));
-    // The destination is checked (and locked) before the build, so that a build is not
-    // wasted on a path that cannot be written.
-    let _lock = if args.describe {
-        None
-    } else {
-        super::output::claim(&out).map_err(CliError::Failed)?
-    };
+    let (out, _lock) = destination(args, &id)?;
     let options = EmitOptions {
         runtime_path: "::camchain_runtime".into(),
         files_dir: source.files_dir.clone(),
@@ -179,6 +169,25 @@ pub fn run(args: &FmuArgs, interrupt: &Interrupt) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The FMU's path (`--out`, else `<id>.fmu`), checked and locked before anything is built, so
+/// that no build is wasted on a path that cannot be written (no lock with `--describe`, which
+/// writes no file).
+fn destination(
+    args: &FmuArgs,
+    id: &str,
+) -> Result<(PathBuf, Option<super::output::Lock>), CliError> {
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{id}.fmu")));
+    let lock = if args.describe {
+        None
+    } else {
+        super::output::claim(&out).map_err(CliError::Failed)?
+    };
+    Ok((out, lock))
+}
+
 /// Writes the FMU: the description and the library as `binaries/<platform>/<id>.so`.
 fn pack(
     out: &Path,
@@ -209,15 +218,7 @@ fn pack_library(args: &FmuArgs, library: &Path, platform: &str) -> Result<(), Cl
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let id = identifier(stem.strip_prefix("lib").unwrap_or(&stem));
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{id}.fmu")));
-    let _lock = if args.describe {
-        None
-    } else {
-        super::output::claim(&out).map_err(CliError::Failed)?
-    };
+    let (out, _lock) = destination(args, &id)?;
     let xml = describe(library, &id)?;
     if args.describe {
         print!("{xml}");
