@@ -12,8 +12,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Set by cargo when the `random-models` feature is on (this package's own tests).
     if std::env::var_os("CARGO_FEATURE_RANDOM_MODELS").is_some() {
         let out = std::path::PathBuf::from(std::env::var("OUT_DIR")?).join("random_models");
+        // The articulated-body sweeps: tests/suite/random_compiled.rs compares them with the
+        // numeric reference and runs them against the reference's simulations.
         camchain_build::Config::new()
             .out_dir(out)
+            .formulation(camchain_build::Formulation::Articulated)
             .include_file("random_models.rs")
             .compile_models(&["tests/random_models"])?;
         // The contact kinds the built-in models do not use (tests/suite/contacts_compiled.rs).
@@ -54,11 +57,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect();
         files.sort();
-        for (dir, mode) in [
-            ("folded", camchain_build::ParameterMode::FoldAll),
+        // The second copy also gets the articulated-body sweeps, checked against the folded
+        // copy's dense M, F and Q (tests/common/articulated.rs) and taking that route in
+        // every run of it.
+        for (dir, mode, formulation) in [
+            (
+                "folded",
+                camchain_build::ParameterMode::FoldAll,
+                camchain_build::Formulation::Auto,
+            ),
             (
                 "all_at_run_time",
                 camchain_build::ParameterMode::AllAtRunTime,
+                camchain_build::Formulation::Articulated,
             ),
         ] {
             // Entry points as calls of the fused pair: the comparison reads values, not the
@@ -67,6 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             camchain_build::Config::new()
                 .out_dir(out.join(dir))
                 .parameters(mode)
+                .formulation(formulation)
                 .entry_points(camchain_build::EntryPoints::ViaFusedPair)
                 .include_file("models.rs")
                 .compile_models(&files)?;

@@ -101,7 +101,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-pub use camchain_codegen::EntryPoints;
+pub use camchain_codegen::{EntryPoints, Formulation};
 
 /// The directory under `OUT_DIR` that [`compile_models`] writes to by default, and that
 /// `camchain::include_model!` reads from.
@@ -199,6 +199,16 @@ impl Config {
     /// [`EntryPoints::Auto`]: their own expressions unless the model is large.
     pub fn entry_points(&mut self, entry_points: EntryPoints) -> &mut Self {
         self.options.entry_points = entry_points;
+        self
+    }
+
+    /// Which forward dynamics the generated code gives the runtime: the dense mass matrix
+    /// factored at run time, or the articulated-body sweeps (O(n) per sweep, one more sweep
+    /// per constraint row). Default [`Formulation::Auto`]: the one with the smaller
+    /// estimated operation count per right-hand side, shown in the generated header with
+    /// the other's. A model file's `simulation: (formulation: …)` takes precedence.
+    pub fn formulation(&mut self, formulation: Formulation) -> &mut Self {
+        self.options.formulation = formulation;
         self
     }
 

@@ -1,6 +1,7 @@
 //! The whole symbolic derivation of a model: kinematics, cam constraints, dynamics, energy
 //! and prescribed motions, all in one expression graph.
 
+use crate::articulated::{ArticulatedTerms, articulated};
 use crate::contact::{ContactTerms, contact_terms};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::scalar::{scalar_to_expr, value_and_derivatives};
@@ -50,6 +51,9 @@ pub struct Derivation {
     pub energy: EnergyTerms,
     /// Prescribed motions of driven joints.
     pub drives: Vec<DriveTerms>,
+    /// The articulated-body forward dynamics (derived after the rest, so that the other
+    /// terms' graph is what it would be without them).
+    pub articulated: ArticulatedTerms,
     /// The value of every model parameter (what the interpreter gives the run-time ones).
     pub parameter_values: Vec<f64>,
     /// Every numeric field that depends on run-time parameters, as an expression of them
@@ -141,13 +145,26 @@ impl Derivation {
         if !d.graph.exhausted() {
             d.collect_linear();
         }
+        d.derive_articulated(model);
         d
     }
 
     /// The derivation before [`linear::collect_linear`]: what the recursions build, for
     /// comparisons (the pass must never cost operations).
     pub fn uncollected(model: &Model) -> Self {
-        Self::uncollected_in(model, Graph::new())
+        let mut d = Self::uncollected_in(model, Graph::new());
+        d.derive_articulated(model);
+        d
+    }
+
+    /// The articulated-body terms, on the kinematics (rebuilt: the graph returns the nodes
+    /// it already holds).
+    fn derive_articulated(&mut self, model: &Model) {
+        if self.graph.exhausted() {
+            return;
+        }
+        let kin = forward(&mut self.graph, model, &self.symbols);
+        self.articulated = articulated(&mut self.graph, model, &self.symbols, &kin);
     }
 
     fn uncollected_in(model: &Model, mut g: Graph) -> Self {
@@ -203,6 +220,7 @@ impl Derivation {
             loops,
             energy,
             drives,
+            articulated: ArticulatedTerms::default(),
             parameter_values: model.parameters.iter().map(|p| p.value).collect(),
             fields,
             profile_checks,

@@ -65,13 +65,13 @@ pub fn backward(
 
 /// Spatial inertia about a frame origin, in that frame.
 #[derive(Debug, Clone, Copy)]
-struct Inertia {
+pub(crate) struct Inertia {
     /// Mass.
-    mass: Id,
+    pub(crate) mass: Id,
     /// First moment h = Σ m c.
-    first: V3,
+    pub(crate) first: V3,
     /// Inertia tensor about the origin (symmetric).
-    tensor: [V3; 3],
+    pub(crate) tensor: [V3; 3],
 }
 
 /// Numeric mass, first moment and inertia about the joint point of one body.
@@ -98,7 +98,7 @@ fn inertia_fields(i: usize) -> impl Iterator<Item = Field> {
 /// Body i's mass, first moment and inertia about its joint point: constants computed here
 /// when none of its fields is read at run time, otherwise expressions of the parameters
 /// (the same formulas in the graph).
-fn body_inertia(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Inertia {
+pub(crate) fn body_inertia(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Inertia {
     let body = &model.bodies[i];
     if Symbols::any_runtime(model, inertia_fields(i)) {
         return body_inertia_symbolic(g, model, s, i);
@@ -182,7 +182,7 @@ fn to_parent(g: &mut Graph, child: &BodyKinematics, c: &Inertia) -> Inertia {
 }
 
 /// R I Rᵀ for the child's joint rotation (upper triangle computed, mirrored).
-fn rotate_tensor(g: &mut Graph, child: &BodyKinematics, t: &[V3; 3]) -> [V3; 3] {
+pub(crate) fn rotate_tensor(g: &mut Graph, child: &BodyKinematics, t: &[V3; 3]) -> [V3; 3] {
     if child.relative == crate::kinematics::Rotation::Identity {
         return *t;
     }
@@ -222,7 +222,7 @@ fn add_inertia(g: &mut Graph, a: &Inertia, b: &Inertia) -> Inertia {
     }
 }
 
-fn mat_vec(g: &mut Graph, m: &[V3; 3], v: V3) -> V3 {
+pub(crate) fn mat_vec(g: &mut Graph, m: &[V3; 3], v: V3) -> V3 {
     [
         vec3::dot(g, m[0], v),
         vec3::dot(g, m[1], v),
@@ -231,7 +231,7 @@ fn mat_vec(g: &mut Graph, m: &[V3; 3], v: V3) -> V3 {
 }
 
 /// The children of every body.
-fn children(model: &Model) -> Vec<Vec<usize>> {
+pub(crate) fn children(model: &Model) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new(); model.n()];
     for (i, b) in model.bodies.iter().enumerate() {
         if let Some(p) = b.parent {
@@ -243,7 +243,7 @@ fn children(model: &Model) -> Vec<Vec<usize>> {
 
 /// A spatial force (moment about the frame origin, force), moved from a child's frame to its
 /// parent's: f' = R f, n' = R n + r × f'.
-fn force_to_parent(g: &mut Graph, child: &BodyKinematics, n: V3, f: V3) -> (V3, V3) {
+pub(crate) fn force_to_parent(g: &mut Graph, child: &BodyKinematics, n: V3, f: V3) -> (V3, V3) {
     let f = child.relative.apply(g, f);
     let n = child.relative.apply(g, n);
     let r_f = vec3::cross(g, child.offset, f);
@@ -477,7 +477,7 @@ fn subtree_masses(g: &mut Graph, model: &Model, s: &Symbols) -> Vec<Id> {
 }
 
 /// k (q − rest) + c q̇ of joint i (the sign of Q in M q̈ + F + Q = 0).
-fn spring_damper_load(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Id {
+pub(crate) fn spring_damper_load(g: &mut Graph, model: &Model, s: &Symbols, i: usize) -> Id {
     let Some(sd) = model.bodies[i].joint.spring else {
         return g.zero();
     };

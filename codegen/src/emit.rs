@@ -26,6 +26,7 @@ use crate::expr::{Id, OpCount};
 use crate::model::Model;
 use std::fmt::Write;
 
+mod articulated;
 mod contacts;
 mod docs;
 mod emitter;
@@ -47,6 +48,7 @@ mod testing;
 mod trigonometry;
 mod wrapper;
 
+pub use articulated::{Choice, Formulation};
 use contacts::{contact_kinematics_dispatch, contact_kinematics_helpers, contact_kinematics_specs};
 use docs::ConstraintDocs;
 use function::emit_function_full;
@@ -127,6 +129,10 @@ pub struct EmitOptions {
     /// that links `camchain-runtime` with `default-features = false` (the contract alone, no
     /// linear algebra, the fastest cold build) turns them off and simulates elsewhere.
     pub simulation_methods: bool,
+    /// Which forward dynamics the generated code gives the runtime ([`Formulation`]): by
+    /// default the one with the smaller estimated operation count per right-hand side (the
+    /// header shows both estimates).
+    pub formulation: Formulation,
 }
 
 impl Default for EmitOptions {
@@ -140,6 +146,7 @@ impl Default for EmitOptions {
             node_limit: crate::expr::NODE_LIMIT,
             code_limit: MAX_CODE_BYTES,
             simulation_methods: true,
+            formulation: Formulation::Auto,
         }
     }
 }
@@ -179,7 +186,14 @@ pub fn generate_from(
     let specs = function_specs(model, &mut d);
     let parametric = model.runtime_parameters().next().is_some();
     let kinematics_specs = contact_kinematics_specs(model, &mut d, parametric);
-    let mut fused = FusedTerms::new(&mut d);
+    // The model file's choice, unless it leaves it to the build's.
+    let asked = match model.simulation.formulation {
+        Formulation::Auto => options.formulation,
+        chosen => chosen,
+    };
+    let choice = articulated::choose(&d, &dense_roots(&d), asked);
+    let aba = choice.articulated.then(|| articulated::outputs(&d));
+    let mut fused = FusedTerms::new(&mut d, aba);
     if let Some(e) = d.too_large(model) {
         return Err(e.to_string());
     }
@@ -255,6 +269,29 @@ pub fn generate_from(
          fn cache_len(&self) -> usize {{ {} }}",
         fused.cache_len()
     );
+    if choice.articulated {
+        let cache_given = fused.cache_given();
+        let (aba_specs, factors) = articulated::specs(
+            &d,
+            &fused.articulated,
+            &fused.response,
+            &cache_given,
+            fused.cache_len() > 0,
+            &derived("self."),
+        );
+        for (spec, given) in &aba_specs {
+            let (text, count) = emit_function_full(&d, spec, "", true, given, &[], &[]);
+            functions.push_str(&text);
+            within_code_limit(functions.len(), options.code_limit)?;
+            op_counts.push((spec.name.clone(), count));
+        }
+        let _ = writeln!(
+            functions,
+            "/// Entries of the factors `articulated_terms` writes for `articulated_response`.\n\
+             fn articulated_len(&self) -> usize {{ {} }}",
+            factors.max(1)
+        );
+    }
     let mut helpers =
         contact_kinematics_helpers(&d, &kinematics_specs, &mut op_counts, &derived(""));
     helpers.push_str(&implicit_helpers(&d, &mut op_counts, &derived("")));
@@ -307,7 +344,7 @@ pub fn generate_from(
         source: source.to_string(),
         code: format!(
             "{}\n{}",
-            header(model, source, &op_counts, wrap, runtime.is_some()),
+            header(model, source, &op_counts, wrap, runtime.is_some(), &choice),
             formatted
         ),
         op_counts,
@@ -319,6 +356,20 @@ pub fn generate_from(
 /// bodies, `codegen/tests/common/chain.rs`, is 17.6 MB of text and takes 1.0 GB in all), and
 /// no compiler builds a much longer module in reasonable time; a model whose code would be
 /// longer is refused before it is formatted.
+/// The velocity level's outputs of the dense route: M, F, Q and every row's c.
+fn dense_roots(d: &Derivation) -> Vec<Id> {
+    let dy = &d.dynamics;
+    let rows = d.constraint_rows();
+    dy.mass
+        .iter()
+        .flatten()
+        .chain(&dy.inertial)
+        .chain(&dy.applied)
+        .copied()
+        .chain(rows.iter().map(|r| r.2))
+        .collect()
+}
+
 pub const MAX_CODE_BYTES: usize = 32 << 20;
 
 /// An error when the generated text (`len` bytes) has grown past `limit`

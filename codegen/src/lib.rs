@@ -17,6 +17,7 @@
 //! - [`design`]: cams designed from a follower's motion law (the envelope construction).
 //! - [`emit`]: the generated Rust module.
 
+pub mod articulated;
 pub mod assembly;
 pub mod contact;
 pub mod derive;
@@ -36,7 +37,7 @@ pub use derive::Derivation;
 pub use error::ModelError;
 pub use model::{Model, ParameterMode};
 
-pub use emit::{EmitOptions, EntryPoints, Generated};
+pub use emit::{Choice, EmitOptions, EntryPoints, Formulation, Generated};
 
 use std::path::Path;
 

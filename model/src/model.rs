@@ -6,7 +6,7 @@
 //! parsed profile and drive expressions.
 
 use crate::profile::Scalar;
-pub use camchain_runtime::{FollowerKind, IntegratorKind, JointKind, LoopKind};
+pub use camchain_runtime::{FollowerKind, Formulation, IntegratorKind, JointKind, LoopKind};
 use serde::Deserialize;
 
 mod cam_profile;
@@ -334,6 +334,8 @@ pub struct Simulation {
     /// One-sided contact with this coefficient of restitution (in [0, 1]), or `None` for
     /// bilateral contact.
     pub restitution: Option<f64>,
+    /// How the generated code solves for the accelerations (default: by operation count).
+    pub formulation: Formulation,
 }
 
 /// Initial guess and assembly instructions.

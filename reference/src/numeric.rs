@@ -665,6 +665,7 @@ mod tests {
                 rtol: 1e-8,
                 atol: 1e-10,
                 restitution: None,
+                formulation: Default::default(),
             },
             files: Vec::new(),
         }

@@ -9,7 +9,7 @@
 //! Matrices are dense row-major slices so that generated code can write them without
 //! allocation.
 
-pub use crate::kinds::{FollowerKind, IntegratorKind, JointKind, LoopKind};
+pub use crate::kinds::{FollowerKind, Formulation, IntegratorKind, JointKind, LoopKind};
 
 /// Description of one generalised coordinate.
 #[derive(Debug, Clone, PartialEq)]
@@ -547,6 +547,63 @@ pub trait Dynamics {
         self.equations(t, q, qd, out.mass, out.inertial, out.applied);
         self.constraint_bias(q, qd, out.bias);
     }
+
+    /// The length of the factors [`Dynamics::articulated_terms`] writes; 0 (the default)
+    /// when the model does not provide the articulated-body forward dynamics, whose two
+    /// functions are then never called.
+    fn articulated_len(&self) -> usize {
+        0
+    }
+
+    /// The articulated-body forward dynamics at (t, q, q̇) without constraint forces (docs/
+    /// method.md §12), reading `cache` as filled by [`Dynamics::position_terms`] at the same
+    /// q: see [`ArticulatedTerms`]. Provided by generated models whose
+    /// [`Dynamics::articulated_len`] is not 0; the default writes NaN.
+    fn articulated_terms(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        cache: &[f64],
+        out: ArticulatedTerms<'_>,
+    ) {
+        let _ = (t, q, qd, cache);
+        out.qdd.fill(f64::NAN);
+        out.drive.fill(f64::NAN);
+    }
+
+    /// For a generalised force τ (length n, driven entries ignored): x = M_ff⁻¹ τ_f on the
+    /// free coordinates into `qdd`, and M_df x on the driven ones into `drive` (other
+    /// entries unchanged), M at the q of the `articulated_terms` call that wrote `factors`.
+    /// The default writes NaN.
+    fn articulated_response(
+        &self,
+        factors: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+        drive: &mut [f64],
+    ) {
+        let _ = (factors, tau);
+        qdd.fill(f64::NAN);
+        drive.fill(f64::NAN);
+    }
+}
+
+/// Buffers of [`Dynamics::articulated_terms`].
+#[derive(Debug)]
+pub struct ArticulatedTerms<'a> {
+    /// In: q̈ of the driven coordinates. Out: q̈ of the free ones (independent and
+    /// dependent) without constraint forces, i.e. solving the free rows of
+    /// `M q̈ + F + Q = 0` (13).
+    pub qdd: &'a mut [f64],
+    /// Out: the driven coordinates' rows of `M q̈ + F + Q` at those accelerations (the load
+    /// the drive supplies before the constraint forces). Other entries are left unchanged.
+    pub drive: &'a mut [f64],
+    /// Out: c(q, q̇), eqs. (7, 8), one entry per constraint.
+    pub bias: &'a mut [f64],
+    /// Out: what [`Dynamics::articulated_response`] reads (length
+    /// [`Dynamics::articulated_len`]).
+    pub factors: &'a mut [f64],
 }
 
 /// Output buffers of [`Dynamics::velocity_terms`]: M (n×n, row-major), F, Q (n) and c (m).

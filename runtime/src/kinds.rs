@@ -232,6 +232,31 @@ impl LoopKind {
     }
 }
 
+/// A forward-dynamics formulation's names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FormulationSpec {
+    /// Its name in messages and output (`articulated`).
+    pub name: &'static str,
+    /// What it is, for help texts and generated headers.
+    pub about: &'static str,
+}
+
+registry! {
+    /// How a model's generated code solves for the accelerations (docs/method.md §12): the
+    /// model file's `simulation: (formulation: …)` and `camchain_build::Config::formulation`.
+    #[derive(Default)]
+    pub enum Formulation: FormulationSpec, "formulation" {
+        /// The one with the smaller estimated operation count per right-hand side.
+        #[default]
+        Auto => FormulationSpec { name: "auto", about: "the smaller estimated operation count per right-hand side" },
+        /// M, F and Q formed, the reduced mass matrix factored: O(n²) to form, O(n³) to
+        /// factor, the least work for small models.
+        Dense => FormulationSpec { name: "dense", about: "the mass matrix formed and the reduced system factored" },
+        /// The articulated-body sweeps, O(n) each, one more sweep per constraint row.
+        Articulated => FormulationSpec { name: "articulated", about: "the articulated-body sweeps, one more per constraint row" },
+    }
+}
+
 /// An integrator's names and properties.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct IntegratorSpec {

@@ -5,6 +5,8 @@
 use camchain::runtime::Dynamics;
 use std::cell::Cell;
 
+pub mod articulated;
+
 /// A tiny deterministic generator (xorshift64) so random states are reproducible.
 pub struct Rng(u64);
 
@@ -224,6 +226,16 @@ pub fn compare_dynamics_at(
             [pq, pv, pa].concat()
         });
         assert_close_recorded(&a, &b, tol, &format!("{name}: prescribed motion"), &worst);
+        let mut rng = Rng::new(q.len() as u64 + 3);
+        let mut draw = || rng.uniform(-1.0, 1.0);
+        let residual =
+            articulated::articulated_residual(generated, numeric, (&q, &qd, t), &mut draw);
+        assert!(
+            residual <= tol,
+            "{name}: the articulated sweeps' residual in the other model's equations is \
+             {residual:e} at q = {q:?} (tolerance {tol:e})"
+        );
+        worst.set(worst.get().max(residual));
     }
     worst.get()
 }

@@ -6,7 +6,10 @@
 //! `cycloidal_roller`, `tests/golden/cycloidal_roller.rs`, a cam designed from a motion law
 //! (the law's segments as constants and their evaluation, the synthesised profile, a roller's
 //! contact parameter solved by Newton); and that of `four_bar`, `tests/golden/four_bar.rs`, a
-//! closed loop (the cut pin's two equations as rows of h, J and c, and the loop's points).
+//! closed loop (the cut pin's two equations as rows of h, J and c, and the loop's points);
+//! and `tests/golden/paper_concave_articulated.rs`, the folded paper model with the
+//! articulated-body sweeps asked for (`Formulation::Articulated`: `articulated_terms` and
+//! `articulated_response` beside the dense functions).
 //! After an intended change, regenerate them:
 //!
 //! ```sh
@@ -15,7 +18,7 @@
 //!
 //! and review the diff of `build/tests/golden/` with the change.
 
-use camchain_build::ParameterMode;
+use camchain_build::{Formulation, ParameterMode};
 use std::path::{Path, PathBuf};
 
 fn golden_path(name: &str) -> PathBuf {
@@ -30,12 +33,18 @@ fn generated(test: &str, mode: ParameterMode) -> String {
 
 /// The module `compile_models` writes for the built-in model `name`.
 fn generated_model(name: &str, test: &str, mode: ParameterMode) -> String {
+    generated_with(name, test, mode, Formulation::Auto)
+}
+
+/// … with the formulation `formulation`.
+fn generated_with(name: &str, test: &str, mode: ParameterMode, formulation: Formulation) -> String {
     let out = std::env::temp_dir().join(format!("camchain-golden-{test}-{}", std::process::id()));
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../models/{name}.ron"));
     let compiled = camchain_build::Config::new()
         .out_dir(&out)
         .emit_rerun_if_changed(false)
         .parameters(mode)
+        .formulation(formulation)
         .compile_models(&[model])
         .unwrap_or_else(|e| panic!("{e}"));
     let text = std::fs::read_to_string(&compiled[0].output).expect("the generated file");
@@ -72,6 +81,19 @@ fn the_four_bar_generates_its_golden_source() {
     compare_with_golden(
         "four_bar",
         &generated_model("four_bar", "loop", ParameterMode::AsDeclared),
+    );
+}
+
+#[test]
+fn the_articulated_paper_model_generates_its_golden_source() {
+    compare_with_golden(
+        "paper_concave_articulated",
+        &generated_with(
+            "paper_concave",
+            "articulated",
+            ParameterMode::FoldAll,
+            Formulation::Articulated,
+        ),
     );
 }
 

@@ -24,10 +24,19 @@ pub(super) struct FusedTerms {
     pub(super) memo: Vec<TrigMemo>,
     pub(super) position: Vec<(String, Id)>,
     pub(super) velocity: Vec<(String, Id)>,
+    /// The outputs of `articulated_terms` (which reads the cache as `velocity_terms` does)
+    /// and of `articulated_response`, when the model is given them.
+    pub(super) articulated: Vec<(String, Id)>,
+    pub(super) response: Vec<(String, Id)>,
 }
 
 impl FusedTerms {
-    pub(super) fn new(d: &mut Derivation) -> Self {
+    /// The pair, and with `articulated` (the outputs of `articulated_terms` and
+    /// `articulated_response`) those two functions, sharing the position level's values.
+    pub(super) fn new(
+        d: &mut Derivation,
+        articulated: Option<(super::articulated::Outputs, super::articulated::Outputs)>,
+    ) -> Self {
         let n = d.symbols.q.len();
         let dy = &d.dynamics;
         let mut position = Vec::new();
@@ -57,10 +66,27 @@ impl FusedTerms {
         }
         drop(rows);
         let roots = |outputs: &[(String, Id)]| -> Vec<Id> { outputs.iter().map(|o| o.1).collect() };
+        let (split, main_len) = match &articulated {
+            Some((main, response)) => {
+                let before = velocity.len();
+                velocity.extend(main.iter().cloned());
+                velocity.extend(response.iter().cloned());
+                (Some(before), main.len())
+            }
+            None => (None, 0),
+        };
         reuse_position_trigonometry(&mut d.graph, &roots(&position), &mut velocity);
+        let (articulated, response) = match split {
+            Some(at) => {
+                let mut rest = velocity.split_off(at);
+                let response = rest.split_off(main_len);
+                (rest, response)
+            }
+            None => (Vec::new(), Vec::new()),
+        };
         let g = &d.graph;
         let in_position = g.reachable(&roots(&position));
-        let in_velocity = g.reachable(&roots(&velocity));
+        let in_velocity = g.reachable(&[roots(&velocity), roots(&articulated)].concat());
         let cached = (0..g.len())
             .filter(|&i| in_position[i] && in_velocity[i])
             .map(|i| id_at(g, i))
@@ -81,6 +107,8 @@ impl FusedTerms {
             memo,
             position,
             velocity,
+            articulated,
+            response,
         }
     }
 
@@ -98,6 +126,20 @@ impl FusedTerms {
     /// Entries of the cache.
     pub(super) fn cache_len(&self) -> usize {
         3 * self.memo.len() + self.plain_cached().len()
+    }
+
+    /// The nodes a function of the velocity level reads from the cache, with their places.
+    pub(super) fn cache_given(&self) -> Vec<(Id, String)> {
+        let mut given: Vec<(Id, String)> = self
+            .plain_cached()
+            .into_iter()
+            .map(|(k, id)| (id, format!("cache[{k}]")))
+            .collect();
+        for m in &self.memo {
+            given.push((m.sin, format!("cache[{}]", m.slot + 1)));
+            given.push((m.cos, format!("cache[{}]", m.slot + 2)));
+        }
+        given
     }
 
     /// The two function specifications, each with the nodes it reads from the cache.
@@ -143,16 +185,7 @@ impl FusedTerms {
             outputs: self.velocity.clone(),
             tail: String::new(),
         };
-        let mut given: Vec<(Id, String)> = self
-            .plain_cached()
-            .into_iter()
-            .map(|(k, id)| (id, format!("cache[{k}]")))
-            .collect();
-        for m in &self.memo {
-            given.push((m.sin, format!("cache[{}]", m.slot + 1)));
-            given.push((m.cos, format!("cache[{}]", m.slot + 2)));
-        }
-        vec![(position, Vec::new()), (velocity, given)]
+        vec![(position, Vec::new()), (velocity, self.cache_given())]
     }
 }
 
@@ -176,6 +209,8 @@ pub(super) fn all_roots(d: &Derivation, specs: &[FunctionSpec], fused: &FusedTer
         .flat_map(|s| s.outputs.iter().map(|(_, id)| *id))
         .chain(fused.position.iter().map(|(_, id)| *id))
         .chain(fused.velocity.iter().map(|(_, id)| *id))
+        .chain(fused.articulated.iter().map(|(_, id)| *id))
+        .chain(fused.response.iter().map(|(_, id)| *id))
         .collect();
     for c in &d.contacts {
         roots.extend(contact_output_roots(c));
@@ -201,7 +236,7 @@ mod tests {
     #[test]
     fn without_constraints_the_position_level_is_empty_and_caches_nothing() {
         let (m, mut d) = derived("double_pendulum");
-        let fused = FusedTerms::new(&mut d);
+        let fused = FusedTerms::new(&mut d, None);
         assert!(fused.position.is_empty());
         // M (2×2), F (2), Q (2); no c.
         assert_eq!(fused.velocity.len(), 8);
@@ -216,7 +251,7 @@ mod tests {
     fn the_cache_holds_a_slot_triple_per_memoised_angle_then_the_plain_values() {
         // A cam on a revolute joint: its angle's sine and cosine, and the contact parameter.
         let (m, mut d) = derived("cycloidal_roller");
-        let fused = FusedTerms::new(&mut d);
+        let fused = FusedTerms::new(&mut d, None);
         assert_eq!(fused.position.len(), 1 + m.n());
         assert!(!fused.memo.is_empty());
         for (k, memo) in fused.memo.iter().enumerate() {

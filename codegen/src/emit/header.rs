@@ -14,6 +14,7 @@ pub(super) fn header(
     counts: &[(String, OpCount)],
     wrapped: bool,
     parametric: bool,
+    choice: &super::Choice,
 ) -> String {
     let mut out = String::new();
     let _ = writeln!(
@@ -49,6 +50,18 @@ pub(super) fn header(
             c.total()
         );
     }
+    let (chosen, how) = match (choice.articulated, choice.forced) {
+        (true, true) => ("the articulated-body sweeps", "as asked"),
+        (true, false) => ("the articulated-body sweeps", "the smaller estimate"),
+        (false, true) => ("the dense mass matrix", "as asked"),
+        (false, false) => ("the dense mass matrix", "the smaller estimate"),
+    };
+    let _ = writeln!(
+        out,
+        "//\n// Forward dynamics: {chosen} ({how}). Estimated operations per right-hand side:\n\
+         // dense {}, articulated {} (the position level, common to both, not included).",
+        choice.dense, choice.articulated_ops
+    );
     if parametric {
         let names: Vec<String> = model
             .runtime_parameters()
@@ -99,6 +112,13 @@ mod tests {
     use super::*;
     use crate::emit::testing::model;
 
+    const CHOICE: crate::emit::Choice = crate::emit::Choice {
+        articulated: false,
+        forced: false,
+        dense: 120,
+        articulated_ops: 300,
+    };
+
     fn counts() -> Vec<(String, OpCount)> {
         let c = OpCount {
             add_sub: 1,
@@ -111,7 +131,14 @@ mod tests {
 
     #[test]
     fn the_header_tables_every_function_and_says_what_is_read_at_run_time() {
-        let text = header(&model("double_pendulum"), "p.ron", &counts(), false, true);
+        let text = header(
+            &model("double_pendulum"),
+            "p.ron",
+            &counts(),
+            false,
+            true,
+            &CHOICE,
+        );
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(
             lines[0],
@@ -124,6 +151,10 @@ mod tests {
             )
         );
         assert!(!text.contains("call\n// `position_terms`"));
+        assert!(text.contains(
+            "// Forward dynamics: the dense mass matrix (the smaller estimate). Estimated \
+             operations per right-hand side:\n// dense 120, articulated 300"
+        ));
         assert!(
             lines
                 .iter()
@@ -133,7 +164,14 @@ mod tests {
 
     #[test]
     fn a_wrapped_module_says_which_functions_call_the_pair() {
-        let text = header(&model("double_pendulum"), "p.ron", &counts(), true, false);
+        let text = header(
+            &model("double_pendulum"),
+            "p.ron",
+            &counts(),
+            true,
+            false,
+            &CHOICE,
+        );
         assert!(text.contains("`constraint_terms` call\n// `position_terms` and `velocity_terms`"));
         assert!(!text.contains("Read at run time"));
     }

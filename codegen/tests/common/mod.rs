@@ -142,6 +142,7 @@ pub fn paper_concave() -> Model {
             rtol: 1e-10,
             atol: 1e-12,
             restitution: None,
+            formulation: Default::default(),
         },
         files: Vec::new(),
     }
@@ -280,6 +281,7 @@ pub fn spatial_tree() -> Model {
             rtol: 1e-9,
             atol: 1e-9,
             restitution: None,
+            formulation: Default::default(),
         },
         files: Vec::new(),
     }

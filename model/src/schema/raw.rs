@@ -5,7 +5,7 @@
 //! named `foo` in `Joint`"), so they are named after the file's concepts.
 
 use camchain_runtime::kinds::Kind;
-use camchain_runtime::{IntegratorKind, JointKind, LoopKind};
+use camchain_runtime::{Formulation, IntegratorKind, JointKind, LoopKind};
 use serde::de::{EnumAccess, MapAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::fmt;
@@ -558,6 +558,7 @@ pub(super) struct Simulation {
     pub rtol: f64,
     pub atol: f64,
     pub restitution: Option<f64>,
+    pub formulation: Keyword<Formulation>,
 }
 
 impl Default for Simulation {
@@ -570,6 +571,7 @@ impl Default for Simulation {
             rtol: 1e-10,
             atol: 1e-12,
             restitution: None,
+            formulation: Keyword(Formulation::Auto),
         }
     }
 }

@@ -23,6 +23,10 @@ impl Workspace {
     /// Multipliers and drive loads from (14), after [`Self::solve_accelerations`]:
     /// J_vᵀ λ = −(M q̈ + F + Q)_v, then τ_d = (M q̈ + F + Q + Jᵀλ)_d (zero elsewhere).
     pub fn solve_multipliers(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
+        if self.articulated.solved {
+            // The articulated route solved λ and the drive loads with the accelerations.
+            return Ok(());
+        }
         residual_into(
             &mut self.residual,
             &self.mass,

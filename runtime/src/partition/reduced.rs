@@ -18,6 +18,10 @@ impl Workspace {
         partition: &Partition,
         t: f64,
     ) -> Result<(), SimError> {
+        if self.articulated_route(model) {
+            return self.solve_articulated(model, partition, t);
+        }
+        self.articulated.solved = false;
         // One call: generated models share the kinematics between M, F, Q and c, and take
         // the sines and cosines from the position level.
         let all_rows = self.m == self.nc;

@@ -56,6 +56,8 @@ pub struct Workspace {
     pub(super) length_scale: f64,
     /// A next correction at most this times (1 + ‖v‖∞) ends Newton too (0: strict).
     pub(super) newton_slack: f64,
+    /// The articulated-body route's buffers ([`Self::use_articulated`]).
+    pub(super) articulated: super::articulated::Buffers,
 }
 
 impl Workspace {
@@ -95,6 +97,7 @@ impl Workspace {
             drive: vec![0.0; n],
             length_scale: 1.0,
             newton_slack: 0.0,
+            articulated: Default::default(),
         }
     }
 

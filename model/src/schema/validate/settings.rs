@@ -72,6 +72,7 @@ pub(super) fn simulation(s: &raw::Simulation, at: &Locator) -> Checked<Simulatio
         ));
     }
     Ok(Simulation {
+        formulation: s.formulation.0,
         t_end,
         dt_out,
         integrator,

@@ -1,0 +1,155 @@
+//! The acceleration level by the articulated-body sweeps (docs/method.md §12), for models
+//! that provide them ([`Dynamics::articulated_len`]): no mass matrix is formed.
+//!
+//! `articulated_terms` gives q̈⁰, the free coordinates' accelerations without constraint
+//! forces (the driven ones prescribed), and the drive loads τ⁰ at q̈⁰. Each solved
+//! constraint row k then gets its response A_k = M_ff⁻¹ (−J_kᵀ) (and its driven rows
+//! M_df A_k), so that with (14), M q̈ + F + Q + Jᵀ λ = τ,
+//!
+//! ```text
+//! q̈_f = q̈⁰_f + Σ_k λ_k A_k,   (J A) λ = −(J q̈⁰ + c)   (J q̈ + c = 0, eq. 8)
+//! τ_d = τ⁰_d + Σ_k λ_k (M_df A_k + J_kd)
+//! ```
+//!
+//! −J A = J_f M_ff⁻¹ J_fᵀ is symmetric positive definite whenever the solved rows are
+//! independent on the free coordinates, which the partition guarantees: it solves only rows
+//! whose J_v, a square block of J_f, is invertible (redundant rows are left out, their
+//! multipliers zero). So no regularisation is needed; at a singular position, where J_v
+//! degenerates, the partition's own re-partitioning and errors apply unchanged.
+
+use super::linalg::{cholesky_factor, cholesky_solve, dot};
+use super::{Partition, Workspace};
+use crate::dynamics::{ArticulatedTerms, Dynamics};
+use crate::error::SimError;
+
+/// The buffers of the articulated route (empty until first used).
+#[derive(Debug, Clone)]
+pub(super) struct Buffers {
+    /// Use the articulated route when the model provides it (the default).
+    pub(super) enabled: bool,
+    /// True after an articulated solve: λ and the drive loads are already known.
+    pub(super) solved: bool,
+    factors: Vec<f64>,
+    /// A_k, row-major nc × n (driven entries 0).
+    responses: Vec<f64>,
+    /// M_df A_k, row-major nc × n (driven entries only).
+    response_drive: Vec<f64>,
+    /// −J A (nc × nc), then its Cholesky factor.
+    delassus: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+impl Default for Buffers {
+    fn default() -> Self {
+        Buffers {
+            enabled: true,
+            solved: false,
+            factors: Vec::new(),
+            responses: Vec::new(),
+            response_drive: Vec::new(),
+            delassus: Vec::new(),
+            tau: Vec::new(),
+        }
+    }
+}
+
+impl Workspace {
+    /// Uses the articulated-body sweeps when the model provides them (`true`, the default)
+    /// or always the dense route (`false`): for comparisons of the two.
+    pub fn use_articulated(&mut self, on: bool) {
+        self.articulated.enabled = on;
+    }
+
+    /// True when the next right-hand side of `model` takes the articulated route.
+    pub fn articulated_route(&self, model: &dyn Dynamics) -> bool {
+        self.articulated.enabled && model.articulated_len() > 0
+    }
+
+    /// The articulated counterpart of the dense reduction: q̈, ü, λ and the drive loads at
+    /// the state, with the position level already evaluated (as for
+    /// [`Self::solve_accelerations`]).
+    pub(super) fn solve_articulated(
+        &mut self,
+        model: &dyn Dynamics,
+        partition: &Partition,
+        t: f64,
+    ) -> Result<(), SimError> {
+        let (n, nc) = (self.n, self.nc);
+        let b = &mut self.articulated;
+        b.factors.resize(model.articulated_len(), 0.0);
+        b.responses.resize(nc * n, 0.0);
+        b.response_drive.resize(nc * n, 0.0);
+        b.delassus.resize(nc * nc, 0.0);
+        b.tau.resize(n, 0.0);
+        let all_rows = self.m == self.nc;
+        self.drive.fill(0.0);
+        let out = ArticulatedTerms {
+            qdd: &mut self.qdd,
+            drive: &mut self.drive,
+            bias: if all_rows {
+                &mut self.bias
+            } else {
+                &mut self.full_bias
+            },
+            factors: &mut b.factors,
+        };
+        model.articulated_terms(t, &self.q, &self.qd, &self.cache, out);
+        if !all_rows {
+            for (k, &row) in self.rows.iter().enumerate() {
+                self.bias[k] = self.full_bias[row];
+            }
+        }
+        for k in 0..nc {
+            let row = &self.jacobian[k * n..(k + 1) * n];
+            for (tau, &j) in b.tau.iter_mut().zip(row) {
+                *tau = -j;
+            }
+            let (qdd, drive) = (
+                &mut b.responses[k * n..(k + 1) * n],
+                &mut b.response_drive[k * n..(k + 1) * n],
+            );
+            model.articulated_response(&b.factors, &b.tau, qdd, drive);
+            for &d in partition.driven() {
+                qdd[d] = 0.0;
+            }
+        }
+        // −J A λ = J q̈⁰ + c, row by row of the solved constraints.
+        for j in 0..nc {
+            let row = &self.jacobian[j * n..(j + 1) * n];
+            for k in 0..=j {
+                let entry = -dot(row, &b.responses[k * n..(k + 1) * n]);
+                b.delassus[j * nc + k] = entry;
+                b.delassus[k * nc + j] = entry;
+            }
+            self.lambda[j] = dot(row, &self.qdd) + self.bias[j];
+        }
+        if nc > 0 && !cholesky_factor(&mut b.delassus, nc) {
+            return Err(self.singular(t));
+        }
+        cholesky_solve(&b.delassus, nc, &mut self.lambda);
+        for (k, &lambda) in self.lambda.iter().enumerate() {
+            let response = &b.responses[k * n..(k + 1) * n];
+            for (qdd, &a) in self.qdd.iter_mut().zip(response) {
+                *qdd += lambda * a;
+            }
+            let row = &self.jacobian[k * n..(k + 1) * n];
+            for &d in partition.driven() {
+                self.drive[d] += lambda * (b.response_drive[k * n + d] + row[d]);
+            }
+        }
+        for (udd, &u) in self.udd.iter_mut().zip(partition.independent()) {
+            *udd = self.qdd[u];
+        }
+        b.solved = true;
+        if self.qdd.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "q̈"));
+        }
+        if self.lambda.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "λ"));
+        }
+        if self.drive.iter().any(|x| !x.is_finite()) {
+            return Err(self.non_finite(t, "drive load"));
+        }
+        Ok(())
+    }
+}
