@@ -30,7 +30,7 @@
 //! τ given at run time, giving M_ff⁻¹ τ (f: the free coordinates) and the driven rows
 //! M_df M_ff⁻¹ τ. It reads U, 1/D and the joint transforms from the first function's
 //! outputs (the "factors"); the runtime calls it once per constraint row to form
-//! J M⁻¹ Jᵀ (docs/method.md §12).
+//! J M⁻¹ Jᵀ (docs/method.md §14).
 //!
 //! Joint specialisation comes from the expression graph: S is a constant axis, so a
 //! revolute joint about z reads one column of I^A; rotations about a coordinate axis have

@@ -1,5 +1,5 @@
 //! What a run tells its caller while it goes, how the caller stops it, and how a run whose
-//! steps no longer advance time is stopped with a diagnosis (docs/method.md §12).
+//! steps no longer advance time is stopped with a diagnosis (docs/method.md §14).
 //!
 //! A [`Monitor`] sees every output sample as soon as it is computed and every accepted step;
 //! either can stop the run ([`SimError::Interrupted`], with everything computed so far). A

@@ -556,7 +556,7 @@ pub trait Dynamics {
     }
 
     /// The articulated-body forward dynamics at (t, q, q̇) without constraint forces (docs/
-    /// method.md §12), reading `cache` as filled by [`Dynamics::position_terms`] at the same
+    /// method.md §14), reading `cache` as filled by [`Dynamics::position_terms`] at the same
     /// q: see [`ArticulatedTerms`]. Provided by generated models whose
     /// [`Dynamics::articulated_len`] is not 0; the default writes NaN.
     fn articulated_terms(

@@ -242,7 +242,7 @@ pub struct FormulationSpec {
 }
 
 registry! {
-    /// How a model's generated code solves for the accelerations (docs/method.md §12): the
+    /// How a model's generated code solves for the accelerations (docs/method.md §14): the
     /// model file's `simulation: (formulation: …)` and `camchain_build::Config::formulation`.
     #[derive(Default)]
     pub enum Formulation: FormulationSpec, "formulation" {

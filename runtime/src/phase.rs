@@ -239,7 +239,7 @@ impl Reading {
 
 /// A piece of a flight's step turns the cam by at most this much relative to the follower
 /// point (rad): a cam's profile is smooth over a quarter radian, so the cubic Hermite check
-/// of each piece sees every lobe (docs/method.md §12).
+/// of each piece sees every lobe (docs/method.md §14).
 const PIECE_TURN: f64 = 0.25;
 
 /// Most pieces a flight's step is cut into.

@@ -1,6 +1,6 @@
 //! In-step event scans: a watched function that crosses zero and comes back within one
 //! integration step is found, not only a sign change between the step's two ends
-//! (docs/method.md §12).
+//! (docs/method.md §14).
 //!
 //! Two kinds of watched function, with different costs:
 //!

@@ -158,7 +158,7 @@ pub(super) fn specs(
         main_given.push((var, format!("out.qdd[{i}]")));
     }
     let terms = FunctionSpec {
-        doc: "The articulated-body sweeps (docs/method.md §12): q̈ of the free coordinates \
+        doc: "The articulated-body sweeps (docs/method.md §14): q̈ of the free coordinates \
               without constraint forces (the driven ones' q̈ read from `out.qdd`), the driven \
               coordinates' rows of M q̈ + F + Q, c, and the factors the response reads."
             .into(),

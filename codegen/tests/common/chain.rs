@@ -72,3 +72,23 @@ pub fn planar_chain_ron(n: usize) -> String {
          simulation: (t_end: 1.0, dt_out: 0.01),\n)\n"
     )
 }
+
+/// The planar chain of [`planar_chain_ron`] with its tip on a cam: a knife edge at the far
+/// end of the last link on the profile y = 0.05 sin x − 0.1 in the ground's plane (the
+/// planar counterpart of [`chain_ron`]'s contact).
+#[allow(dead_code)] // used by the formulations example, not by every test binary
+pub fn planar_contact_ron(n: usize) -> String {
+    let plain = planar_chain_ron(n);
+    let tip = format!(
+        "    markers: [(name: \"tip\", body: \"b{last}\", position: (0.2, 0.0, 0.0))],\n    \
+         contacts: [(marker: \"tip\", profile: \"0.05*x.sin() - 0.1\")],\n    simulation:",
+        last = n - 1
+    );
+    plain
+        .replacen(
+            &format!("name: \"planar{n}\""),
+            &format!("name: \"planar_contact{n}\""),
+            1,
+        )
+        .replacen("    simulation:", &tip, 1)
+}

@@ -1,4 +1,4 @@
-//! The acceleration level by the articulated-body sweeps (docs/method.md §12), for models
+//! The acceleration level by the articulated-body sweeps (docs/method.md §14), for models
 //! that provide them ([`Dynamics::articulated_len`]): no mass matrix is formed.
 //!
 //! `articulated_terms` gives q̈⁰, the free coordinates' accelerations without constraint

@@ -1,0 +1,331 @@
+//! The two forward-dynamics formulations side by side (issue 30), outside the test suite (it
+//! compiles and times code):
+//!
+//! ```text
+//! cargo run --release -p camchain-codegen --example formulations -- OUTDIR [N ...]
+//! ```
+//!
+//! For the chains of `tests/common/chain.rs` (the spatial chain with its tip on a cam, and
+//! the planar chain with its tip on a cam) with N bodies (default 4, 8, 16, 32, 64), it
+//! generates each model twice, the dense route and the articulated-body sweeps asked for,
+//! builds one throwaway crate per model holding both (release, one shared target directory,
+//! the runtime built first and excluded), and times in one run, interleaved batch by batch:
+//!
+//! - `derivative`, the constrained reduced right-hand side (Newton on the dependent
+//!   coordinate, velocities, accelerations, λ), at 8 states 1 ms apart along the model's run
+//!   taken in turn (so every call computes its sines and cosines);
+//! - the unconstrained forward dynamics at the same states: `position_terms` +
+//!   `articulated_terms` (articulated), `position_terms` + `velocity_terms` and an LDLᵀ
+//!   solve of M q̈ = −(F + Q) (dense).
+//!
+//! Medians of 31 batches (each ≥ 2 ms) in ns per call. Also the operation counts and the
+//! choice `Formulation::Auto` makes. Results: `OUTDIR/formulations.md` and `.csv`.
+
+#[path = "../tests/common/chain.rs"]
+mod chain;
+
+use camchain_codegen::{EmitOptions, Formulation};
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+const SIZES: [usize; 5] = [4, 8, 16, 32, 64];
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(out) = args.first() else {
+        eprintln!("usage: formulations OUTDIR [N ...]");
+        return ExitCode::from(2);
+    };
+    let sizes: Vec<usize> = args[1..].iter().filter_map(|a| a.parse().ok()).collect();
+    let sizes = if sizes.is_empty() {
+        SIZES.to_vec()
+    } else {
+        sizes
+    };
+    match run(Path::new(out), &sizes) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(out: &Path, sizes: &[usize]) -> Result<(), String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let out = out.canonicalize().map_err(|e| e.to_string())?;
+    let runtime = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../runtime")
+        .canonicalize()
+        .map_err(|e| e.to_string())?;
+    let target = out.join("target");
+    let warm = write_crate(&out, "warm", &[], &runtime)?;
+    cargo_build(&warm, &target)?;
+    let mut md = String::from(
+        "| family | N | auto chooses | dense ops (velocity_terms) | articulated ops (terms + response) | rhs dense [ns] | rhs articulated [ns] | dense / articulated | unconstrained dense [ns] | unconstrained articulated [ns] |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mut csv = String::from(
+        "family,n,auto,dense_ops,articulated_ops,response_ops,rhs_dense_ns,rhs_articulated_ns,free_dense_ns,free_articulated_ns\n",
+    );
+    for &n in sizes {
+        for (family, text) in [
+            ("spatial", chain::chain_ron(n)),
+            ("planar", chain::planar_contact_ron(n)),
+        ] {
+            let name = format!("{family}{n}");
+            let file = out.join(format!("{name}.ron"));
+            std::fs::write(&file, &text).map_err(|e| e.to_string())?;
+            let model =
+                camchain_codegen::schema::parse_model(&text, &file).map_err(|e| e.to_string())?;
+            let generate = |formulation| {
+                let options = EmitOptions {
+                    runtime_path: "::camchain_runtime".to_string(),
+                    formulation,
+                    ..Default::default()
+                };
+                camchain_codegen::emit::generate_with(&model, &file.display().to_string(), &options)
+            };
+            let ops = |g: &camchain_codegen::Generated, f: &str| {
+                g.op_counts
+                    .iter()
+                    .find(|(name, _)| name == f)
+                    .map_or(0, |(_, c)| c.total())
+            };
+            let dense = generate(Formulation::Dense)?;
+            let articulated = generate(Formulation::Articulated)?;
+            let auto = generate(Formulation::Auto)?;
+            let chosen = if ops(&auto, "articulated_terms") > 0 {
+                "articulated"
+            } else {
+                "dense"
+            };
+            let dir = write_crate(
+                &out,
+                &name,
+                &[("dense", &dense.code), ("articulated", &articulated.code)],
+                &runtime,
+            )?;
+            cargo_build(&dir, &target)?;
+            let exe = target.join("release").join(format!("formulations_{name}"));
+            let output = Command::new(&exe)
+                .output()
+                .map_err(|e| format!("{}: {e}", exe.display()))?;
+            if !output.status.success() {
+                return Err(format!(
+                    "{name}: {}",
+                    String::from_utf8_lossy(&output.stderr)
+                ));
+            }
+            let v: Vec<f64> = String::from_utf8_lossy(&output.stdout)
+                .split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            let [rd, ra, fd, fa] = v[..] else {
+                return Err(format!("{name}: unexpected output {v:?}"));
+            };
+            let (d_ops, a_ops, r_ops) = (
+                ops(&dense, "velocity_terms"),
+                ops(&articulated, "articulated_terms"),
+                ops(&articulated, "articulated_response"),
+            );
+            let _ = writeln!(
+                md,
+                "| {family} | {n} | {chosen} | {d_ops} | {a_ops} + {r_ops} | {rd:.0} | {ra:.0} | {:.2}× | {fd:.0} | {fa:.0} |",
+                rd / ra
+            );
+            let _ = writeln!(
+                csv,
+                "{family},{n},{chosen},{d_ops},{a_ops},{r_ops},{rd:.1},{ra:.1},{fd:.1},{fa:.1}"
+            );
+            eprintln!("{name}: done");
+        }
+    }
+    std::fs::write(out.join("formulations.md"), &md).map_err(|e| e.to_string())?;
+    std::fs::write(out.join("formulations.csv"), &csv).map_err(|e| e.to_string())?;
+    print!("{md}");
+    Ok(())
+}
+
+/// A crate `formulations_NAME` holding the modules `modules` and timing them.
+fn write_crate(
+    out: &Path,
+    name: &str,
+    modules: &[(&str, &str)],
+    runtime: &Path,
+) -> Result<PathBuf, String> {
+    let dir = out.join("crates").join(name);
+    std::fs::create_dir_all(dir.join("src")).map_err(|e| e.to_string())?;
+    let manifest = format!(
+        "[package]\nname = \"formulations_{name}\"\nversion = \"0.0.0\"\nedition = \"2024\"\n\
+         [dependencies]\ncamchain-runtime = {{ path = {:?} }}\n[workspace]\n",
+        runtime.display().to_string()
+    );
+    std::fs::write(dir.join("Cargo.toml"), manifest).map_err(|e| e.to_string())?;
+    let mut main = String::new();
+    for (module, code) in modules {
+        std::fs::write(dir.join(format!("src/{module}.rs")), code).map_err(|e| e.to_string())?;
+        let _ = writeln!(main, "#[allow(dead_code, clippy::all)]\nmod {module};");
+    }
+    if modules.is_empty() {
+        main.push_str("fn main() {}\n");
+    } else {
+        main.push_str(TIMING);
+    }
+    std::fs::write(dir.join("src/main.rs"), main).map_err(|e| e.to_string())?;
+    Ok(dir)
+}
+
+/// The measuring program: both modules' models, the same states, batches interleaved.
+const TIMING: &str = r#"
+use camchain_runtime::{Dynamics, Simulate, State, VelocityTerms, ArticulatedTerms};
+use std::hint::black_box;
+
+fn states(model: &dyn Simulate) -> Vec<State> {
+    let mut state = model.assemble(0.0).expect("assembles");
+    let mut out = Vec::new();
+    for _ in 0..8 {
+        model.step(&mut state, 1e-3).expect("steps");
+        out.push(state.clone());
+    }
+    out
+}
+
+fn batch(f: &mut dyn FnMut()) -> f64 {
+    let mut reps = 1;
+    loop {
+        let t = std::time::Instant::now();
+        for _ in 0..reps {
+            f();
+        }
+        let s = t.elapsed().as_secs_f64();
+        if s >= 2e-3 {
+            return s * 1e9 / reps as f64;
+        }
+        reps *= 2;
+    }
+}
+
+fn rhs<'a>(model: &'a dyn Simulate, states: &'a [State]) -> impl FnMut() + 'a {
+    let mut current = states[0].clone();
+    let mut dy = vec![0.0; current.integrated_len()];
+    let mut k = 0;
+    move || {
+        let next = &states[k % states.len()];
+        k += 1;
+        current.t = next.t;
+        current.q.copy_from_slice(&next.q);
+        current.qd.copy_from_slice(&next.qd);
+        model.derivative(&mut current, &mut dy).expect("a consistent state");
+        black_box(&dy);
+    }
+}
+
+/// Unconstrained forward dynamics, dense: the fused pair and an LDLᵀ solve of M.
+fn free_dense<'a>(model: &'a dyn Dynamics, states: &'a [State]) -> impl FnMut() + 'a {
+    let info = model.info();
+    let (n, m) = (info.n(), info.n_constraints());
+    let (mut h, mut j, mut cache) = (vec![0.0; m], vec![0.0; m * n], vec![0.0; model.cache_len()]);
+    let (mut mass, mut f, mut a, mut c) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n], vec![0.0; m]);
+    let mut x = vec![0.0; n];
+    let mut k = 0;
+    move || {
+        let s = &states[k % states.len()];
+        k += 1;
+        model.position_terms(&s.q, &mut h, &mut j, &mut cache);
+        let out = VelocityTerms { mass: &mut mass, inertial: &mut f, applied: &mut a, bias: &mut c };
+        model.velocity_terms(s.t, &s.q, &s.qd, &cache, out);
+        // L D Lᵀ in place (lower triangle), then the solve.
+        for col in 0..n {
+            let mut d = mass[col * n + col];
+            for p in 0..col {
+                let l = mass[col * n + p];
+                d -= l * l * mass[p * n + p];
+            }
+            mass[col * n + col] = d;
+            for r in col + 1..n {
+                let mut v = mass[r * n + col];
+                for p in 0..col {
+                    v -= mass[r * n + p] * mass[col * n + p] * mass[p * n + p];
+                }
+                mass[r * n + col] = v / d;
+            }
+        }
+        for i in 0..n {
+            let mut v = -(f[i] + a[i]);
+            for p in 0..i {
+                v -= mass[i * n + p] * x[p];
+            }
+            x[i] = v;
+        }
+        for i in 0..n {
+            x[i] /= mass[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let mut v = x[i];
+            for p in i + 1..n {
+                v -= mass[p * n + i] * x[p];
+            }
+            x[i] = v;
+        }
+        black_box(&x);
+    }
+}
+
+/// Unconstrained forward dynamics, articulated: the position level and the sweeps.
+fn free_articulated<'a>(model: &'a dyn Dynamics, states: &'a [State]) -> impl FnMut() + 'a {
+    let info = model.info();
+    let (n, m) = (info.n(), info.n_constraints());
+    let (mut h, mut j, mut cache) = (vec![0.0; m], vec![0.0; m * n], vec![0.0; model.cache_len()]);
+    let (mut qdd, mut drive, mut c) = (vec![0.0; n], vec![0.0; n], vec![0.0; m]);
+    let mut factors = vec![0.0; model.articulated_len()];
+    let mut k = 0;
+    move || {
+        let s = &states[k % states.len()];
+        k += 1;
+        model.position_terms(&s.q, &mut h, &mut j, &mut cache);
+        let out = ArticulatedTerms { qdd: &mut qdd, drive: &mut drive, bias: &mut c, factors: &mut factors };
+        model.articulated_terms(s.t, &s.q, &s.qd, &cache, out);
+        black_box(&qdd);
+    }
+}
+
+fn main() {
+    let dense = dense::Model;
+    let articulated = articulated::Model;
+    let states = states(&articulated);
+    let mut fns: Vec<Box<dyn FnMut()>> = vec![
+        Box::new(rhs(&dense, &states)),
+        Box::new(rhs(&articulated, &states)),
+        Box::new(free_dense(&dense, &states)),
+        Box::new(free_articulated(&articulated, &states)),
+    ];
+    let mut samples = vec![Vec::new(); fns.len()];
+    for _ in 0..31 {
+        for (f, s) in fns.iter_mut().zip(samples.iter_mut()) {
+            s.push(batch(f.as_mut()));
+        }
+    }
+    for s in &mut samples {
+        s.sort_by(f64::total_cmp);
+        print!("{} ", s[s.len() / 2]);
+    }
+    println!();
+}
+"#;
+
+fn cargo_build(dir: &Path, target: &Path) -> Result<(), String> {
+    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .args(["build", "--release", "--quiet", "--manifest-path"])
+        .arg(dir.join("Cargo.toml"))
+        .arg("--target-dir")
+        .arg(target)
+        .status()
+        .map_err(|e| e.to_string())?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("cargo build failed in {}", dir.display()))
+    }
+}
