@@ -58,6 +58,12 @@ pub struct ArticulatedTerms {
     pub response: Vec<(usize, Id)>,
     /// (coordinate, load): the response's driven rows, M_df M_ff⁻¹ τ.
     pub response_loads: Vec<(usize, Id)>,
+    /// The variables of a vector x, one per coordinate, and M(q) x: the mass matrix's
+    /// product by the same recursions (O(n) operations), so that a model on this route can
+    /// give M column by column without emitting its n² entries.
+    pub mass_x: Vec<Id>,
+    /// M(q) x, one entry per coordinate.
+    pub mass_product: Vec<Id>,
 }
 
 /// A spatial force: moment about the frame's origin, force.
@@ -282,7 +288,79 @@ pub fn articulated(
         }
         motion[i] = Some(after);
     }
+    (out.mass_x, out.mass_product) = mass_product(g, model, s, kin, &names);
     out
+}
+
+/// M(q) x by the recursions without velocities, weights or loads: the accelerations of the
+/// joint rates x forward (A1), each body's inertial load I δa, summed from the tip and
+/// projected on its joint.
+fn mass_product(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    kin: &[BodyKinematics],
+    names: &[&str],
+) -> (Vec<Id>, Vec<Id>) {
+    let n = model.n();
+    let x: Vec<Id> = names.iter().map(|c| g.var(&format!("__x_{c}"))).collect();
+    let mut motion: Vec<Option<Motion>> = vec![None; n];
+    for i in 0..n {
+        if g.exhausted() {
+            break;
+        }
+        g.set_section(format!(
+            "{}: acceleration for M x (forward sweep)",
+            model.bodies[i].name
+        ));
+        let before = incoming(g, model, kin, &motion, i);
+        let step = vec3::scale(g, x[i], kin[i].axis);
+        motion[i] = Some(match model.bodies[i].joint.kind {
+            JointKind::Revolute => Motion {
+                w: vec3::add(g, before.w, step),
+                v: before.v,
+            },
+            JointKind::Prismatic => Motion {
+                w: before.w,
+                v: vec3::add(g, before.v, step),
+            },
+        });
+    }
+    let kids = children(model);
+    let mut loads: Vec<Option<Force>> = vec![None; n];
+    let mut product = vec![g.zero(); n];
+    for i in (0..n).rev() {
+        let Some(a) = motion[i] else { continue };
+        g.set_section(format!(
+            "{}: inertial load for M x (backward sweep)",
+            model.bodies[i].name
+        ));
+        let body = body_inertia(g, model, s, i);
+        let rigid = rigid(g, &body);
+        let mut load = apply(g, &rigid, a);
+        for &c in &kids[i] {
+            if let Some(lc) = loads[c].take() {
+                let (n_p, f_p) = force_to_parent(g, &kin[c], lc.n, lc.f);
+                load = add_force(g, load, Force { n: n_p, f: f_p });
+            }
+        }
+        product[i] = project(g, model.bodies[i].joint.kind, kin[i].axis, load);
+        loads[i] = Some(load);
+    }
+    (x, product)
+}
+
+/// I a: the load of an inertia for an acceleration (n = A ω̇ + B a, f = Bᵀ ω̇ + C a).
+fn apply(g: &mut Graph, i: &Articulated, a: Motion) -> Force {
+    let aw = mat_vec(g, &i.a, a.w);
+    let bv = mat_vec(g, &i.b, a.v);
+    let bt = transpose(&i.b);
+    let btw = mat_vec(g, &bt, a.w);
+    let cv = mat_vec(g, &i.c, a.v);
+    Force {
+        n: vec3::add(g, aw, bv),
+        f: vec3::add(g, btw, cv),
+    }
 }
 
 /// The parent's δa seen at body i's joint point, in body i's frame (zero at the ground):

@@ -191,8 +191,15 @@ pub fn generate_from(
         Formulation::Auto => options.formulation,
         chosen => chosen,
     };
-    let choice = articulated::choose(&d, &dense_roots(&d), asked);
-    let aba = choice.articulated.then(|| articulated::outputs(&d));
+    let dense = dense_roots(&d);
+    let choice = articulated::choose(&d, &dense, asked);
+    // A large model on the articulated route gives M column by column (n products M e_j,
+    // O(n) code each) instead of emitting its n² entries: M is off its right-hand side's
+    // path, and M's code was most of such a model's build.
+    let mass_by_columns = choice.articulated && d.graph.op_count(&dense).total() > LARGE_MODEL_OPS;
+    let aba = choice
+        .articulated
+        .then(|| articulated::groups(&d, mass_by_columns));
     let mut fused = FusedTerms::new(&mut d, aba);
     if let Some(e) = d.too_large(model) {
         return Err(e.to_string());
@@ -213,11 +220,14 @@ pub fn generate_from(
         .iter()
         .map(|(spec, given)| fused_count(&d, spec, &[given.clone(), derived("self.")].concat()))
         .sum();
-    let wrap = match options.entry_points {
-        EntryPoints::Auto => fused_ops > LARGE_MODEL_OPS,
-        EntryPoints::Standalone => false,
-        EntryPoints::ViaFusedPair => true,
-    };
+    // M's entries are not emitted at all when M comes column by column: the entry points
+    // call the pair whatever was asked.
+    let wrap = mass_by_columns
+        || match options.entry_points {
+            EntryPoints::Auto => fused_ops > LARGE_MODEL_OPS,
+            EntryPoints::Standalone => false,
+            EntryPoints::ViaFusedPair => true,
+        };
     let mut functions = String::new();
     let mut op_counts = Vec::new();
     let geometry_warm: Vec<(Id, String)> = d
@@ -292,6 +302,14 @@ pub fn generate_from(
             factors.max(1)
         );
     }
+    let mut inherent = String::new();
+    if mass_by_columns {
+        let (spec, given) =
+            articulated::mass_times_spec(&d, &fused.mass, &fused.cache_given(), &derived("self."));
+        let (text, count) = emit_function_full(&d, &spec, "", true, &given, &[], &[]);
+        let _ = writeln!(inherent, "impl Model {{\n{text}}}");
+        op_counts.push((spec.name.clone(), count));
+    }
     let mut helpers =
         contact_kinematics_helpers(&d, &kinematics_specs, &mut op_counts, &derived(""));
     helpers.push_str(&implicit_helpers(&d, &mut op_counts, &derived("")));
@@ -335,6 +353,7 @@ pub fn generate_from(
          {values}{functions}\n{}\n}}\n",
         contact_kinematics_dispatch(model, runtime.is_some())
     );
+    file.push_str(&inherent);
     file.push_str(&helpers);
     file.push_str(&op_count_table(&op_counts));
     within_code_limit(file.len(), options.code_limit)?;

@@ -27,7 +27,7 @@
 // | `derive` | 1 | 2 | 0 | 0 | 0 | 0 | 3 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
-// dense 157, articulated 162 (the position level, common to both, not included).
+// dense 157, articulated 242 (the position level, common to both, not included).
 //
 // Read at run time: `omega`, `m`, `k`, `free`, `c` (see `Parameters`); `derive` computes what depends on them
 // alone once per parameter set, and the counts above do not include it.

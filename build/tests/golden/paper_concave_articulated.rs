@@ -26,7 +26,7 @@
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
 // Forward dynamics: the articulated-body sweeps (as asked). Estimated operations per right-hand side:
-// dense 238, articulated 299 (the position level, common to both, not included).
+// dense 238, articulated 459 (the position level, common to both, not included).
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -1022,7 +1022,7 @@ impl rt::Dynamics for Model {
     fn cache_len(&self) -> usize {
         9
     }
-    /// The articulated-body sweeps (docs/method.md §12): q̈ of the free coordinates without constraint forces (the driven ones' q̈ read from `out.qdd`), the driven coordinates' rows of M q̈ + F + Q, c, and the factors the response reads.
+    /// The articulated-body sweeps (docs/method.md §14): q̈ of the free coordinates without constraint forces (the driven ones' q̈ read from `out.qdd`), the driven coordinates' rows of M q̈ + F + Q, c, and the factors the response reads.
     fn articulated_terms(
         &self,
         _t: f64,

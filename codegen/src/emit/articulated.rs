@@ -38,6 +38,80 @@ pub struct Choice {
 }
 
 /// The outputs of the two functions, before the position level's trigonometry is shared.
+/// The outputs of the articulated functions, and of `mass_times` when M is given column by
+/// column.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Groups {
+    pub(super) main: Outputs,
+    pub(super) response: Outputs,
+    /// `out[i]` = (M x)_i, when the model gives M column by column.
+    pub(super) mass: Outputs,
+}
+
+/// [`outputs`] grouped, with `mass_times`'s when `mass_by_columns`.
+pub(super) fn groups(d: &Derivation, mass_by_columns: bool) -> Groups {
+    let (main, response) = outputs(d);
+    let mass = if mass_by_columns {
+        (d.articulated.mass_product.iter().enumerate())
+            .map(|(i, &e)| (format!("out[{i}]"), e))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    Groups {
+        main,
+        response,
+        mass,
+    }
+}
+
+/// `mass_times(q, cache, x, out)`: out = M(q) x, reading the position level's cache.
+pub(super) fn mass_times_spec(
+    d: &Derivation,
+    mass: &Outputs,
+    cache_given: &[(Id, String)],
+    derived: &[(Id, String)],
+) -> (FunctionSpec, Vec<(Id, String)>) {
+    let mut given = [cache_given, derived].concat();
+    for (i, &var) in d.articulated.mass_x.iter().enumerate() {
+        given.push((var, format!("x[{i}]")));
+    }
+    let spec = FunctionSpec {
+        doc: "M(q) x by the recursions (no velocities, weights or loads), reading the cache \
+              `position_terms` filled at q: `velocity_terms` forms M column by column with it \
+              (docs/method.md §14.4)."
+            .into(),
+        name: "mass_times".into(),
+        params: vec![
+            param("q", "&[f64]"),
+            param("cache", "&[f64]"),
+            param("x", "&[f64]"),
+            param("out", "&mut [f64]"),
+        ],
+        ret: None,
+        outputs: mass.clone(),
+        tail: String::new(),
+    };
+    (spec, given)
+}
+
+/// The end of `velocity_terms` for a model that gives M column by column: M e_j for every j.
+pub(super) fn mass_columns_tail(n: usize) -> String {
+    format!(
+        "// M column by column: M e_j by `mass_times` (docs/method.md §14.4).\n\
+         let mut unit = [0.0; {n}];\n\
+         let mut column = [0.0; {n}];\n\
+         for j in 0..{n} {{\n\
+             unit[j] = 1.0;\n\
+             self.mass_times(q, cache, &unit, &mut column);\n\
+             unit[j] = 0.0;\n\
+             for (i, value) in column.iter().enumerate() {{\n\
+                 out.mass[i * {n} + j] = *value;\n\
+             }}\n\
+         }}\n"
+    )
+}
+
 pub(super) fn outputs(d: &Derivation) -> (Outputs, Outputs) {
     let a = &d.articulated;
     let mut main: Vec<(String, Id)> = Vec::new();
@@ -116,8 +190,14 @@ pub(super) fn choose(d: &Derivation, dense_roots: &[Id], asked: Formulation) -> 
     let response_ops = d.graph.op_count_until(&response_roots, &given).total();
     let main_ops = d.graph.op_count(&main_roots).total();
     // Per row: a response, J times it for every row (2 n m), the combination (2 n); the
-    // multipliers' Cholesky m³ / 3.
-    let articulated_ops = main_ops + m * (response_ops + 2 * n * m + 2 * n) + m * m * m / 3;
+    // multipliers' Cholesky m³ / 3. The sweeps are a chain of dependent operations (each
+    // body waits for its child's articulated inertia, a division among them) where the
+    // dense route's terms are independent of each other: 40 n more, calibrated on the
+    // scaling chains (`codegen/examples/formulations.rs`, BENCHMARKS.md), where the planar
+    // chain of 8 bodies runs about as fast both ways and the spatial one of 16 faster
+    // articulated.
+    let articulated_ops =
+        main_ops + m * (response_ops + 2 * n * m + 2 * n) + m * m * m / 3 + 40 * n;
     let (articulated, forced) = match asked {
         Formulation::Auto => (articulated_ops < dense, false),
         Formulation::Dense => (false, true),

@@ -28,15 +28,15 @@ pub(super) struct FusedTerms {
     /// and of `articulated_response`, when the model is given them.
     pub(super) articulated: Vec<(String, Id)>,
     pub(super) response: Vec<(String, Id)>,
+    /// `mass_times`'s outputs when `velocity_terms` forms M column by column (M's entries
+    /// are then not among its outputs).
+    pub(super) mass: Vec<(String, Id)>,
 }
 
 impl FusedTerms {
     /// The pair, and with `articulated` (the outputs of `articulated_terms` and
     /// `articulated_response`) those two functions, sharing the position level's values.
-    pub(super) fn new(
-        d: &mut Derivation,
-        articulated: Option<(super::articulated::Outputs, super::articulated::Outputs)>,
-    ) -> Self {
+    pub(super) fn new(d: &mut Derivation, articulated: Option<super::articulated::Groups>) -> Self {
         let n = d.symbols.q.len();
         let dy = &d.dynamics;
         let mut position = Vec::new();
@@ -50,9 +50,12 @@ impl FusedTerms {
             }
         }
         let mut velocity = Vec::new();
+        let by_columns = articulated.as_ref().is_some_and(|a| !a.mass.is_empty());
         for i in 0..n {
             for j in 0..n {
-                velocity.push((format!("out.mass[{}]", i * n + j), dy.mass[i][j]));
+                if !by_columns {
+                    velocity.push((format!("out.mass[{}]", i * n + j), dy.mass[i][j]));
+                }
             }
         }
         for (i, &e) in dy.inertial.iter().enumerate() {
@@ -66,27 +69,20 @@ impl FusedTerms {
         }
         drop(rows);
         let roots = |outputs: &[(String, Id)]| -> Vec<Id> { outputs.iter().map(|o| o.1).collect() };
-        let (split, main_len) = match &articulated {
-            Some((main, response)) => {
-                let before = velocity.len();
-                velocity.extend(main.iter().cloned());
-                velocity.extend(response.iter().cloned());
-                (Some(before), main.len())
-            }
-            None => (None, 0),
-        };
+        let groups = articulated.unwrap_or_default();
+        let at = velocity.len();
+        let lengths = [groups.main.len(), groups.response.len()];
+        velocity.extend(groups.main);
+        velocity.extend(groups.response);
+        velocity.extend(groups.mass);
         reuse_position_trigonometry(&mut d.graph, &roots(&position), &mut velocity);
-        let (articulated, response) = match split {
-            Some(at) => {
-                let mut rest = velocity.split_off(at);
-                let response = rest.split_off(main_len);
-                (rest, response)
-            }
-            None => (Vec::new(), Vec::new()),
-        };
+        let mut articulated = velocity.split_off(at);
+        let mut response = articulated.split_off(lengths[0]);
+        let mass = response.split_off(lengths[1]);
         let g = &d.graph;
         let in_position = g.reachable(&roots(&position));
-        let in_velocity = g.reachable(&[roots(&velocity), roots(&articulated)].concat());
+        let in_velocity =
+            g.reachable(&[roots(&velocity), roots(&articulated), roots(&mass)].concat());
         let cached = (0..g.len())
             .filter(|&i| in_position[i] && in_velocity[i])
             .map(|i| id_at(g, i))
@@ -109,6 +105,7 @@ impl FusedTerms {
             velocity,
             articulated,
             response,
+            mass,
         }
     }
 
@@ -167,14 +164,23 @@ impl FusedTerms {
             outputs: position_outputs,
             tail: String::new(),
         };
+        let by_columns = !self.mass.is_empty();
         let velocity = FunctionSpec {
             doc: docs.velocity_terms(),
             name: "velocity_terms".into(),
             params: vec![
                 param("t", "f64"),
-                param("q", "&[f64]"),
+                Param {
+                    name: "q",
+                    ty: "&[f64]",
+                    always_used: by_columns,
+                },
                 param("qd", "&[f64]"),
-                cache_param("&[f64]"),
+                Param {
+                    name: "cache",
+                    ty: "&[f64]",
+                    always_used: uses_cache || by_columns,
+                },
                 Param {
                     name: "out",
                     ty: "rt::VelocityTerms<'_>",
@@ -183,7 +189,11 @@ impl FusedTerms {
             ],
             ret: None,
             outputs: self.velocity.clone(),
-            tail: String::new(),
+            tail: if by_columns {
+                super::articulated::mass_columns_tail(self.mass.len())
+            } else {
+                String::new()
+            },
         };
         vec![(position, Vec::new()), (velocity, self.cache_given())]
     }
@@ -211,6 +221,7 @@ pub(super) fn all_roots(d: &Derivation, specs: &[FunctionSpec], fused: &FusedTer
         .chain(fused.velocity.iter().map(|(_, id)| *id))
         .chain(fused.articulated.iter().map(|(_, id)| *id))
         .chain(fused.response.iter().map(|(_, id)| *id))
+        .chain(fused.mass.iter().map(|(_, id)| *id))
         .collect();
     for c in &d.contacts {
         roots.extend(contact_output_roots(c));
