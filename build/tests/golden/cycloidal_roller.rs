@@ -520,7 +520,14 @@ impl rt::Dynamics for Model {
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -585,7 +592,14 @@ impl rt::Dynamics for Model {
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -655,7 +669,14 @@ impl rt::Dynamics for Model {
             + c_cam_angle * neg_roller_convective_y;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -768,7 +789,14 @@ impl rt::Dynamics for Model {
             + c_cam_angle * neg_roller_convective_y;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -876,7 +904,17 @@ impl rt::Dynamics for Model {
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            rt::contact::warm_or(out[0].parameter, || f64::NAN),
+            rt::contact::warm_or(
+                out[0].parameter,
+                || rt::contact::pitch_parameter(
+                    neg_roller_j2_cam_angle,
+                    roller_j1_cam_angle,
+                    rt::contact::Pitch::Translating {
+                        offset: 0.0,
+                    },
+                    (0.0, 6.283185307179586),
+                ),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -1041,7 +1079,17 @@ impl rt::Dynamics for Model {
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            rt::contact::warm_or(cache[6], || f64::NAN),
+            rt::contact::warm_or(
+                cache[6],
+                || rt::contact::pitch_parameter(
+                    neg_roller_j2_cam_angle,
+                    roller_j1_cam_angle,
+                    rt::contact::Pitch::Translating {
+                        offset: 0.0,
+                    },
+                    (0.0, 6.283185307179586),
+                ),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -1276,7 +1324,14 @@ fn contact_kinematics_0(
         + c_cam_angle * neg_roller_convective_y;
     let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
     let roller_parameter = rt::contact::solve(
-        f64::NAN,
+        rt::contact::pitch_parameter(
+            neg_roller_j2_cam_angle,
+            roller_j1_cam_angle,
+            rt::contact::Pitch::Translating {
+                offset: 0.0,
+            },
+            (0.0, 6.283185307179586),
+        ),
         (0.0, 6.283185307179586),
         |s_try| roller_parameter_residual(
             derived,

@@ -22,9 +22,12 @@ use super::curve::{
 };
 use super::relative::Relative;
 use super::{ContactTerms, Formulas};
+use crate::design::{CamDesign, Motion};
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{Symbols, vec3};
 use crate::model::{Field, Model, Profile};
+use camchain_runtime::contact::Pitch;
+use camchain_runtime::kinds::Outline;
 
 /// What follows the profile.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +39,25 @@ pub enum Rim {
     /// A roller of this radius (0 for a knife edge) in a face cam's groove, its centre on
     /// the groove's centre line (the profile).
     Groove(f64),
+}
+
+/// How a design's follower point moves, for Newton's cold start: a knife's edge or a
+/// roller's centre on a disc or face cam (the profile's parameter is the design's u = −σθ,
+/// `camchain_model::design::profile_expressions`); `None` for a flat face or a barrel.
+fn pitch_of(design: &CamDesign) -> Option<Pitch> {
+    match (design.senses.shape.outline(), &design.geometry.motion) {
+        (Outline::Line, _) | (_, Motion::Axial { .. }) => None,
+        (Outline::Point | Outline::Circle, Motion::Translating { offset }) => {
+            Some(Pitch::Translating { offset: *offset })
+        }
+        (Outline::Point | Outline::Circle, Motion::Oscillating { pivot, arm, .. }) => {
+            Some(Pitch::Oscillating {
+                pivot: *pivot,
+                arm: *arm,
+                swing: design.senses.swing,
+            })
+        }
+    }
 }
 
 /// The terms of contact `index` followed as `rim` says.
@@ -72,7 +94,13 @@ pub fn nearest(
         // A ball on a surface of revolution, in its meridian half-plane (r, Z): from Z.
         Profile::Revolution { .. } => Guess::Input(1),
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
-        Profile::Parametric { .. } | Profile::Face { .. } => Guess::Scan,
+        // A cam designed from a law: its pitch curve inverted at the follower point (exact
+        // in contact); any other parametric curve: a scan of its range.
+        Profile::Parametric { .. } | Profile::Face { .. } => contact
+            .design
+            .as_ref()
+            .and_then(pitch_of)
+            .map_or(Guess::Scan, Guess::Pitch),
     };
     let what = match rim {
         Rim::Roller(_) => format!(
