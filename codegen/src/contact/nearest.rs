@@ -17,6 +17,7 @@
 //! roller's centre stays on it: h = D, with J and c as above; the roller touches the inner
 //! flank c(s*) − ρ n, whose curvature is κ/(1 + κρ) (docs/method.md §13.7).
 
+use super::circle;
 use super::curve::{
     self, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
 };
@@ -42,21 +43,17 @@ pub enum Rim {
 }
 
 /// How a design's follower point moves, for Newton's cold start: a knife's edge or a
-/// roller's centre on a disc or face cam (the profile's parameter is the design's u = −σθ,
-/// `camchain_model::design::profile_expressions`); `None` for a flat face or a barrel.
+/// roller's centre on a disc or face cam guided along a line (the profile's parameter is the
+/// design's u = −σθ, `camchain_model::design::profile_expressions`); `None` for a flat face
+/// or a barrel, and for now for an oscillating follower: away from contact (the reference
+/// tests' states) its start can lie on the far side of the range's ends from the nearest
+/// point, and Newton then ends 2π from the reference's parameter (polynomial_rocker).
 fn pitch_of(design: &CamDesign) -> Option<Pitch> {
     match (design.senses.shape.outline(), &design.geometry.motion) {
-        (Outline::Line, _) | (_, Motion::Axial { .. }) => None,
         (Outline::Point | Outline::Circle, Motion::Translating { offset }) => {
             Some(Pitch::Translating { offset: *offset })
         }
-        (Outline::Point | Outline::Circle, Motion::Oscillating { pivot, arm, .. }) => {
-            Some(Pitch::Oscillating {
-                pivot: *pivot,
-                arm: *arm,
-                swing: design.senses.swing,
-            })
-        }
+        (Outline::Line, _) | (_, Motion::Axial { .. } | Motion::Oscillating { .. }) => None,
     }
 }
 
@@ -73,6 +70,9 @@ pub fn nearest(
         Rim::Roller(r) => Some(r),
         Rim::Knife | Rim::Groove(_) => None,
     };
+    if let (Rim::Knife | Rim::Roller(_), Some(circle)) = (rim, circle::circular(model, index)) {
+        return circle::on_circle(g, model, s, index, rel, radius, circle);
+    }
     let contact = &model.contacts[index];
     let name = &contact.name;
     let side = follower_side(&contact.profile);
