@@ -122,6 +122,9 @@ pub enum Guess {
     },
     /// None: the best sample of the range by the objective.
     Scan,
+    /// A designed cam's pitch curve inverted at the point (input 0, input 1)
+    /// (`camchain_runtime::contact::pitch_parameter`).
+    Pitch(camchain_runtime::contact::Pitch),
 }
 
 /// A variable defined implicitly: the root s of ψ(s; p) = 0 with ψ'(s) < 0 (a minimum of

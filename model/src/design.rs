@@ -712,6 +712,42 @@ mod tests {
         }
     }
 
+    /// Newton's cold start for a designed cam (`camchain_runtime::contact::pitch_parameter`,
+    /// what the code generator emits for it) inverts the pitch curve: at every design point
+    /// of every knife and roller design it gives the profile's parameter u = −σθ (wrapped to
+    /// [0, 2π)) to rounding, so that a contact's first solve at a new state needs no scan.
+    #[test]
+    fn the_pitch_curve_inverted_is_the_profiles_parameter() {
+        use camchain_runtime::contact::{Pitch, pitch_parameter};
+        let tau = std::f64::consts::TAU;
+        let mut checked = 0;
+        for (what, g, senses, h) in designs() {
+            let pitch = match (senses.shape.outline(), &g.motion) {
+                (Outline::Line, _) | (_, Motion::Axial { .. }) => continue,
+                (_, Motion::Translating { offset }) => Pitch::Translating { offset: *offset },
+                (_, Motion::Oscillating { pivot, arm, .. }) => Pitch::Oscillating {
+                    pivot: *pivot,
+                    arm: *arm,
+                    swing: senses.swing,
+                },
+            };
+            let d = design(g.clone(), senses, h);
+            for k in 0..360 {
+                let theta = tau * (k as f64 + 0.3) / 360.0;
+                let at = d.at(theta);
+                let u = pitch_parameter(at.pitch[0], at.pitch[1], pitch, (0.0, tau));
+                let expected = (-senses.turning * theta).rem_euclid(tau);
+                let off = (u - expected).abs().min(tau - (u - expected).abs());
+                assert!(
+                    off < 1e-12 && (0.0..tau).contains(&u),
+                    "{what}: θ = {theta}: u = {u}, expected {expected}"
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 4 * 360);
+    }
+
     /// The closed-form radius of curvature (the module's formulas) against the curvature of
     /// the profile's expressions, differentiated in forward mode (`crate::jet`, through
     /// `crate::samples::curvature`: an independent route, nothing of the radii's derivation

@@ -53,6 +53,65 @@ pub fn warm_or(slot: f64, cold: impl FnOnce() -> f64) -> f64 {
     if slot.is_finite() { slot } else { cold() }
 }
 
+/// How the follower point of a cam designed from a motion law moves in the design frame
+/// (`camchain_model::design`): what [`pitch_parameter`] inverts. The follower point is a
+/// knife's edge or a roller's centre; the design frame is the cam frame at cam angle 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pitch {
+    /// Along the design frame's y axis on the line x = `offset` (m), above the cam's axis.
+    Translating {
+        /// The guide's offset from the cam's centre (m).
+        offset: f64,
+    },
+    /// On the circle of radius `arm` (m) about `pivot` (design frame, m); `swing` (±1) is
+    /// the sense in which the arm is turned from the pivot's line towards the cam's centre.
+    Oscillating {
+        /// The arm's pivot (m).
+        pivot: [f64; 2],
+        /// From the pivot to the follower point (m).
+        arm: f64,
+        /// +1 when the arm lies counterclockwise of the line from the pivot to the cam's
+        /// centre, −1 clockwise.
+        swing: f64,
+    },
+}
+
+/// The parameter u of a designed cam's profile (and pitch curve) whose pitch point is the
+/// follower point (x, y) of the cam frame, wrapped into `range`: Newton's cold start for a
+/// designed cam, in place of a scan of the profile.
+///
+/// The design turns the follower's point P (design frame) into the cam frame by R(u), so
+/// that the polar angle of (x, y) is u plus that of P. P itself is where the follower's path
+/// (a guide's line, an arm's circle) is at the distance |(x, y)| from the cam's centre, since
+/// a rotation keeps distances. Exact (to rounding) wherever the follower point is on the
+/// pitch curve, as it is in contact; a start near the root elsewhere (a follower in
+/// flight, a design whose dimensions a run-time parameter changed). NaN where the path
+/// never comes to that distance: [`solve`] then scans.
+pub fn pitch_parameter(x: f64, y: f64, pitch: Pitch, range: (f64, f64)) -> f64 {
+    let r2 = x * x + y * y;
+    let design = match pitch {
+        Pitch::Translating { offset } => [offset, (r2 - offset * offset).sqrt()],
+        Pitch::Oscillating { pivot, arm, swing } => {
+            let d = pivot[0].hypot(pivot[1]);
+            // The angle α between the arm and the inward line −A/d: |A + a u|² = r².
+            let cos = (d * d + arm * arm - r2) / (2.0 * d * arm);
+            let sin = swing.signum() * (1.0 - cos * cos).sqrt();
+            let inward = [-pivot[0] / d, -pivot[1] / d];
+            [
+                pivot[0] + arm * (cos * inward[0] - sin * inward[1]),
+                pivot[1] + arm * (sin * inward[0] + cos * inward[1]),
+            ]
+        }
+    };
+    let u = y.atan2(x) - design[1].atan2(design[0]);
+    let length = range.1 - range.0;
+    if length > 0.0 && length.is_finite() {
+        range.0 + (u - range.0).rem_euclid(length)
+    } else {
+        u
+    }
+}
+
 /// Newton's method with steps limited to [`MAX_STEP_FRACTION`] of `length`.
 fn newton(mut s: f64, length: f64, residual: &impl Fn(f64) -> [f64; 2]) -> Option<f64> {
     let max_step = MAX_STEP_FRACTION * length;

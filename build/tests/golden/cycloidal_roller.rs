@@ -523,7 +523,14 @@ impl rt::Dynamics for Model {
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -588,7 +595,14 @@ impl rt::Dynamics for Model {
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -658,7 +672,14 @@ impl rt::Dynamics for Model {
             + c_cam_angle * neg_roller_convective_y;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -771,7 +792,14 @@ impl rt::Dynamics for Model {
             + c_cam_angle * neg_roller_convective_y;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            f64::NAN,
+            rt::contact::pitch_parameter(
+                neg_roller_j2_cam_angle,
+                roller_j1_cam_angle,
+                rt::contact::Pitch::Translating {
+                    offset: 0.0,
+                },
+                (0.0, 6.283185307179586),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -879,7 +907,17 @@ impl rt::Dynamics for Model {
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            rt::contact::warm_or(out[0].parameter, || f64::NAN),
+            rt::contact::warm_or(
+                out[0].parameter,
+                || rt::contact::pitch_parameter(
+                    neg_roller_j2_cam_angle,
+                    roller_j1_cam_angle,
+                    rt::contact::Pitch::Translating {
+                        offset: 0.0,
+                    },
+                    (0.0, 6.283185307179586),
+                ),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -1044,7 +1082,17 @@ impl rt::Dynamics for Model {
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
-            rt::contact::warm_or(cache[6], || f64::NAN),
+            rt::contact::warm_or(
+                cache[6],
+                || rt::contact::pitch_parameter(
+                    neg_roller_j2_cam_angle,
+                    roller_j1_cam_angle,
+                    rt::contact::Pitch::Translating {
+                        offset: 0.0,
+                    },
+                    (0.0, 6.283185307179586),
+                ),
+            ),
             (0.0, 6.283185307179586),
             |s_try| roller_parameter_residual(
                 &self.derived,
@@ -1279,7 +1327,14 @@ fn contact_kinematics_0(
         + c_cam_angle * neg_roller_convective_y;
     let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
     let roller_parameter = rt::contact::solve(
-        f64::NAN,
+        rt::contact::pitch_parameter(
+            neg_roller_j2_cam_angle,
+            roller_j1_cam_angle,
+            rt::contact::Pitch::Translating {
+                offset: 0.0,
+            },
+            (0.0, 6.283185307179586),
+        ),
         (0.0, 6.283185307179586),
         |s_try| roller_parameter_residual(
             derived,

@@ -6,7 +6,7 @@
 //! - [`curve`]: the profile as a curve c(s) (explicit, polar, parametric);
 //! - the kinds: [`knife`] (a knife edge on y = f(x), the paper's eqs. 1–8, in closed form),
 //!   [`nearest`] (a roller, or a knife edge, on any profile: the profile point nearest the
-//!   follower point, found by Newton), [`flat`] (a flat face: the profile's extreme point
+//!   follower point, found by Newton; on a circular profile in closed form: [`circle`]), [`flat`] (a flat face: the profile's extreme point
 //!   along the face's normal), [`surface`] (a point on a cam surface z = f(x, y), or in a
 //!   barrel cam's groove) and [`revolution`] (a point outside a surface of revolution).
 //!
@@ -15,6 +15,7 @@
 //! the outputs take it from there.
 
 pub mod ball;
+pub mod circle;
 pub mod curve;
 pub mod flat;
 pub mod knife;

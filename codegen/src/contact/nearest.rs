@@ -17,14 +17,18 @@
 //! roller's centre stays on it: h = D, with J and c as above; the roller touches the inner
 //! flank c(s*) − ρ n, whose curvature is κ/(1 + κρ) (docs/method.md §13.7).
 
+use super::circle;
 use super::curve::{
     self, dot2, follower_side, labelled_frame, perp, solved_point, sub2, trial_point,
 };
 use super::relative::Relative;
 use super::{ContactTerms, Formulas};
+use crate::design::{CamDesign, Motion};
 use crate::expr::{Graph, Guess, Implicit};
 use crate::kinematics::{Symbols, vec3};
 use crate::model::{Field, Model, Profile};
+use camchain_runtime::contact::Pitch;
+use camchain_runtime::kinds::Outline;
 
 /// What follows the profile.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +40,21 @@ pub enum Rim {
     /// A roller of this radius (0 for a knife edge) in a face cam's groove, its centre on
     /// the groove's centre line (the profile).
     Groove(f64),
+}
+
+/// How a design's follower point moves, for Newton's cold start: a knife's edge or a
+/// roller's centre on a disc or face cam guided along a line (the profile's parameter is the
+/// design's u = −σθ, `camchain_model::design::profile_expressions`); `None` for a flat face
+/// or a barrel, and for now for an oscillating follower: away from contact (the reference
+/// tests' states) its start can lie on the far side of the range's ends from the nearest
+/// point, and Newton then ends 2π from the reference's parameter (polynomial_rocker).
+fn pitch_of(design: &CamDesign) -> Option<Pitch> {
+    match (design.senses.shape.outline(), &design.geometry.motion) {
+        (Outline::Point | Outline::Circle, Motion::Translating { offset }) => {
+            Some(Pitch::Translating { offset: *offset })
+        }
+        (Outline::Line, _) | (_, Motion::Axial { .. } | Motion::Oscillating { .. }) => None,
+    }
 }
 
 /// The terms of contact `index` followed as `rim` says.
@@ -51,6 +70,9 @@ pub fn nearest(
         Rim::Roller(r) => Some(r),
         Rim::Knife | Rim::Groove(_) => None,
     };
+    if let (Rim::Knife | Rim::Roller(_), Some(circle)) = (rim, circle::circular(model, index)) {
+        return circle::on_circle(g, model, s, index, rel, radius, circle);
+    }
     let contact = &model.contacts[index];
     let name = &contact.name;
     let side = follower_side(&contact.profile);
@@ -72,7 +94,13 @@ pub fn nearest(
         // A ball on a surface of revolution, in its meridian half-plane (r, Z): from Z.
         Profile::Revolution { .. } => Guess::Input(1),
         Profile::Polar { .. } => Guess::Angle { x: 0, y: 1 },
-        Profile::Parametric { .. } | Profile::Face { .. } => Guess::Scan,
+        // A cam designed from a law: its pitch curve inverted at the follower point (exact
+        // in contact); any other parametric curve: a scan of its range.
+        Profile::Parametric { .. } | Profile::Face { .. } => contact
+            .design
+            .as_ref()
+            .and_then(pitch_of)
+            .map_or(Guess::Scan, Guess::Pitch),
     };
     let what = match rim {
         Rim::Roller(_) => format!(

@@ -335,6 +335,7 @@ impl<'g> Emitter<'g> {
             Guess::Input(i) => inputs[i].clone(),
             Guess::Angle { x, y } => format!("{}.atan2({})", inputs[y], inputs[x]),
             Guess::Scan => "f64::NAN".to_string(),
+            Guess::Pitch(pitch) => pitch_call(&inputs, pitch, def.range),
         };
         let guess = match self.warm.get(&id) {
             Some(slot) => format!("rt::contact::warm_or({slot}, || {cold})"),
@@ -598,4 +599,36 @@ fn output_name(target: &str) -> String {
     } else {
         name
     }
+}
+
+/// `rt::contact::pitch_parameter(x, y, rt::contact::Pitch::…, range)`: a designed cam's
+/// cold start.
+fn pitch_call(
+    inputs: &[String],
+    pitch: camchain_runtime::contact::Pitch,
+    range: (f64, f64),
+) -> String {
+    use camchain_runtime::contact::Pitch;
+    let path = match pitch {
+        Pitch::Translating { offset } => {
+            format!(
+                "rt::contact::Pitch::Translating {{ offset: {} }}",
+                lit(offset)
+            )
+        }
+        Pitch::Oscillating { pivot, arm, swing } => format!(
+            "rt::contact::Pitch::Oscillating {{ pivot: [{}, {}], arm: {}, swing: {} }}",
+            lit(pivot[0]),
+            lit(pivot[1]),
+            lit(arm),
+            lit(swing)
+        ),
+    };
+    format!(
+        "rt::contact::pitch_parameter({}, {}, {path}, ({}, {}))",
+        inputs[0],
+        inputs[1],
+        lit(range.0),
+        lit(range.1)
+    )
 }

@@ -68,6 +68,9 @@ impl Graph {
             Guess::Input(i) => inputs[i],
             Guess::Angle { x, y } => inputs[y].atan2(inputs[x]),
             Guess::Scan => f64::NAN,
+            Guess::Pitch(pitch) => {
+                camchain_runtime::contact::pitch_parameter(inputs[0], inputs[1], pitch, def.range)
+            }
         };
         let local = std::cell::RefCell::new(local);
         let eval_at = |s: f64, roots: &[Id]| {
