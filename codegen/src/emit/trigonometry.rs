@@ -120,8 +120,10 @@ pub(super) fn angle_name(g: &Graph, angle: Id) -> Option<String> {
         |k| names.push(g.var_names().get(k as usize)),
         &mut ok,
     );
+    // The generator's own inputs (`__x_q1`, the joint rates M multiplies) are not angles.
+    let internal = names.iter().flatten().any(|n| n.starts_with("__"));
     let names: Option<Vec<String>> = names.into_iter().map(|n| n.map(|n| sanitize(n))).collect();
-    names.filter(|_| ok).map(|n| n.join("_"))
+    names.filter(|_| ok && !internal).map(|n| n.join("_"))
 }
 
 /// sin or cos of the angle `vars` from two known angles P, R with vars = P − R or P + R.
