@@ -16,6 +16,7 @@
 //!
 //! Everything works in a preallocated [`Workspace`]; no step allocates.
 
+mod band;
 mod choice;
 mod linalg;
 mod multipliers;

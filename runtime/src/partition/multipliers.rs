@@ -1,7 +1,8 @@
 //! The constraint multipliers, the contact normal forces they give and the drive loads,
 //! from (14) after the accelerations.
 
-use super::linalg::{lu_solve_transposed, residual_into};
+use super::band::solve_dependent_transposed;
+use super::linalg::residual_into;
 use super::{Partition, Workspace};
 use crate::error::SimError;
 
@@ -33,7 +34,7 @@ impl Workspace {
         for (lambda, &v) in self.lambda.iter_mut().zip(partition.dependent()) {
             *lambda = -self.residual[v];
         }
-        lu_solve_transposed(&self.jv_lu, &self.pivots, self.nc, &mut self.lambda);
+        solve_dependent_transposed(&self.band, &self.jv_lu, &self.pivots, &mut self.lambda);
         if self.lambda.iter().any(|x| !x.is_finite()) {
             return Err(self.non_finite(t, "λ"));
         }

@@ -1,7 +1,8 @@
 //! The acceleration level, eqs. (16)–(18): the reduced mass matrix Tᵀ M T, its right-hand
 //! side and their L D Lᵀ solve for ü, then q̈ = T ü + g.
 
-use super::linalg::{dot, lu_solve, residual_into, solve_ldlt, solve_reduced};
+use super::band::solve_dependent;
+use super::linalg::{dot, residual_into, solve_ldlt, solve_reduced};
 use super::{Partition, Workspace};
 use crate::dynamics::{Dynamics, VelocityTerms};
 use crate::error::SimError;
@@ -175,12 +176,12 @@ impl Workspace {
                 .sum();
             self.b_vector[k] = -(self.bias[k] + driven);
         }
-        lu_solve(&self.jv_lu, &self.pivots, nc, &mut self.b_vector);
+        solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.b_vector);
         for (a, &u) in partition.independent().iter().enumerate() {
             for k in 0..nc {
                 self.scratch[k] = -self.jacobian[k * n + u];
             }
-            lu_solve(&self.jv_lu, &self.pivots, nc, &mut self.scratch);
+            solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.scratch);
             for k in 0..nc {
                 self.b_matrix[k * nu + a] = self.scratch[k];
             }
