@@ -179,6 +179,7 @@ pub(super) fn dependent_log_determinant(
     // Chained loops: J_v is a band matrix, factored in O(nc) (once per step, to decide on a
     // re-partition).
     let mut band = Band::default();
+    band.jacobian_rows.update(&j[..nc * n], n);
     match band.factor(j, n, dependent, 0.0) {
         Some(true) => return band.log_determinant(),
         Some(false) => return f64::NEG_INFINITY,

@@ -1,8 +1,7 @@
 //! The constraint multipliers, the contact normal forces they give and the drive loads,
 //! from (14) after the accelerations.
 
-use super::band::solve_dependent_transposed;
-use super::linalg::residual_into;
+use super::band::{residual_rows, solve_dependent_transposed};
 use super::{Partition, Workspace};
 use crate::error::SimError;
 
@@ -24,7 +23,8 @@ impl Workspace {
     /// Multipliers and drive loads from (14), after [`Self::solve_accelerations`]:
     /// J_vᵀ λ = −(M q̈ + F + Q)_v, then τ_d = (M q̈ + F + Q + Jᵀλ)_d (zero elsewhere).
     pub fn solve_multipliers(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
-        residual_into(
+        residual_rows(
+            &mut self.band.mass_rows,
             &mut self.residual,
             &self.mass,
             &self.qdd,

@@ -3,9 +3,9 @@
 //! velocities.
 
 use super::Workspace;
-use super::choice::conditioning;
 use super::band::solve_dependent;
-use super::linalg::{dot, euclidean, gather_columns, lu_factor, max_abs};
+use super::choice::conditioning;
+use super::linalg::{euclidean, gather_columns, lu_factor, max_abs};
 use crate::dynamics::Dynamics;
 use crate::error::SimError;
 
@@ -309,7 +309,10 @@ impl Workspace {
     /// Factors J_v of the J last evaluated (by [`Self::solve_positions`], which always ends
     /// with an evaluation at the returned q, or [`Self::factor_jacobian`]).
     pub fn factor_current_jacobian(&mut self, dependent: &[usize], t: f64) -> Result<(), SimError> {
-        if self.jacobian.iter().any(|x| !x.is_finite()) {
+        // Which columns of each row may be nonzero (checked): the row operations below and
+        // those of the velocity and acceleration levels read only those.
+        self.band.jacobian_rows.update(&self.jacobian, self.n);
+        if self.band.jacobian_rows.any_non_finite(&self.jacobian) {
             return Err(self.non_finite(t, "J"));
         }
         let floor = self.jacobian_floor();
@@ -347,8 +350,7 @@ impl Workspace {
             self.qd[v] = 0.0;
         }
         for k in 0..self.nc {
-            let row = &self.jacobian[k * self.n..(k + 1) * self.n];
-            self.scratch[k] = -dot(row, &self.qd);
+            self.scratch[k] = -self.band.jacobian_rows.dot_row(&self.jacobian, k, &self.qd);
         }
         solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.scratch);
         for (&vd, &v) in self.scratch.iter().zip(dependent) {
