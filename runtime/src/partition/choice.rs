@@ -1,6 +1,7 @@
 //! The choice of the dependent coordinates (and of the independent constraint rows) and its
 //! conditioning, which decides when a run re-partitions.
 
+use super::band::Band;
 use super::linalg::{gather_columns, lu_factor};
 
 /// Re-partition threshold on [`conditioning`]: the dependent coordinates are re-chosen after
@@ -175,6 +176,15 @@ pub(super) fn dependent_log_determinant(
     n: usize,
     dependent: &[usize],
 ) -> f64 {
+    // Chained loops: J_v is a band matrix, factored in O(nc) (once per step, to decide on a
+    // re-partition).
+    let mut band = Band::default();
+    band.jacobian_rows.update(&j[..nc * n], n);
+    match band.factor(j, n, dependent, 0.0) {
+        Some(true) => return band.log_determinant(),
+        Some(false) => return f64::NEG_INFINITY,
+        None => {}
+    }
     let mut stack = [0.0; 16];
     let mut pivots_stack = [0; 4];
     let mut heap = Vec::new();

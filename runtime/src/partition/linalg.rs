@@ -1,20 +1,6 @@
 //! The small dense kernels of the partitioned dynamics: LU with partial pivoting for J_v,
 //! the square-root-free L D Lᵀ for the reduced mass matrix, and vector helpers.
 
-/// `out = M x + F + Q`.
-pub(super) fn residual_into(
-    out: &mut [f64],
-    mass: &[f64],
-    x: &[f64],
-    inertial: &[f64],
-    applied: &[f64],
-) {
-    let n = out.len();
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = dot(&mass[i * n..(i + 1) * n], x) + inertial[i] + applied[i];
-    }
-}
-
 pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

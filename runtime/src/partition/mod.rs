@@ -17,6 +17,7 @@
 //! Everything works in a preallocated [`Workspace`]; no step allocates.
 
 mod articulated;
+mod band;
 mod choice;
 mod linalg;
 mod multipliers;

@@ -1,7 +1,7 @@
 //! The constraint multipliers, the contact normal forces they give and the drive loads,
 //! from (14) after the accelerations.
 
-use super::linalg::{lu_solve_transposed, residual_into};
+use super::band::{residual_rows, solve_dependent_transposed};
 use super::{Partition, Workspace};
 use crate::error::SimError;
 
@@ -27,7 +27,8 @@ impl Workspace {
             // The articulated route solved λ and the drive loads with the accelerations.
             return Ok(());
         }
-        residual_into(
+        residual_rows(
+            &mut self.band.mass_rows,
             &mut self.residual,
             &self.mass,
             &self.qdd,
@@ -37,7 +38,7 @@ impl Workspace {
         for (lambda, &v) in self.lambda.iter_mut().zip(partition.dependent()) {
             *lambda = -self.residual[v];
         }
-        lu_solve_transposed(&self.jv_lu, &self.pivots, self.nc, &mut self.lambda);
+        solve_dependent_transposed(&self.band, &self.jv_lu, &self.pivots, &mut self.lambda);
         if self.lambda.iter().any(|x| !x.is_finite()) {
             return Err(self.non_finite(t, "λ"));
         }

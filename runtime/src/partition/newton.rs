@@ -3,8 +3,9 @@
 //! velocities.
 
 use super::Workspace;
+use super::band::solve_dependent;
 use super::choice::conditioning;
-use super::linalg::{dot, euclidean, gather_columns, lu_factor, lu_solve, max_abs};
+use super::linalg::{euclidean, gather_columns, lu_factor, max_abs};
 use crate::dynamics::Dynamics;
 use crate::error::SimError;
 
@@ -161,7 +162,7 @@ impl Workspace {
     ) -> Result<f64, SimError> {
         let norm = euclidean(&self.h);
         self.scratch.copy_from_slice(&self.h);
-        lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.scratch);
         for (saved, &v) in self.saved_v.iter_mut().zip(dependent) {
             *saved = self.q[v];
         }
@@ -258,7 +259,7 @@ impl Workspace {
             return self.scratch[0].abs();
         }
         self.scratch.copy_from_slice(&self.h);
-        lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.scratch);
         max_abs(&self.scratch)
     }
 
@@ -308,12 +309,22 @@ impl Workspace {
     /// Factors J_v of the J last evaluated (by [`Self::solve_positions`], which always ends
     /// with an evaluation at the returned q, or [`Self::factor_jacobian`]).
     pub fn factor_current_jacobian(&mut self, dependent: &[usize], t: f64) -> Result<(), SimError> {
-        if self.jacobian.iter().any(|x| !x.is_finite()) {
+        // Which columns of each row may be nonzero (checked): the row operations below and
+        // those of the velocity and acceleration levels read only those.
+        self.band.jacobian_rows.update(&self.jacobian, self.n);
+        if self.band.jacobian_rows.any_non_finite(&self.jacobian) {
             return Err(self.non_finite(t, "J"));
         }
-        gather_columns(&self.jacobian, self.n, dependent, &mut self.jv_lu);
         let floor = self.jacobian_floor();
-        if lu_factor(&mut self.jv_lu, &mut self.pivots, self.nc, floor) {
+        // A band matrix (chained loops) is factored as one; anything else densely.
+        let factored = match self.band.factor(&self.jacobian, self.n, dependent, floor) {
+            Some(factored) => factored,
+            None => {
+                gather_columns(&self.jacobian, self.n, dependent, &mut self.jv_lu);
+                lu_factor(&mut self.jv_lu, &mut self.pivots, self.nc, floor)
+            }
+        };
+        if factored {
             Ok(())
         } else {
             Err(self.singular(t))
@@ -339,10 +350,9 @@ impl Workspace {
             self.qd[v] = 0.0;
         }
         for k in 0..self.nc {
-            let row = &self.jacobian[k * self.n..(k + 1) * self.n];
-            self.scratch[k] = -dot(row, &self.qd);
+            self.scratch[k] = -self.band.jacobian_rows.dot_row(&self.jacobian, k, &self.qd);
         }
-        lu_solve(&self.jv_lu, &self.pivots, self.nc, &mut self.scratch);
+        solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.scratch);
         for (&vd, &v) in self.scratch.iter().zip(dependent) {
             self.qd[v] = vd;
         }

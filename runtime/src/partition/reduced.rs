@@ -1,7 +1,8 @@
 //! The acceleration level, eqs. (16)–(18): the reduced mass matrix Tᵀ M T, its right-hand
 //! side and their L D Lᵀ solve for ü, then q̈ = T ü + g.
 
-use super::linalg::{dot, lu_solve, residual_into, solve_ldlt, solve_reduced};
+use super::band::{residual_rows, solve_dependent};
+use super::linalg::{dot, solve_ldlt, solve_reduced};
 use super::{Partition, Workspace};
 use crate::dynamics::{Dynamics, VelocityTerms};
 use crate::error::SimError;
@@ -179,12 +180,12 @@ impl Workspace {
                 .sum();
             self.b_vector[k] = -(self.bias[k] + driven);
         }
-        lu_solve(&self.jv_lu, &self.pivots, nc, &mut self.b_vector);
+        solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.b_vector);
         for (a, &u) in partition.independent().iter().enumerate() {
             for k in 0..nc {
                 self.scratch[k] = -self.jacobian[k * n + u];
             }
-            lu_solve(&self.jv_lu, &self.pivots, nc, &mut self.scratch);
+            solve_dependent(&self.band, &self.jv_lu, &self.pivots, &mut self.scratch);
             for k in 0..nc {
                 self.b_matrix[k * nu + a] = self.scratch[k];
             }
@@ -230,7 +231,8 @@ impl Workspace {
             self.project_single_dependent(partition);
             return;
         }
-        residual_into(
+        residual_rows(
+            &mut self.band.mass_rows,
             &mut self.residual,
             &self.mass,
             &self.qdd,
@@ -275,14 +277,22 @@ impl Workspace {
         }
     }
 
-    /// `mass_t` = M T (n×nu): column a is M[:, u_a] + Σ_k M[:, v_k] B[k, a].
+    /// `mass_t` = M T (n×nu): column a is M[:, u_a] + Σ_k M[:, v_k] B[k, a], the sum over
+    /// the v_k within row i's extent of M (the others' terms are zero).
     pub(super) fn multiply_mass_by_t(&mut self, partition: &Partition) {
         let (n, nu) = (self.n, self.nu);
+        let dependent = partition.dependent();
+        let sorted = dependent.windows(2).all(|w| w[0] < w[1]);
         for i in 0..n {
             let row = &self.mass[i * n..(i + 1) * n];
+            let (first, end) = if sorted {
+                self.band.mass_rows.dependent_range(i, dependent)
+            } else {
+                (0, dependent.len())
+            };
             for (a, &u) in partition.independent().iter().enumerate() {
-                let coupling: f64 = (partition.dependent().iter().enumerate())
-                    .map(|(k, &v)| row[v] * self.b_matrix[k * nu + a])
+                let coupling: f64 = (first..end)
+                    .map(|k| row[dependent[k]] * self.b_matrix[k * nu + a])
                     .sum();
                 self.mass_t[i * nu + a] = row[u] + coupling;
             }

@@ -43,6 +43,8 @@ pub struct Workspace {
     pub(super) cache: Vec<f64>,
     pub(super) jv_lu: Vec<f64>,
     pub(super) pivots: Vec<usize>,
+    /// J_v factored as a band matrix, when it is one (chained loops).
+    pub(super) band: super::band::Band,
     pub(super) scratch: Vec<f64>,
     pub(super) saved_v: Vec<f64>,
     pub(super) b_matrix: Vec<f64>,
@@ -86,6 +88,7 @@ impl Workspace {
             cache: Vec::new(),
             jv_lu: vec![0.0; nc * nc],
             pivots: vec![0; nc],
+            band: super::band::Band::default(),
             scratch: vec![0.0; nc],
             saved_v: vec![0.0; nc],
             b_matrix: vec![0.0; nc * nu],
