@@ -22,37 +22,6 @@ use super::{Partition, Workspace};
 use crate::dynamics::{ArticulatedTerms, Dynamics};
 use crate::error::SimError;
 
-/// The buffers of the articulated route (empty until first used).
-#[derive(Debug, Clone)]
-pub(super) struct Buffers {
-    /// Use the articulated route when the model provides it (the default).
-    pub(super) enabled: bool,
-    /// True after an articulated solve: λ and the drive loads are already known.
-    pub(super) solved: bool,
-    factors: Vec<f64>,
-    /// A_k, row-major nc × n (driven entries 0).
-    responses: Vec<f64>,
-    /// M_df A_k, row-major nc × n (driven entries only).
-    response_drive: Vec<f64>,
-    /// −J A (nc × nc), then its Cholesky factor.
-    delassus: Vec<f64>,
-    tau: Vec<f64>,
-}
-
-impl Default for Buffers {
-    fn default() -> Self {
-        Buffers {
-            enabled: true,
-            solved: false,
-            factors: Vec::new(),
-            responses: Vec::new(),
-            response_drive: Vec::new(),
-            delassus: Vec::new(),
-            tau: Vec::new(),
-        }
-    }
-}
-
 impl Workspace {
     /// Uses the articulated-body sweeps when the model provides them (`true`, the default)
     /// or always the dense route (`false`): for comparisons of the two.

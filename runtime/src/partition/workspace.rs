@@ -59,7 +59,7 @@ pub struct Workspace {
     /// A next correction at most this times (1 + ‖v‖∞) ends Newton too (0: strict).
     pub(super) newton_slack: f64,
     /// The articulated-body route's buffers ([`Self::use_articulated`]).
-    pub(super) articulated: super::articulated::Buffers,
+    pub(super) articulated: ArticulatedBuffers,
 }
 
 impl Workspace {
@@ -328,6 +328,37 @@ impl Workspace {
             q: self.q.clone(),
             residual,
             on_cam: residual <= self.residual_tolerance(),
+        }
+    }
+}
+
+/// The buffers of the articulated route (empty until first used).
+#[derive(Debug, Clone)]
+pub(super) struct ArticulatedBuffers {
+    /// Use the articulated route when the model provides it (the default).
+    pub(super) enabled: bool,
+    /// True after an articulated solve: λ and the drive loads are already known.
+    pub(super) solved: bool,
+    pub(super) factors: Vec<f64>,
+    /// A_k, row-major nc × n (driven entries 0).
+    pub(super) responses: Vec<f64>,
+    /// M_df A_k, row-major nc × n (driven entries only).
+    pub(super) response_drive: Vec<f64>,
+    /// −J A (nc × nc), then its Cholesky factor.
+    pub(super) delassus: Vec<f64>,
+    pub(super) tau: Vec<f64>,
+}
+
+impl Default for ArticulatedBuffers {
+    fn default() -> Self {
+        ArticulatedBuffers {
+            enabled: true,
+            solved: false,
+            factors: Vec::new(),
+            responses: Vec::new(),
+            response_drive: Vec::new(),
+            delassus: Vec::new(),
+            tau: Vec::new(),
         }
     }
 }
