@@ -398,3 +398,45 @@ fn the_cam_driven_four_bar_closes_where_the_circles_meet() {
     println!("cam_rocker_linkage: lever angle against the circles' intersection {worst:.2e} rad");
     assert!(worst < 1e-10, "the lever is off by {worst:e} rad");
 }
+
+#[test]
+fn the_n_four_bars_reduced_acceleration_is_its_pendulums() {
+    // At a consistent state of the linkage (every crank at θ, every coupler translating:
+    // p = −θ, ṗ = −θ̇) every crank's acceleration is the pendulum's, θ̈ = −(g M r / I) cos θ
+    // with I = 41/3 + 40 kg m² and M r = 41/2 + 40 kg m (pendulum.ron's formulas), for any θ̇
+    // (I does not depend on θ: no velocity term). This exercises the whole right-hand side
+    // of 80 loop rows (Newton, the band LU of J_v, B and b, M T) against the closed
+    // form. Measured 1.7e-13 rad/s² (round-off of the 80-row solves); 1e-10 of the ~11 rad/s²
+    // leaves a margin of 6e3, and also covers states 0.05 rad from the singular positions,
+    // where these exactly symmetric states keep the round-off from growing (docs/method.md
+    // §11.4).
+    let model = models::by_name("n_four_bar").expect("built in");
+    let info = model.info();
+    let gain = 9.81 * (41.0 / 2.0 + 40.0) / (41.0 / 3.0 + 40.0);
+    let mut state = model.assemble(0.0).expect("assembles");
+    let mut worst: f64 = 0.0;
+    for (theta, omega) in [
+        (1.3, -1.0),
+        (0.05, -4.6),
+        (-2.0, -6.0),
+        (3.1, -3.0),
+        (-7.0, 2.0),
+    ] {
+        for (i, c) in info.coordinates.iter().enumerate() {
+            let crank = c.name.starts_with('c');
+            state.q[i] = if crank { theta } else { -theta };
+            state.qd[i] = if crank { omega } else { -omega };
+        }
+        let mut dy = vec![0.0; state.integrated_len()];
+        model.derivative(&mut state, &mut dy).expect("evaluates");
+        // y = (u, u̇, …), u one crank's angle (the partition's choice: the last one's).
+        let &[u] = state.independent() else {
+            panic!("one independent coordinate, got {:?}", state.independent())
+        };
+        assert!(info.coordinates[u].name.starts_with('c'));
+        let exact = -gain * theta.cos();
+        worst = worst.max((dy[1] - exact).abs());
+    }
+    println!("n_four_bar: reduced acceleration against the pendulum's {worst:.2e} rad/s²");
+    assert!(worst < 1e-10 * gain, "off by {worst:e} rad/s²");
+}

@@ -25,6 +25,7 @@
 //! Timings are medians over batches, generated and numeric batches interleaved so that
 //! machine noise hits both alike. No timing is asserted anywhere (see the tests).
 
+mod a02;
 mod cams;
 mod designs;
 mod evaluations;
