@@ -314,17 +314,7 @@ fn mass_product(
             model.bodies[i].name
         ));
         let before = incoming(g, model, kin, &motion, i);
-        let step = vec3::scale(g, x[i], kin[i].axis);
-        motion[i] = Some(match model.bodies[i].joint.kind {
-            JointKind::Revolute => Motion {
-                w: vec3::add(g, before.w, step),
-                v: before.v,
-            },
-            JointKind::Prismatic => Motion {
-                w: before.w,
-                v: vec3::add(g, before.v, step),
-            },
-        });
+        motion[i] = Some(with_joint_rate(g, model, kin, i, before, x[i]));
     }
     let kids = children(model);
     let mut loads: Vec<Option<Force>> = vec![None; n];
@@ -404,8 +394,20 @@ fn joint_acceleration(
         }
         None => joint.rate,
     };
+    (qdd, with_joint_rate(g, model, kin, i, before, qdd))
+}
+
+/// δa = δa′ + S q̈: the joint's rate along its axis, angular or linear.
+fn with_joint_rate(
+    g: &mut Graph,
+    model: &Model,
+    kin: &[BodyKinematics],
+    i: usize,
+    before: Motion,
+    qdd: Id,
+) -> Motion {
     let step = vec3::scale(g, qdd, kin[i].axis);
-    let after = match model.bodies[i].joint.kind {
+    match model.bodies[i].joint.kind {
         JointKind::Revolute => Motion {
             w: vec3::add(g, before.w, step),
             v: before.v,
@@ -414,8 +416,7 @@ fn joint_acceleration(
             w: before.w,
             v: vec3::add(g, before.v, step),
         },
-    };
-    (qdd, after)
+    }
 }
 
 /// Sᵀ (I^A δa + p^A) of a driven joint, written Uᵀ δa + Sᵀ p^A (I^A is symmetric).
