@@ -35,6 +35,9 @@ pub struct Choice {
     /// … of the articulated route: `articulated_terms`, one `articulated_response` per
     /// constraint row, and the multipliers' solve.
     pub articulated_ops: usize,
+    /// True when M is formed column by column by `mass_times` (a large model on the
+    /// articulated route) instead of from its emitted entries.
+    pub mass_by_columns: bool,
 }
 
 /// The outputs of the two functions, before the position level's trigonometry is shared.
@@ -208,6 +211,7 @@ pub(super) fn choose(d: &Derivation, dense_roots: &[Id], asked: Formulation) -> 
         forced,
         dense,
         articulated_ops,
+        mass_by_columns: false,
     }
 }
 

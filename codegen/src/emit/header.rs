@@ -62,6 +62,14 @@ pub(super) fn header(
          // dense {}, articulated {} (the position level, common to both, not included).",
         choice.dense, choice.articulated_ops
     );
+    if choice.mass_by_columns {
+        let _ = writeln!(
+            out,
+            "// M is not emitted entry by entry: `velocity_terms` forms it column by column with n calls\n\
+             // of `mass_times` (the counts of `mass_matrix` and `equations` above are those of the\n\
+             // symbolic entries they return, not of that work)."
+        );
+    }
     if parametric {
         let names: Vec<String> = model
             .runtime_parameters()
@@ -117,6 +125,7 @@ mod tests {
         forced: false,
         dense: 120,
         articulated_ops: 300,
+        mass_by_columns: false,
     };
 
     fn counts() -> Vec<(String, OpCount)> {
@@ -159,6 +168,38 @@ mod tests {
             lines
                 .iter()
                 .all(|l| l.starts_with("//") && l.trim_end() == *l)
+        );
+    }
+
+    #[test]
+    fn a_model_giving_m_by_columns_says_so() {
+        let choice = crate::emit::Choice {
+            articulated: true,
+            mass_by_columns: true,
+            ..CHOICE
+        };
+        let text = header(
+            &model("double_pendulum"),
+            "p.ron",
+            &counts(),
+            true,
+            false,
+            &choice,
+        );
+        assert!(
+            text.contains("Forward dynamics: the articulated-body sweeps (the smaller estimate)")
+        );
+        assert!(text.contains("forms it column by column with n calls\n// of `mass_times`"));
+        assert!(
+            !header(
+                &model("double_pendulum"),
+                "p.ron",
+                &counts(),
+                true,
+                false,
+                &CHOICE
+            )
+            .contains("mass_times")
         );
     }
 
