@@ -16,6 +16,7 @@ mod designs;
 #[path = "../support/eccentric.rs"]
 mod eccentric;
 mod faces;
+mod formulations;
 mod generated_vs_numeric;
 mod grids;
 mod integrators;
