@@ -300,7 +300,7 @@ impl<'a> Locator<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{IntegratorKind, JointKind};
+    use crate::model::{Formulation, IntegratorKind, JointKind};
     use std::path::PathBuf;
 
     /// A small valid model; every value of interest is on its own line (numbers below).
@@ -776,6 +776,28 @@ mod tests {
             "simulation.integrator",
             36,
             "unknown integrator (one of rk4, dopri5, dop853, in any letter case), found `Euler`",
+        );
+    }
+
+    #[test]
+    fn the_formulation_is_a_keyword_of_its_kind() {
+        let m = parse_model(BASE, &file()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.simulation.formulation, Formulation::Auto, "the default");
+        let source = edited(
+            "integrator: Rk4",
+            "integrator: Rk4, formulation: Articulated",
+        );
+        let m = parse_model(&source, &file()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.simulation.formulation, Formulation::Articulated);
+        let e = error_of(&edited(
+            "integrator: Rk4",
+            "integrator: Rk4, formulation: Fast",
+        ));
+        let text = e.to_string();
+        assert!(text.contains("simulation.formulation"), "{text}");
+        assert!(
+            text.contains("`Auto`") && text.contains("`Dense`") && text.contains("`Articulated`"),
+            "{text}"
         );
     }
 
