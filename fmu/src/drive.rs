@@ -10,7 +10,8 @@
 //! speed step acts from the next step on.
 
 use camchain_runtime::{
-    ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo, VelocityTerms,
+    ArticulatedTerms, ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo,
+    VelocityTerms,
 };
 
 /// The times at which a drive is sampled to tell whether its speed is constant: spread over
@@ -182,5 +183,29 @@ impl Dynamics for Driven {
     }
     fn velocity_terms(&self, t: f64, q: &[f64], qd: &[f64], cache: &[f64], out: VelocityTerms) {
         self.inner.velocity_terms(t, q, qd, cache, out);
+    }
+    // The articulated route reads the driven accelerations the runtime takes from
+    // `prescribed` (this view's), so it is forwarded as it is.
+    fn articulated_len(&self) -> usize {
+        self.inner.articulated_len()
+    }
+    fn articulated_terms(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        cache: &[f64],
+        out: ArticulatedTerms<'_>,
+    ) {
+        self.inner.articulated_terms(t, q, qd, cache, out);
+    }
+    fn articulated_response(
+        &self,
+        factors: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+        drive: &mut [f64],
+    ) {
+        self.inner.articulated_response(factors, tau, qdd, drive);
     }
 }
