@@ -71,6 +71,30 @@ def test_parameters_and_sweeps_run_on_the_library(paper, cli_csv):
         assert np.allclose(sweep[name], builtin[name], rtol=1e-12, atol=1e-15), name
 
 
+def test_a_file_asking_for_the_articulated_route_runs_alike(paper, cache, tmp_path):
+    # docs/method.md §14: the compiled library carries the articulated-body functions, and
+    # the package's engine takes that route for it. Against the built-in model on the dense
+    # route: the right-hand sides agree to round-off, the adaptive steps may then differ
+    # marginally, so the runs differ at the file's integration tolerance (1e-10) times the
+    # error's growth over 2 s: 1e-7 of each column's scale leaves margin (as the Rust suite's
+    # tests/suite/formulations.rs).
+    _, path = paper
+    text = path.read_text()
+    asked = text.replace("simulation: (t_end: 10.0,", "simulation: (formulation: Articulated, t_end: 10.0,", 1)
+    assert asked != text
+    other = tmp_path / "paper_concave.ron"
+    other.write_text(asked)
+    compiled = camchain.compile(other, cache_dir=cache, quiet=True)
+    # The library was built from code with the sweeps (the built-in model has none).
+    assert any("fn articulated_terms" in p.read_text() for p in cache.rglob("model.rs"))
+    ours = compiled.simulate(t_end=2.0)
+    builtin = camchain.Model("paper_concave").simulate(t_end=2.0)
+    assert ours.columns == builtin.columns
+    for name in ours.columns:
+        scale = max(1.0, float(np.max(np.abs(builtin[name]))))
+        assert np.max(np.abs(ours[name] - builtin[name])) <= 1e-7 * scale, name
+
+
 def test_a_second_compile_of_the_same_text_is_a_cache_hit(paper, cache, tmp_path, monkeypatch):
     _, path = paper
     # A cache hit runs no cargo: with a cargo that does not exist it still loads (the time

@@ -5,14 +5,15 @@
 use super::Failure;
 use crate::errors::Location;
 use camchain_runtime::{
-    ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo, VelocityTerms,
+    ArticulatedTerms, ContactGeometry, ContactKinematics, Dynamics, Energy, Flank, ModelInfo,
+    VelocityTerms,
 };
 use libloading::Library;
 use std::path::Path;
 use std::sync::Arc;
 
 /// The ABI version of `shim.rs.in` (its `camchain_abi()`).
-pub const ABI: u32 = 1;
+pub const ABI: u32 = 2;
 
 type Ptr = *const Handle;
 type P = *const f64;
@@ -50,6 +51,9 @@ struct Api {
     cache_len: unsafe extern "C" fn(Ptr) -> usize,
     position_terms: unsafe extern "C" fn(Ptr, P, M, M, M),
     velocity_terms: unsafe extern "C" fn(Ptr, f64, P, P, P, M, M, M, M),
+    articulated_len: unsafe extern "C" fn(Ptr) -> usize,
+    articulated_terms: unsafe extern "C" fn(Ptr, f64, P, P, P, M, M, M, M),
+    articulated_response: unsafe extern "C" fn(Ptr, P, P, M, M),
 }
 
 /// A compiled model's library, kept loaded while any instance of it lives (each holds an
@@ -104,6 +108,9 @@ impl Loaded {
             cache_len: get!("cache_len"),
             position_terms: get!("position_terms"),
             velocity_terms: get!("velocity_terms"),
+            articulated_len: get!("articulated_len"),
+            articulated_terms: get!("articulated_terms"),
+            articulated_response: get!("articulated_response"),
         };
         Ok(Arc::new(Loaded {
             _library: library,
@@ -455,6 +462,67 @@ impl Dynamics for Compiled {
                 out.inertial.as_mut_ptr(),
                 out.applied.as_mut_ptr(),
                 out.bias.as_mut_ptr(),
+            )
+        }
+    }
+
+    fn articulated_len(&self) -> usize {
+        // SAFETY: the handle is live while self is.
+        unsafe { (self.loaded.api.articulated_len)(self.handle) }
+    }
+
+    fn articulated_terms(
+        &self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        cache: &[f64],
+        out: ArticulatedTerms<'_>,
+    ) {
+        let (n, m) = (self.n(), self.info.n_constraints());
+        len(q, n);
+        len(qd, n);
+        len(cache, self.cache_len());
+        len(out.qdd, n);
+        len(out.drive, n);
+        len(out.bias, m);
+        len(out.factors, self.articulated_len());
+        // SAFETY: every buffer checked for the lengths the library reads and writes.
+        unsafe {
+            (self.loaded.api.articulated_terms)(
+                self.handle,
+                t,
+                q.as_ptr(),
+                qd.as_ptr(),
+                cache.as_ptr(),
+                out.qdd.as_mut_ptr(),
+                out.drive.as_mut_ptr(),
+                out.bias.as_mut_ptr(),
+                out.factors.as_mut_ptr(),
+            )
+        }
+    }
+
+    fn articulated_response(
+        &self,
+        factors: &[f64],
+        tau: &[f64],
+        qdd: &mut [f64],
+        drive: &mut [f64],
+    ) {
+        let n = self.n();
+        len(factors, self.articulated_len());
+        len(tau, n);
+        len(qdd, n);
+        len(drive, n);
+        // SAFETY: every buffer checked for the lengths the library reads and writes.
+        unsafe {
+            (self.loaded.api.articulated_response)(
+                self.handle,
+                factors.as_ptr(),
+                tau.as_ptr(),
+                qdd.as_mut_ptr(),
+                drive.as_mut_ptr(),
             )
         }
     }

@@ -115,7 +115,14 @@ pub fn compile(
     let info = camchain_reference::NumericModel::new(description.clone())
         .info()
         .clone();
-    let mut parts: Vec<&[u8]> = vec![text.as_bytes(), env!("CARGO_PKG_VERSION").as_bytes()];
+    // The file, the package's version, the shim (its C functions) and the generated code
+    // (what the library is built from, whatever changed in the generator).
+    let mut parts: Vec<&[u8]> = vec![
+        text.as_bytes(),
+        env!("CARGO_PKG_VERSION").as_bytes(),
+        SHIM.as_bytes(),
+        generated.code.as_bytes(),
+    ];
     for file in &description.files {
         parts.push(file.written.as_bytes());
         parts.push(file.text.as_bytes());
