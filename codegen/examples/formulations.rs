@@ -38,12 +38,19 @@ fn main() -> ExitCode {
         eprintln!("usage: formulations OUTDIR [N ...]");
         return ExitCode::from(2);
     };
-    let sizes: Vec<usize> = args[1..].iter().filter_map(|a| a.parse().ok()).collect();
-    let sizes = if sizes.is_empty() {
-        SIZES.to_vec()
-    } else {
-        sizes
-    };
+    let mut sizes = Vec::new();
+    for a in &args[1..] {
+        match a.parse::<usize>() {
+            Ok(n) if n >= 1 => sizes.push(n),
+            _ => {
+                eprintln!("error: `{a}` is not a number of bodies (an integer ≥ 1)");
+                return ExitCode::from(2);
+            }
+        }
+    }
+    if sizes.is_empty() {
+        sizes = SIZES.to_vec();
+    }
     match run(Path::new(out), &sizes) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
