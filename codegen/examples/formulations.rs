@@ -22,8 +22,12 @@
 //! it was preempted, as `scripts/bench/pinocchio` does) in ns per call. Also the operation counts and the
 //! choice `Formulation::Auto` makes. Results: `OUTDIR/formulations.md` and `.csv`.
 
+#[path = "support/cargo.rs"]
+mod cargo;
 #[path = "../tests/common/chain.rs"]
 mod chain;
+
+use cargo::cargo_build;
 
 use camchain_codegen::{EmitOptions, Formulation};
 use std::fmt::Write;
@@ -342,18 +346,3 @@ fn main() {
     println!();
 }
 "#;
-
-fn cargo_build(dir: &Path, target: &Path) -> Result<(), String> {
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["build", "--release", "--quiet", "--manifest-path"])
-        .arg(dir.join("Cargo.toml"))
-        .arg("--target-dir")
-        .arg(target)
-        .status()
-        .map_err(|e| e.to_string())?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(format!("cargo build failed in {}", dir.display()))
-    }
-}

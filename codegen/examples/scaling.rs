@@ -13,8 +13,12 @@
 //! `equations` and `constraint_terms`. Results: `OUTDIR/scaling.md` (markdown table) and
 //! `OUTDIR/scaling.csv`.
 
+#[path = "support/cargo.rs"]
+mod cargo;
 #[path = "../tests/common/chain.rs"]
 mod chain;
+
+use cargo::cargo_build;
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -162,21 +166,6 @@ fn write_crate(out: &Path, n: usize, code: &str, runtime: &Path) -> Result<PathB
     };
     std::fs::write(dir.join("src/main.rs"), main).map_err(|e| e.to_string())?;
     Ok(dir)
-}
-
-fn cargo_build(dir: &Path, target: &Path) -> Result<(), String> {
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["build", "--release", "--quiet", "--manifest-path"])
-        .arg(dir.join("Cargo.toml"))
-        .arg("--target-dir")
-        .arg(target)
-        .status()
-        .map_err(|e| e.to_string())?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(format!("cargo build failed in {}", dir.display()))
-    }
 }
 
 fn report(rows: &[Row]) -> (String, String) {
