@@ -191,12 +191,12 @@ pub fn generate_from(
         Formulation::Auto => options.formulation,
         chosen => chosen,
     };
-    let dense = dense_roots(&d);
-    let mut choice = articulated::choose(&d, &dense, asked);
+    let dense_ops = d.graph.op_count(&dense_roots(&d)).total();
+    let mut choice = articulated::choose(&d, dense_ops, asked);
     // A large model on the articulated route gives M column by column (n products M e_j,
     // O(n) code each) instead of emitting its n² entries: M is off its right-hand side's
     // path, and M's code was most of such a model's build.
-    let mass_by_columns = choice.articulated && d.graph.op_count(&dense).total() > LARGE_MODEL_OPS;
+    let mass_by_columns = choice.articulated && dense_ops > LARGE_MODEL_OPS;
     choice.mass_by_columns = mass_by_columns;
     let aba = choice
         .articulated

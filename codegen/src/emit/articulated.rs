@@ -169,12 +169,12 @@ pub(super) fn factors(g: &Graph, response: &[Id], tau: &[Id]) -> Vec<Id> {
 }
 
 /// Chooses the formulation: `asked` unless it is `Auto`, else the smaller estimate.
-pub(super) fn choose(d: &Derivation, dense_roots: &[Id], asked: Formulation) -> Choice {
+/// `dense_ops`: the operations of the dense route's velocity level (M, F, Q and c).
+pub(super) fn choose(d: &Derivation, dense_ops: usize, asked: Formulation) -> Choice {
     let n = d.symbols.q.len();
     let m = d.constraint_rows().len();
     let nd = d.articulated.driven.len();
     let nu = n.saturating_sub(m + nd);
-    let dense_ops = d.graph.op_count(dense_roots).total();
     // The reduction (16)–(18) at run time: the residual M q̈ + F + Q (n² multiply-adds), B =
     // −J_v⁻¹ J_u (2 m² per column), M T (2 n m per column), Tᵀ M T (nu² (m + 1)) and the
     // factorisation nu³ / 3.
@@ -341,10 +341,14 @@ mod tests {
             .chain(&d.dynamics.applied)
             .copied()
             .collect();
-        let auto = choose(&d, &roots, Formulation::Auto);
+        let auto = choose(&d, d.graph.op_count(&roots).total(), Formulation::Auto);
         assert!(!auto.articulated && !auto.forced, "{auto:?}");
         assert!(auto.dense < auto.articulated_ops);
-        let forced = choose(&d, &roots, Formulation::Articulated);
+        let forced = choose(
+            &d,
+            d.graph.op_count(&roots).total(),
+            Formulation::Articulated,
+        );
         assert!(forced.articulated && forced.forced);
         assert_eq!(forced.dense, auto.dense);
     }
