@@ -40,6 +40,7 @@ mod methods;
 mod model_type;
 mod names;
 mod parameters;
+mod parts;
 mod render;
 mod spec;
 mod tables;
@@ -51,7 +52,7 @@ mod wrapper;
 pub use articulated::{Choice, Formulation};
 use contacts::{contact_kinematics_dispatch, contact_kinematics_helpers, contact_kinematics_specs};
 use docs::ConstraintDocs;
-use function::emit_function_full;
+use function::{emit_function_full, emit_method_in_parts};
 use fused::{FusedTerms, all_roots, function_count, fused_count};
 use header::{header, op_count_table};
 use implicit::implicit_helpers;
@@ -230,6 +231,8 @@ pub fn generate_from(
             EntryPoints::ViaFusedPair => true,
         };
     let mut functions = String::new();
+    // The modules of the large functions' parts (outside the `impl` blocks).
+    let mut part_items = String::new();
     let mut op_counts = Vec::new();
     let geometry_warm: Vec<(Id, String)> = d
         .contacts
@@ -246,6 +249,9 @@ pub fn generate_from(
         };
         let (text, count) = match wrapper(model, fused.cache_len(), &spec.name).filter(|_| wrap) {
             Some(text) => (text, function_count(&d, spec, &derived("self."))),
+            None if warm.is_empty() => {
+                emit_method_in_parts(&d, spec, &derived("self."), &mut part_items)
+            }
             None => emit_function_full(&d, spec, "", true, &derived("self."), &[], warm),
         };
         functions.push_str(&text);
@@ -269,7 +275,11 @@ pub fn generate_from(
         } else {
             Vec::new()
         };
-        let (text, count) = emit_function_full(&d, spec, "", true, &given, memo, &warm);
+        let (text, count) = if memo.is_empty() && warm.is_empty() {
+            emit_method_in_parts(&d, spec, &given, &mut part_items)
+        } else {
+            emit_function_full(&d, spec, "", true, &given, memo, &warm)
+        };
         functions.push_str(&text);
         within_code_limit(functions.len(), options.code_limit)?;
         op_counts.push((spec.name.clone(), count));
@@ -291,7 +301,7 @@ pub fn generate_from(
             &derived("self."),
         );
         for (spec, given) in &aba_specs {
-            let (text, count) = emit_function_full(&d, spec, "", true, given, &[], &[]);
+            let (text, count) = emit_method_in_parts(&d, spec, given, &mut part_items);
             functions.push_str(&text);
             within_code_limit(functions.len(), options.code_limit)?;
             op_counts.push((spec.name.clone(), count));
@@ -307,7 +317,7 @@ pub fn generate_from(
     if mass_by_columns {
         let (spec, given) =
             articulated::mass_times_spec(&d, &fused.mass, &fused.cache_given(), &derived("self."));
-        let (text, count) = emit_function_full(&d, &spec, "", true, &given, &[], &[]);
+        let (text, count) = emit_method_in_parts(&d, &spec, &given, &mut part_items);
         let _ = writeln!(inherent, "impl Model {{\n{text}}}");
         op_counts.push((spec.name.clone(), count));
     }
@@ -355,6 +365,7 @@ pub fn generate_from(
         contact_kinematics_dispatch(model, runtime.is_some())
     );
     file.push_str(&inherent);
+    file.push_str(&part_items);
     file.push_str(&helpers);
     file.push_str(&op_count_table(&op_counts));
     within_code_limit(file.len(), options.code_limit)?;

@@ -4,6 +4,7 @@
 
 use super::emitter::Emitter;
 use super::names::{Names, is_identifier};
+use super::parts;
 use super::spec::{FIELD, FIELDS, FunctionSpec, RETURN};
 use super::trigonometry::TrigMemo;
 use crate::derive::Derivation;
@@ -35,10 +36,35 @@ pub(super) fn emit_function_full(
     memo: &[TrigMemo],
     warm: &[(Id, String)],
 ) -> (String, OpCount) {
+    emit_with(d, spec, prelude, method, given, (memo, warm), None)
+}
+
+/// A method of `Model` as [`emit_function_given`] emits it; one of at least
+/// [`parts::OWN_MODULE_OPS`] operations gets its body moved to a module of its own, appended
+/// to `items` (outside the `impl` block).
+pub(super) fn emit_method_in_parts(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    given: &[(Id, String)],
+    items: &mut String,
+) -> (String, OpCount) {
+    emit_with(d, spec, "", true, given, (&[], &[]), Some(items))
+}
+
+fn emit_with(
+    d: &Derivation,
+    spec: &FunctionSpec,
+    prelude: &str,
+    method: bool,
+    given: &[(Id, String)],
+    (memo, warm): (&[TrigMemo], &[(Id, String)]),
+    items: Option<&mut String>,
+) -> (String, OpCount) {
     let g = &d.graph;
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
     let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
     let count = g.op_count_until(&roots, &given_set);
+    let items = items.filter(|_| method && count.total() >= parts::OWN_MODULE_OPS);
     let mut body = Emitter::new(g, &spec.outputs, given, &d.symbols.params);
     for m in memo {
         body.memo.insert(m.sin, *m);
@@ -78,47 +104,19 @@ pub(super) fn emit_function_full(
             used_params.insert(p.name);
         }
     }
-    let params: Vec<String> = spec
-        .params
-        .iter()
-        .map(|p| {
-            let written = spec
-                .outputs
-                .iter()
-                .any(|(t, _)| t.starts_with(&format!("{}[", p.name)));
-            let used = p.always_used || used_params.contains(p.name) || written;
-            let name = if used {
-                p.name.to_string()
-            } else {
-                format!("_{}", p.name)
-            };
-            format!("{name}: {}", p.ty)
-        })
-        .collect();
-    let receiver = if method { "&self, " } else { "" };
-    let ret = spec.ret.map(|r| format!(" -> {r}")).unwrap_or_default();
-    let mut text = format!(
-        "/// {}\nfn {}({receiver}{}){ret} {{\n",
-        spec.doc,
-        spec.name,
-        params.join(", ")
-    );
-    for (_, line) in &inputs {
-        text.push_str(line);
-    }
-    text.push_str(prelude);
-    text.push_str(&bindings);
+    // The outputs and the tail, after the bindings.
+    let mut after = String::new();
     let mut fields = String::new();
     let filled = zero_filled_arrays(g, &spec.outputs);
     for array in &filled {
-        let _ = writeln!(text, "{array}.fill(0.0);");
+        let _ = writeln!(after, "{array}.fill(0.0);");
     }
     for (target, id) in &spec.outputs {
         if g.is_zero(*id) && array_of(target).is_some_and(|a| filled.contains(&a)) {
             continue;
         }
         if target == RETURN {
-            let _ = writeln!(text, "{}", body.print(*id, 0));
+            let _ = writeln!(after, "{}", body.print(*id, 0));
         } else if let Some(field) = target.strip_prefix(FIELD) {
             let value = body.print(*id, 0);
             if value == field {
@@ -127,10 +125,58 @@ pub(super) fn emit_function_full(
                 let _ = writeln!(fields, "{field}: {value},");
             }
         } else {
-            let _ = writeln!(text, "{target} = {};", body.print(*id, 0));
+            let _ = writeln!(after, "{target} = {};", body.print(*id, 0));
         }
     }
-    text.push_str(&spec.tail.replace(FIELDS, &fields));
+    after.push_str(&spec.tail.replace(FIELDS, &fields));
+    let mut code = String::new();
+    for (_, line) in &inputs {
+        code.push_str(line);
+    }
+    code.push_str(prelude);
+    code.push_str(&bindings);
+    code.push_str(&after);
+    let params: Vec<(String, &str, bool)> = spec
+        .params
+        .iter()
+        .map(|p| {
+            let written = spec
+                .outputs
+                .iter()
+                .any(|(t, _)| t.starts_with(&format!("{}[", p.name)));
+            let used = p.always_used || used_params.contains(p.name) || written;
+            (p.name.to_string(), p.ty, used)
+        })
+        .collect();
+    let ret = spec.ret.map(|r| format!(" -> {r}")).unwrap_or_default();
+    // A large method's body goes to a module of its own; the method passes every argument.
+    let (code, params) = match items {
+        Some(items) => {
+            let (call, module) = parts::moved(&spec.name, &params, &ret, &code);
+            items.push_str(&module);
+            let all_used = params.into_iter().map(|(n, ty, _)| (n, ty, true));
+            (call, all_used.collect())
+        }
+        None => (code, params),
+    };
+    let params: Vec<String> = params
+        .iter()
+        .map(|(name, ty, used)| {
+            if *used {
+                format!("{name}: {ty}")
+            } else {
+                format!("_{name}: {ty}")
+            }
+        })
+        .collect();
+    let receiver = if method { "&self, " } else { "" };
+    let mut text = format!(
+        "/// {}\nfn {}({receiver}{}){ret} {{\n",
+        spec.doc,
+        spec.name,
+        params.join(", ")
+    );
+    text.push_str(&code);
     text.push_str("\n}\n");
     (text, count)
 }

@@ -236,3 +236,42 @@ fn the_build_refuses_a_model_name_that_names_no_module() {
     assert_eq!((e.field.as_str(), e.line), ("name", 0));
     assert!(e.message.contains("some chain-v2"), "{e}");
 }
+
+/// A method of 4000 operations or more has its body in a module of its own, compiled as a
+/// separate codegen unit (in parallel with the rest); the method calls it with every argument.
+/// `tests/random_models/chain16.ron` on the articulated route (its sweeps: about 6900
+/// operations) is compiled this way by the build's tests and checked against the numeric
+/// recursion there (`tests/suite/random_compiled.rs`); the built-in models stay one module.
+#[test]
+fn a_large_method_body_gets_a_module_of_its_own() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/random_models/chain16.ron");
+    let text = std::fs::read_to_string(&path).expect("the random chain");
+    let options = camchain_codegen::EmitOptions {
+        formulation: camchain_codegen::Formulation::Articulated,
+        ..Default::default()
+    };
+    let g = camchain_codegen::generate_source(&text, &path, &options).expect("generates");
+    assert!(count(&g, "articulated_terms") >= 4000);
+    let method = g
+        .code
+        .split("\n    fn articulated_terms(")
+        .nth(1)
+        .expect("the method");
+    let body =
+        &method[method.find('{').expect("its body")..method.find("\n    }").expect("its end")];
+    assert_eq!(
+        body.split_whitespace().collect::<String>(),
+        "{articulated_terms_body::run(self,t,q,qd,cache,out)",
+        "the method only calls its body"
+    );
+    assert!(g.code.contains("mod articulated_terms_body {"));
+    assert_eq!(
+        g.code.matches("_body::run(").count(),
+        g.code.matches("\nmod ").count()
+    );
+    syn::parse_file(&g.code).expect("valid Rust");
+    for (file, g) in every_model() {
+        assert!(!g.code.contains("_body::run("), "{file}: a body moved");
+    }
+}
