@@ -52,7 +52,7 @@ mod wrapper;
 pub use articulated::{Choice, Formulation};
 use contacts::{contact_kinematics_dispatch, contact_kinematics_helpers, contact_kinematics_specs};
 use docs::ConstraintDocs;
-use function::{emit_function_full, emit_method_in_parts};
+use function::{Extras, emit_method, sparse_rows};
 use fused::{FusedTerms, all_roots, function_count, fused_count};
 use header::{header, op_count_table};
 use implicit::implicit_helpers;
@@ -230,8 +230,22 @@ pub fn generate_from(
             EntryPoints::Standalone => false,
             EntryPoints::ViaFusedPair => true,
         };
+    // M and J of many zeros (chained loops) are written by the fused pair within their
+    // rows' extents only, which the model declares (`Dynamics::mass_rows`, `jacobian_rows`).
+    let n = model.n();
+    let fused_rows = |name: &str, array: &str| {
+        let (spec, _) = fused_specs.iter().find(|(s, _)| s.name == name)?;
+        sparse_rows(&d.graph, &spec.outputs, array, n)
+    };
+    let mass_rows = fused_rows("velocity_terms", "out.mass");
+    let jacobian_rows = fused_rows("position_terms", "j");
+    let cleared: Vec<&str> = [("m", &mass_rows), ("j", &jacobian_rows)]
+        .into_iter()
+        .filter(|(_, rows)| rows.is_some())
+        .map(|(a, _)| a)
+        .collect();
     let mut functions = String::new();
-    // The modules of the large functions' parts (outside the `impl` blocks).
+    // The modules of the large methods' bodies (outside the `impl` blocks).
     let mut part_items = String::new();
     let mut op_counts = Vec::new();
     let geometry_warm: Vec<(Id, String)> = d
@@ -247,12 +261,17 @@ pub fn generate_from(
         } else {
             &[]
         };
-        let (text, count) = match wrapper(model, fused.cache_len(), &spec.name).filter(|_| wrap) {
+        let entry = wrapper(model, fused.cache_len(), &spec.name, &cleared).filter(|_| wrap);
+        let (text, count) = match entry {
             Some(text) => (text, function_count(&d, spec, &derived("self."))),
-            None if warm.is_empty() => {
-                emit_method_in_parts(&d, spec, &derived("self."), &mut part_items)
+            None => {
+                let extras = Extras {
+                    warm,
+                    items: Some(&mut part_items),
+                    ..Default::default()
+                };
+                emit_method(&d, spec, &derived("self."), extras)
             }
-            None => emit_function_full(&d, spec, "", true, &derived("self."), &[], warm),
         };
         functions.push_str(&text);
         within_code_limit(functions.len(), options.code_limit)?;
@@ -275,11 +294,17 @@ pub fn generate_from(
         } else {
             Vec::new()
         };
-        let (text, count) = if memo.is_empty() && warm.is_empty() {
-            emit_method_in_parts(&d, spec, &given, &mut part_items)
-        } else {
-            emit_function_full(&d, spec, "", true, &given, memo, &warm)
+        let sparse: &[(&str, usize)] = match spec.name.as_str() {
+            "position_terms" => &[("j", n)],
+            _ => &[("out.mass", n)],
         };
+        let extras = Extras {
+            memo,
+            warm: &warm,
+            sparse,
+            items: Some(&mut part_items),
+        };
+        let (text, count) = emit_method(&d, spec, &given, extras);
         functions.push_str(&text);
         within_code_limit(functions.len(), options.code_limit)?;
         op_counts.push((spec.name.clone(), count));
@@ -290,6 +315,20 @@ pub fn generate_from(
          fn cache_len(&self) -> usize {{ {} }}",
         fused.cache_len()
     );
+    for (name, matrix, writer, rows) in [
+        ("mass_rows", "M", "velocity_terms", &mass_rows),
+        ("jacobian_rows", "J", "position_terms", &jacobian_rows),
+    ] {
+        if let Some(rows) = rows {
+            let list: Vec<String> = rows.iter().map(|(s, e)| format!("({s}, {e})")).collect();
+            let _ = writeln!(
+                functions,
+                "/// For each row of {matrix}, the columns [start, end) outside which it is zero:                  `{writer}` writes {matrix} within them only.\n\
+                 fn {name}(&self) -> Option<&'static [(usize, usize)]> {{ Some(&[{}]) }}",
+                list.join(", ")
+            );
+        }
+    }
     if choice.articulated {
         let cache_given = fused.cache_given();
         let (aba_specs, factors) = articulated::specs(
@@ -301,7 +340,11 @@ pub fn generate_from(
             &derived("self."),
         );
         for (spec, given) in &aba_specs {
-            let (text, count) = emit_method_in_parts(&d, spec, given, &mut part_items);
+            let extras = Extras {
+                items: Some(&mut part_items),
+                ..Default::default()
+            };
+            let (text, count) = emit_method(&d, spec, given, extras);
             functions.push_str(&text);
             within_code_limit(functions.len(), options.code_limit)?;
             op_counts.push((spec.name.clone(), count));
@@ -317,7 +360,11 @@ pub fn generate_from(
     if mass_by_columns {
         let (spec, given) =
             articulated::mass_times_spec(&d, &fused.mass, &fused.cache_given(), &derived("self."));
-        let (text, count) = emit_method_in_parts(&d, &spec, &given, &mut part_items);
+        let extras = Extras {
+            items: Some(&mut part_items),
+            ..Default::default()
+        };
+        let (text, count) = emit_method(&d, &spec, &given, extras);
         let _ = writeln!(inherent, "impl Model {{\n{text}}}");
         op_counts.push((spec.name.clone(), count));
     }

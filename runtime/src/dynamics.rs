@@ -548,6 +548,22 @@ pub trait Dynamics {
         self.constraint_bias(q, qd, out.bias);
     }
 
+    /// For each row of M, the columns [start, end) outside which it is zero at every state,
+    /// when the model knows them: generated models whose M has many zeros (chained loops).
+    /// [`Dynamics::velocity_terms`] then writes each row of M within them only and leaves the
+    /// rest of the buffer as it is, so the buffer must be zero there: freshly zeroed, and
+    /// written by nothing but this model (the runtime's buffers are). The runtime takes
+    /// these extents instead of finding them by reading all of M at every evaluation.
+    /// `None` (the default): `velocity_terms` writes all of M.
+    fn mass_rows(&self) -> Option<&'static [(usize, usize)]> {
+        None
+    }
+
+    /// The same for the rows of J, which [`Dynamics::position_terms`] writes.
+    fn jacobian_rows(&self) -> Option<&'static [(usize, usize)]> {
+        None
+    }
+
     /// The length of the factors [`Dynamics::articulated_terms`] writes; 0 (the default)
     /// when the model does not provide the articulated-body forward dynamics, whose two
     /// functions are then never called.
@@ -659,6 +675,9 @@ macro_rules! forward_free_motion {
             applied: &mut [f64],
         ) {
             self.$inner.equations(t, q, qd, m, f, applied);
+        }
+        fn mass_rows(&self) -> Option<&'static [(usize, usize)]> {
+            self.$inner.mass_rows()
         }
         fn cache_len(&self) -> usize {
             self.$inner.cache_len()

@@ -36,19 +36,40 @@ pub(super) fn emit_function_full(
     memo: &[TrigMemo],
     warm: &[(Id, String)],
 ) -> (String, OpCount) {
-    emit_with(d, spec, prelude, method, given, (memo, warm), None)
+    let extras = Extras {
+        memo,
+        warm,
+        ..Default::default()
+    };
+    emit_with(d, spec, prelude, method, given, extras)
 }
 
-/// A method of `Model` as [`emit_function_given`] emits it; one of at least
-/// [`parts::OWN_MODULE_OPS`] operations gets its body moved to a module of its own, appended
-/// to `items` (outside the `impl` block).
-pub(super) fn emit_method_in_parts(
+/// An output array written within its rows' extents: name, columns, each row's [start, end).
+type SparseArray<'a> = (&'a str, usize, Vec<(usize, usize)>);
+
+/// What a method of `Model` may have beyond its specification.
+#[derive(Default)]
+pub(super) struct Extras<'a> {
+    /// Sine–cosine pairs computed through the cache (`rt::sin_cos_memo`).
+    pub(super) memo: &'a [TrigMemo],
+    /// Where the Newton solves of implicit variables start (their kept solutions).
+    pub(super) warm: &'a [(Id, String)],
+    /// Output arrays (name, columns) written only within their rows' extents
+    /// ([`sparse_rows`]; the caller's buffer is zero outside).
+    pub(super) sparse: &'a [(&'a str, usize)],
+    /// Where the module of a method of at least [`parts::OWN_MODULE_OPS`] operations goes
+    /// (outside the `impl` block); `None`: the body stays in the method.
+    pub(super) items: Option<&'a mut String>,
+}
+
+/// A method of `Model` as [`emit_function_full`] emits it, with `extras`.
+pub(super) fn emit_method(
     d: &Derivation,
     spec: &FunctionSpec,
     given: &[(Id, String)],
-    items: &mut String,
+    extras: Extras,
 ) -> (String, OpCount) {
-    emit_with(d, spec, "", true, given, (&[], &[]), Some(items))
+    emit_with(d, spec, "", true, given, extras)
 }
 
 fn emit_with(
@@ -57,9 +78,14 @@ fn emit_with(
     prelude: &str,
     method: bool,
     given: &[(Id, String)],
-    (memo, warm): (&[TrigMemo], &[(Id, String)]),
-    items: Option<&mut String>,
+    extras: Extras,
 ) -> (String, OpCount) {
+    let Extras {
+        memo,
+        warm,
+        sparse,
+        items,
+    } = extras;
     let g = &d.graph;
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
     let given_set: HashSet<Id> = given.iter().map(|(id, _)| *id).collect();
@@ -107,12 +133,28 @@ fn emit_with(
     // The outputs and the tail, after the bindings.
     let mut after = String::new();
     let mut fields = String::new();
-    let filled = zero_filled_arrays(g, &spec.outputs);
+    // Arrays written within their rows' extents only: neither cleared nor written outside.
+    let extents: Vec<SparseArray> = sparse
+        .iter()
+        .filter_map(|&(a, columns)| {
+            sparse_rows(g, &spec.outputs, a, columns).map(|rows| (a, columns, rows))
+        })
+        .collect();
+    let mut filled = zero_filled_arrays(g, &spec.outputs);
+    filled.retain(|a| !extents.iter().any(|(s, _, _)| s == a));
     for array in &filled {
         let _ = writeln!(after, "{array}.fill(0.0);");
     }
     for (target, id) in &spec.outputs {
         if g.is_zero(*id) && array_of(target).is_some_and(|a| filled.contains(&a)) {
+            continue;
+        }
+        let outside = |(a, columns, rows): &SparseArray| {
+            let k = index_in(target, a)?;
+            let (start, end) = rows[k / columns];
+            Some(!(start..end).contains(&(k % columns)))
+        };
+        if g.is_zero(*id) && extents.iter().any(|e| outside(e) == Some(true)) {
             continue;
         }
         if target == RETURN {
@@ -186,6 +228,44 @@ fn emit_with(
 /// is 98 % zeros) would otherwise be mostly `m[k] = 0.0;` lines. Below it, the assignments
 /// are kept (and the small models' code stays as it was).
 pub(super) const ZERO_FILL_THRESHOLD: usize = 64;
+
+/// The extents of the rows of the output array `array` (targets `array[k]`, row-major with
+/// `columns` columns) when at least [`ZERO_FILL_THRESHOLD`] of its entries are zero: for each
+/// row, [first, last + 1) of its nonzero entries ((0, 0) for a zero row). `None` otherwise,
+/// or when the outputs do not cover whole rows.
+pub(super) fn sparse_rows(
+    g: &Graph,
+    outputs: &[(String, Id)],
+    array: &str,
+    columns: usize,
+) -> Option<Vec<(usize, usize)>> {
+    let entries: Vec<(usize, Id)> = outputs
+        .iter()
+        .filter_map(|(t, id)| index_in(t, array).map(|k| (k, *id)))
+        .collect();
+    let zeros = entries.iter().filter(|(_, id)| g.is_zero(*id)).count();
+    if columns == 0 || zeros < ZERO_FILL_THRESHOLD || entries.len() % columns != 0 {
+        return None;
+    }
+    let mut rows = vec![(usize::MAX, 0); entries.len() / columns];
+    for &(k, id) in &entries {
+        let row = rows.get_mut(k / columns)?;
+        if !g.is_zero(id) {
+            *row = (row.0.min(k % columns), row.1.max(k % columns + 1));
+        }
+    }
+    Some(
+        rows.into_iter()
+            .map(|(s, e)| if s == usize::MAX { (0, 0) } else { (s, e) })
+            .collect(),
+    )
+}
+
+/// k when `target` is `array[k]`.
+fn index_in(target: &str, array: &str) -> Option<usize> {
+    let rest = target.strip_prefix(array)?.strip_prefix('[')?;
+    rest.strip_suffix(']')?.parse().ok()
+}
 
 /// The array of an output target `name[index]` (`m`, `out.mass`), if it is one.
 pub(super) fn array_of(target: &str) -> Option<&str> {
@@ -333,5 +413,58 @@ mod tests {
         outputs.push(("m[99]".into(), x));
         assert_eq!(zero_filled_arrays(&g, &outputs), ["m"]);
         assert!(zero_filled_arrays(&g, &outputs[1..]).is_empty());
+    }
+
+    #[test]
+    fn a_sparse_array_is_written_within_its_rows_extents_only() {
+        // 10 rows of 10 columns, each row nonzero at its diagonal and the next column (the
+        // last row at its diagonal only), one zero in row 3's extent: 81 zeros.
+        let mut g = Graph::new();
+        let zero = g.constant(0.0);
+        let x = g.var("x");
+        let mut outputs = Vec::new();
+        for k in 0..100 {
+            let (i, j) = (k / 10, k % 10);
+            let nonzero = (j == i || j == i + 1) && !(i == 3 && j == 4);
+            let value = if nonzero { x } else { zero };
+            outputs.push((format!("m[{k}]"), value));
+        }
+        outputs[35].1 = x; // row 3: columns 3 and 5, the zero at 4 inside the extent
+        let rows = sparse_rows(&g, &outputs, "m", 10).expect("sparse");
+        assert_eq!(rows[0], (0, 2));
+        assert_eq!(rows[3], (3, 6));
+        assert_eq!(rows[9], (9, 10));
+        // Fewer zeros than the threshold: written whole.
+        assert_eq!(sparse_rows(&g, &outputs[..50], "m", 10), None);
+        // Not whole rows.
+        assert_eq!(sparse_rows(&g, &outputs[..95], "m", 10), None);
+
+        let (_, d) = crate::emit::testing::derived("double_pendulum");
+        let mut d = d;
+        let q1 = d.symbols.q[0];
+        let zero = d.graph.constant(0.0);
+        let outputs: Vec<(String, Id)> = (0..100)
+            .map(|k| {
+                let value = if k % 11 == 0 { q1 } else { zero };
+                (format!("m[{k}]"), value)
+            })
+            .collect();
+        let spec = FunctionSpec {
+            doc: "A diagonal.".into(),
+            name: "f".into(),
+            params: vec![param("q", "&[f64]"), param("m", "&mut [f64]")],
+            ret: None,
+            outputs,
+            tail: String::new(),
+        };
+        let extras = Extras {
+            sparse: &[("m", 10)],
+            ..Default::default()
+        };
+        let (text, _) = emit_with(&d, &spec, "", false, &[], extras);
+        assert!(!text.contains("fill"), "{text}");
+        assert_eq!(text.matches("m[").count(), 10, "the diagonal only: {text}");
+        let (text, _) = emit_function_given(&d, &spec, "", false, &[]);
+        assert!(text.contains("m.fill(0.0);"), "{text}");
     }
 }

@@ -49,8 +49,14 @@ const VELOCITY: [&str; 4] = ["m", "f", "applied", "c"];
 
 /// The body of `name` as a call of the fused pair (whose cache has `cache_len` entries),
 /// with stack scratch for the outputs it does not return; `None` for the functions that keep
-/// their own expressions.
-pub(super) fn wrapper(model: &Model, cache_len: usize, name: &str) -> Option<String> {
+/// their own expressions. The returned arrays of `cleared` (`m`, `j`: those the pair writes
+/// within their rows' extents only) are zeroed first.
+pub(super) fn wrapper(
+    model: &Model,
+    cache_len: usize,
+    name: &str,
+    cleared: &[&str],
+) -> Option<String> {
     let entry = ENTRY_POINTS.iter().find(|e| e.name == name)?;
     let (n, nc) = (model.n(), model.n_constraints());
     let length = |array: &str| match array {
@@ -74,6 +80,9 @@ pub(super) fn wrapper(model: &Model, cache_len: usize, name: &str) -> Option<Str
          expression is compiled once).\nfn {name}({}) {{\nlet mut cache = [0.0; {cache_len}];\n",
         params.join(", ")
     );
+    for array in entry.returns.iter().filter(|a| cleared.contains(a)) {
+        let _ = writeln!(body, "{array}.fill(0.0);");
+    }
     let scratch = |body: &mut String, array: &str| {
         if !returned(array) {
             let _ = writeln!(body, "let {array} = &mut [0.0; {}];", length(array));
@@ -114,7 +123,7 @@ mod tests {
         let m = model("four_bar");
         assert_eq!((m.n(), m.n_constraints()), (3, 2));
         assert_eq!(
-            wrapper(&m, 7, "constraint").as_deref(),
+            wrapper(&m, 7, "constraint", &[]).as_deref(),
             Some(
                 format!(
                     "{DOC}fn constraint(&self, q: &[f64], h: &mut [f64]) {{\n\
@@ -131,7 +140,7 @@ mod tests {
     fn mass_matrix_evaluates_at_rest_at_time_zero_with_scratch_for_the_rest() {
         let m = model("four_bar");
         assert_eq!(
-            wrapper(&m, 0, "mass_matrix").as_deref(),
+            wrapper(&m, 0, "mass_matrix", &[]).as_deref(),
             Some(
                 format!(
                     "{DOC}fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {{\n\
@@ -153,7 +162,7 @@ mod tests {
 
     #[test]
     fn equations_pass_time_and_rates_and_return_three_arrays() {
-        let text = wrapper(&model("four_bar"), 1, "equations").unwrap_or_default();
+        let text = wrapper(&model("four_bar"), 1, "equations", &[]).unwrap_or_default();
         assert!(text.contains(
             "fn equations(&self, t: f64, q: &[f64], qd: &[f64], m: &mut [f64], f: &mut [f64], \
              applied: &mut [f64])"
@@ -166,8 +175,8 @@ mod tests {
     #[test]
     fn functions_with_their_own_expressions_have_no_wrapper() {
         let m = model("four_bar");
-        assert_eq!(wrapper(&m, 0, "energy"), None);
-        assert_eq!(wrapper(&m, 0, "position_terms"), None);
+        assert_eq!(wrapper(&m, 0, "energy", &[]), None);
+        assert_eq!(wrapper(&m, 0, "position_terms", &[]), None);
         assert_eq!(ENTRY_POINTS.len(), 8);
     }
 }

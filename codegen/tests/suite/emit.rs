@@ -275,3 +275,39 @@ fn a_large_method_body_gets_a_module_of_its_own() {
         assert!(!g.code.contains("_body::run("), "{file}: a body moved");
     }
 }
+
+/// M and J of many zeros (A02's 81 × 81 M is 98 % zeros) are written by the fused pair within
+/// their rows' extents only, and the model declares the extents (`mass_rows`,
+/// `jacobian_rows`): a right-hand side neither clears nor scans n² entries. The paper's
+/// models keep whole matrices.
+#[test]
+fn sparse_matrices_are_written_within_declared_row_extents() {
+    let models = every_model();
+    let code = |name: &str| {
+        &models
+            .iter()
+            .find(|(file, _)| file.contains(name))
+            .unwrap_or_else(|| panic!("{name}"))
+            .1
+            .code
+    };
+    let a02 = code("n_four_bar");
+    assert!(a02.contains("fn mass_rows(&self)"));
+    assert!(a02.contains("fn jacobian_rows(&self)"));
+    // Crank i and its coupler (coordinates c_i, p_i adjacent) are M's only coupling.
+    let rows: String = a02[a02.find("fn mass_rows").expect("declared")..]
+        .split_whitespace()
+        .take(20)
+        .collect();
+    assert!(rows.contains("Some(&[(0,2),(0,2),(2,4),(2,4),"), "{rows}");
+    let pair: String = ["fn position_terms", "fn velocity_terms"]
+        .iter()
+        .map(|f| {
+            let start = a02.find(f).expect("the fused pair");
+            a02[start..start + a02[start..].find("\n    }").expect("its end")].to_string()
+        })
+        .collect();
+    assert!(!pair.contains(".fill("), "neither array cleared whole");
+    let paper = code("paper_concave");
+    assert!(!paper.contains("fn mass_rows") && !paper.contains("fn jacobian_rows"));
+}

@@ -227,6 +227,9 @@ pub(crate) struct Extents {
     /// [start, end) of each row; (0, 0) when the row has been zero.
     rows: Vec<(usize, usize)>,
     columns: usize,
+    /// The extents the model declares ([`crate::Dynamics::mass_rows`]): taken as they are
+    /// (widened by one check when first taken), not checked at every update.
+    declared: Option<&'static [(usize, usize)]>,
 }
 
 impl Extents {
@@ -235,6 +238,22 @@ impl Extents {
     /// rows.
     pub(super) fn update(&mut self, a: &[f64], columns: usize) {
         let rows = a.len().checked_div(columns).unwrap_or(0);
+        if let Some(declared) = self.declared.filter(|d| d.len() == rows) {
+            if self.columns == columns && self.rows.len() == rows {
+                return;
+            }
+            // First taken: the declaration, widened by the nonzeros of this matrix.
+            self.columns = columns;
+            self.rows = declared
+                .iter()
+                .map(|&(s, e)| {
+                    let s = s.min(columns);
+                    (s, e.clamp(s, columns))
+                })
+                .collect();
+            self.scan(a, columns);
+            return;
+        }
         if self.columns != columns || self.rows.len() != rows {
             self.columns = columns;
             let start = if columns < SMALLEST_EXTENTS {
@@ -247,6 +266,26 @@ impl Extents {
         if columns < SMALLEST_EXTENTS {
             return;
         }
+        self.scan(a, columns);
+    }
+
+    /// Takes the model's declared extents (`None`: find them by reading the matrix). A change
+    /// of declaration is checked at the next update.
+    pub(super) fn declare(&mut self, declared: Option<&'static [(usize, usize)]>) {
+        let same = match (self.declared, declared) {
+            (Some(a), Some(b)) => std::ptr::eq(a, b),
+            (None, None) => true,
+            _ => false,
+        };
+        if !same {
+            self.declared = declared;
+            // Taken (or left) at the next update.
+            self.columns = 0;
+        }
+    }
+
+    /// Widens the extents to every nonzero (or NaN) of `a` outside them.
+    fn scan(&mut self, a: &[f64], columns: usize) {
         for (extent, row) in self.rows.iter_mut().zip(a.chunks_exact(columns)) {
             let (start, end) = *extent;
             if nonzero_bits(&row[..start]) | nonzero_bits(&row[end..]) == 0 {
@@ -490,5 +529,35 @@ mod tests {
             factored(&mut Band::default(), &j, n, &dependent),
             Some(false)
         );
+    }
+
+    #[test]
+    fn declared_extents_are_taken_once_then_trusted() {
+        // 3 rows of 20 columns: row 0 nonzero in 2..4, row 1 in 10..12, row 2 zero.
+        let columns = 20;
+        let mut a = vec![0.0; 3 * columns];
+        a[2] = 1.0;
+        a[3] = -2.0;
+        a[columns + 10] = 3.0;
+        static DECLARED: [(usize, usize); 3] = [(2, 4), (9, 12), (0, 0)];
+        let mut extents = Extents::default();
+        extents.declare(Some(&DECLARED));
+        // Taken at the first update, widened by a nonzero the declaration left out.
+        a[2 * columns + 5] = 4.0;
+        extents.update(&a, columns);
+        let rows: Vec<_> = (0..3).map(|k| extents.row(k, columns)).collect();
+        assert_eq!(rows, [(2, 4), (9, 12), (5, 6)]);
+        // Then trusted: not read again (the model writes nothing outside).
+        a[19] = 5.0;
+        extents.update(&a, columns);
+        assert_eq!(extents.row(0, columns), (2, 4));
+        // Without a declaration the matrix is read at every update.
+        extents.declare(None);
+        extents.update(&a, columns);
+        assert_eq!(extents.row(0, columns), (2, 20));
+        // A declaration of another shape is not taken.
+        extents.declare(Some(&DECLARED[..2]));
+        extents.update(&a, columns);
+        assert_eq!(extents.row(2, columns), (5, 6));
     }
 }

@@ -26,6 +26,7 @@ impl Workspace {
         // One call: generated models share the kinematics between M, F, Q and c, and take
         // the sines and cosines from the position level.
         let all_rows = self.m == self.nc;
+        self.band.mass_rows.declare(model.mass_rows());
         let out = VelocityTerms {
             mass: &mut self.mass,
             inertial: &mut self.inertial,

@@ -111,6 +111,9 @@ impl Workspace {
         self.m = m;
         self.rows = rows.to_vec();
         if m == self.nc {
+            // Written by `position_terms` again: zero where it may not write (its rows'
+            // extents, `Dynamics::jacobian_rows`).
+            self.jacobian.fill(0.0);
             self.full_h.clear();
             self.full_jacobian.clear();
             self.full_bias.clear();
@@ -307,8 +310,11 @@ impl Workspace {
             self.cache.resize(len, f64::NAN);
         }
         if self.m == self.nc {
+            self.band.jacobian_rows.declare(model.jacobian_rows());
             model.position_terms(&self.q, &mut self.h, &mut self.jacobian, &mut self.cache);
         } else {
+            // The declared rows are those of all of J, not of the rows kept.
+            self.band.jacobian_rows.declare(None);
             model.position_terms(
                 &self.q,
                 &mut self.full_h,
