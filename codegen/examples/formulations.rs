@@ -2,8 +2,11 @@
 //! compiles and times code):
 //!
 //! ```text
-//! cargo run --release -p camchain-codegen --example formulations -- OUTDIR [N ...]
+//! cargo run --release -p camchain-codegen --example formulations -- OUTDIR [--native] [N ...]
 //! ```
+//!
+//! `--native` builds the measured crates for this machine's processor (`-C
+//! target-cpu=native`, as `scripts/bench/pinocchio` builds Pinocchio with `-march=native`).
 //!
 //! For the chains of `tests/common/chain.rs` (the spatial chain with its tip on a cam, and
 //! the planar chain with its tip on a cam) with N bodies (default 4, 8, 16, 32, 64), it
@@ -39,11 +42,12 @@ const SIZES: [usize; 5] = [4, 8, 16, 32, 64];
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(out) = args.first() else {
-        eprintln!("usage: formulations OUTDIR [N ...]");
+        eprintln!("usage: formulations OUTDIR [--native] [N ...]");
         return ExitCode::from(2);
     };
     let mut sizes = Vec::new();
-    for a in &args[1..] {
+    let native = args[1..].iter().any(|a| a == "--native");
+    for a in args[1..].iter().filter(|a| *a != "--native") {
         match a.parse::<usize>() {
             Ok(n) if n >= 1 => sizes.push(n),
             _ => {
@@ -55,7 +59,7 @@ fn main() -> ExitCode {
     if sizes.is_empty() {
         sizes = SIZES.to_vec();
     }
-    match run(Path::new(out), &sizes) {
+    match run(Path::new(out), &sizes, native) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
@@ -64,16 +68,17 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(out: &Path, sizes: &[usize]) -> Result<(), String> {
+fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let out = out.canonicalize().map_err(|e| e.to_string())?;
     let runtime = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../runtime")
         .canonicalize()
         .map_err(|e| e.to_string())?;
-    let target = out.join("target");
+    // Builds for the native processor have a target directory of their own.
+    let target = out.join(if native { "target-native" } else { "target" });
     let warm = write_crate(&out, "warm", &[], &runtime)?;
-    cargo_build(&warm, &target)?;
+    cargo_build(&warm, &target, native)?;
     let mut md = String::from(
         "| family | N | auto chooses | dense ops (velocity_terms) | articulated ops (terms + response) | rhs dense [ns] | rhs articulated [ns] | dense / articulated | unconstrained dense [ns] | unconstrained articulated [ns] |\n\
          |---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
@@ -119,7 +124,7 @@ fn run(out: &Path, sizes: &[usize]) -> Result<(), String> {
                 &[("dense", &dense.code), ("articulated", &articulated.code)],
                 &runtime,
             )?;
-            cargo_build(&dir, &target)?;
+            cargo_build(&dir, &target, native)?;
             let exe = target.join("release").join(format!("formulations_{name}"));
             let output = Command::new(&exe)
                 .output()

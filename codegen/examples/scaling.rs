@@ -70,7 +70,7 @@ fn run(out: &Path, build: bool) -> Result<(), String> {
     if build {
         // Build the runtime once, so that its build is not in any N's figure.
         let warm = write_crate(&out, 0, "", &runtime)?;
-        cargo_build(&warm, &target)?;
+        cargo_build(&warm, &target, false)?;
     }
     let mut rows = Vec::new();
     for n in SIZES {
@@ -109,7 +109,7 @@ fn run(out: &Path, build: bool) -> Result<(), String> {
         if build {
             let dir = write_crate(&out, n, &generated.code, &runtime)?;
             let start = Instant::now();
-            cargo_build(&dir, &target)?;
+            cargo_build(&dir, &target, false)?;
             row.build_s = Some(start.elapsed().as_secs_f64());
             let exe = target.join("release").join(format!("scaling_chain{n}"));
             let output = Command::new(&exe)

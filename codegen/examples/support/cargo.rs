@@ -3,10 +3,20 @@
 use std::path::Path;
 use std::process::Command;
 
-/// `cargo build --release` of the crate in `dir` into the shared `target` directory.
-pub fn cargo_build(dir: &Path, target: &Path) -> Result<(), String> {
-    let status = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args(["build", "--release", "--quiet", "--manifest-path"])
+/// `cargo build --release` of the crate in `dir` into the shared `target` directory; with
+/// `native`, for this machine's processor (`-C target-cpu=native`, what `-march=native` is
+/// to a C++ compiler).
+pub fn cargo_build(dir: &Path, target: &Path, native: bool) -> Result<(), String> {
+    let mut command = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    command.args(["build", "--release", "--quiet"]);
+    if native {
+        command.args([
+            "--config",
+            "build.rustflags=[\"-C\", \"target-cpu=native\"]",
+        ]);
+    }
+    let status = command
+        .arg("--manifest-path")
         .arg(dir.join("Cargo.toml"))
         .arg("--target-dir")
         .arg(target)
