@@ -16,10 +16,13 @@
 //! carried by a body turning at ω has columns u_j × v (revolute j), rate ω × v and
 //! v̈° = α° × v + ω × (ω × v).
 
+mod gap;
+
 use crate::contact::relative::{Labels, PointMotion, point_motion};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
 use crate::model::{Field, JointKind, LoopKind, LoopPoint, Model, normal_pair};
+use gap::closure_gap;
 
 /// One scalar equation of a loop: h, J, c.
 #[derive(Debug, Clone)]
@@ -192,7 +195,8 @@ pub fn loop_terms(
             ));
             let motions = [0, 1].map(|side| side_motion(g, model, kin, s, l, side));
             let [a, b] = [0, 1].map(|side| Carried::point(g, s, &motions[side]));
-            let gap = a.minus(g, &b);
+            let mut gap = a.minus(g, &b);
+            gap.value = closure_gap(g, &motions);
             vec3::label(g, gap.value, &format!("loop_{}_gap", cut.name));
             let [body_a, body_b] = cut.sides.map(|p: LoopPoint| p.body);
             let rows = match (cut.kind, cut.planar) {

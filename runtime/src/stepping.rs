@@ -685,6 +685,11 @@ pub(crate) fn load_state(
         // Newton ends with h, J, the cache and the factored J_v of the returned q.
         solve_positions_with_restart(model, partition.dependent(), ws, t)?;
         ws.polish_positions(partition.dependent());
+        // Near a singular position J changes across the polish by as much as the rows'
+        // own size: evaluated again at the polished q (docs/method.md §11.4).
+        if ws.rows_shrunk() {
+            ws.factor_jacobian(model, partition.dependent(), t)?;
+        }
     }
     ws.solve_velocities(partition.dependent());
     Ok(())

@@ -21,9 +21,9 @@
 // | `load_power` | 0 | 1 | 0 | 0 | 0 | 0 | 1 |
 // | `loop_points` | 4 | 6 | 0 | 6 | 0 | 0 | 16 |
 // | `damper_power` | 0 | 0 | 0 | 0 | 0 | 0 | 0 |
-// | `position_terms` | 9 | 6 | 0 | 6 | 0 | 0 | 21 |
+// | `position_terms` | 8 | 6 | 0 | 6 | 0 | 0 | 20 |
 // | `velocity_terms` | 13 | 35 | 0 | 0 | 0 | 0 | 48 |
-// | `derive` | 7 | 22 | 0 | 0 | 0 | 0 | 29 |
+// | `derive` | 8 | 22 | 0 | 0 | 0 | 0 | 30 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
 // dense 120, articulated 295 (the position level, common to both, not included).
@@ -297,18 +297,19 @@ struct Derived {
     g: f64,
     term1: f64,
     term2: f64,
+    term3: f64,
     inertia_rocker_zz: f64,
     first_moment_rocker_x: f64,
-    term3: f64,
     term4: f64,
+    term5: f64,
     inertia_coupler_zz: f64,
     first_moment_coupler_x: f64,
-    term5: f64,
     term6: f64,
     term7: f64,
-    weight_arm_crank_x: f64,
     term8: f64,
+    weight_arm_crank_x: f64,
     term9: f64,
+    term10: f64,
 }
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
 /// Every quantity the generated functions read that depends on the parameters alone.
@@ -337,7 +338,7 @@ fn derive(p: &Parameters) -> Derived {
     let first_moment_coupler_x = m_coupler * first_moment_coupler_x_t1;
     // crank: composite inertia and column q_crank of M
     let weight_arm_crank_x_t1 = 0.5 * a;
-    let field_term9_t1 = flywheel + 0.08333333333333333 * (a * (a * m_crank));
+    let field_term10_t1 = flywheel + 0.08333333333333333 * (a * (a * m_crank));
     let weight_arm_crank_x_t2 = a * m_coupler;
     // crank: gravity load of the subtree on joint q_crank
     let weight_arm_crank_x = m_crank * weight_arm_crank_x_t1 + weight_arm_crank_x_t2;
@@ -351,21 +352,22 @@ fn derive(p: &Parameters) -> Derived {
         m_rocker,
         torque,
         g,
-        term1: first_moment_rocker_x_t1,
-        term2: inertia_rocker_zz_t1,
+        term1: -d,
+        term2: first_moment_rocker_x_t1,
+        term3: inertia_rocker_zz_t1,
         inertia_rocker_zz,
         first_moment_rocker_x,
-        term3: first_moment_coupler_x_t1,
-        term4: inertia_coupler_zz_t1,
+        term4: first_moment_coupler_x_t1,
+        term5: inertia_coupler_zz_t1,
         inertia_coupler_zz,
         first_moment_coupler_x,
-        term5: weight_arm_crank_x_t1,
-        term6: field_term9_t1,
-        term7: weight_arm_crank_x_t2,
+        term6: weight_arm_crank_x_t1,
+        term7: field_term10_t1,
+        term8: weight_arm_crank_x_t2,
         weight_arm_crank_x,
-        term8: -torque,
-        term9: m_crank * (weight_arm_crank_x_t1 * weight_arm_crank_x_t1)
-            + (inertia_coupler_zz + field_term9_t1),
+        term9: -torque,
+        term10: m_crank * (weight_arm_crank_x_t1 * weight_arm_crank_x_t1)
+            + (inertia_coupler_zz + field_term10_t1),
     }
 }
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
@@ -780,9 +782,9 @@ impl rt::Dynamics for Model {
         let momentum_moment_q_coupler_q_crank_z = inertia_coupler_zz
             + a * momentum_q_coupler_q_crank_y;
         // crank: composite inertia and column q_crank of M
-        let term7 = self.derived.term7;
-        let term9 = self.derived.term9;
-        let inertia_crank_zz = a * (term7 + 2.0 * momentum_q_coupler_q_crank_y) + term9;
+        let term8 = self.derived.term8;
+        let term10 = self.derived.term10;
+        let inertia_crank_zz = a * (term8 + 2.0 * momentum_q_coupler_q_crank_y) + term10;
         m[0] = inertia_crank_zz;
         m[1] = momentum_moment_q_coupler_q_crank_z;
         m[2] = 0.0;
@@ -850,8 +852,8 @@ impl rt::Dynamics for Model {
         let weight_arm_crank_x = self.derived.weight_arm_crank_x;
         let weight_moment_crank_z = weight_moment_coupler_z
             + minus_g_crank_y * weight_arm_crank_x;
-        let term8 = self.derived.term8;
-        applied[0] = weight_moment_crank_z + term8;
+        let term9 = self.derived.term9;
+        applied[0] = weight_moment_crank_z + term9;
         applied[1] = weight_moment_coupler_z;
         applied[2] = weight_moment_rocker_z;
     }
@@ -899,9 +901,9 @@ impl rt::Dynamics for Model {
         let momentum_moment_q_coupler_q_crank_z = inertia_coupler_zz
             + a * momentum_q_coupler_q_crank_y;
         // crank: composite inertia and column q_crank of M
-        let term7 = self.derived.term7;
-        let term9 = self.derived.term9;
-        let inertia_crank_zz = a * (term7 + 2.0 * momentum_q_coupler_q_crank_y) + term9;
+        let term8 = self.derived.term8;
+        let term10 = self.derived.term10;
+        let inertia_crank_zz = a * (term8 + 2.0 * momentum_q_coupler_q_crank_y) + term10;
         // coupler: inertial loads and joint q_coupler load (backward recursion)
         let neg_centripetal_force_coupler_x = omega_coupler_sq * first_moment_coupler_x;
         let moment_of_acc_coupler_z = acc_coupler_y * first_moment_coupler_x;
@@ -918,7 +920,7 @@ impl rt::Dynamics for Model {
         let weight_arm_crank_x = self.derived.weight_arm_crank_x;
         let weight_moment_crank_z = weight_moment_coupler_z
             + minus_g_crank_y * weight_arm_crank_x;
-        let term8 = self.derived.term8;
+        let term9 = self.derived.term9;
         m[0] = inertia_crank_zz;
         m[1] = momentum_moment_q_coupler_q_crank_z;
         m[2] = 0.0;
@@ -931,7 +933,7 @@ impl rt::Dynamics for Model {
         f[0] = moment_coupler_in_parent_z;
         f[1] = moment_of_acc_coupler_z;
         f[2] = 0.0;
-        applied[0] = weight_moment_crank_z + term8;
+        applied[0] = weight_moment_crank_z + term9;
         applied[1] = weight_moment_coupler_z;
         applied[2] = weight_moment_rocker_z;
     }
@@ -944,7 +946,6 @@ impl rt::Dynamics for Model {
         let a = self.derived.a;
         let b = self.derived.b;
         let c_2 = self.derived.c;
-        let d = self.derived.d;
         // crank: joint q_crank, rotation, velocities and accelerations
         let c_q_crank = q_crank.cos();
         let s_q_crank = q_crank.sin();
@@ -964,9 +965,10 @@ impl rt::Dynamics for Model {
         let loop_pin_a_arm_q_crank_y = pos_coupler_y + loop_pin_a_segment_q_coupler_y;
         let loop_pin_b_segment_q_rocker_x = c_2 * c_q_rocker;
         let loop_pin_b_segment_q_rocker_y = c_2 * s_q_rocker;
-        let loop_pin_gap_x = loop_pin_a_arm_q_crank_x
-            - (d + loop_pin_b_segment_q_rocker_x);
         let loop_pin_gap_y = loop_pin_a_arm_q_crank_y - loop_pin_b_segment_q_rocker_y;
+        let term1 = self.derived.term1;
+        let loop_pin_gap_x = term1
+            + (loop_pin_a_arm_q_crank_x - loop_pin_b_segment_q_rocker_x);
         h[0] = loop_pin_gap_x;
         h[1] = loop_pin_gap_y;
     }
@@ -1150,30 +1152,30 @@ impl rt::Dynamics for Model {
         // rocker: joint q_rocker, rotation, velocities and accelerations
         let s_q_rocker = q_rocker.sin();
         // rocker: composite inertia and column q_rocker of M
-        let term1 = self.derived.term1;
         let term2 = self.derived.term2;
-        // coupler: composite inertia and column q_coupler of M
         let term3 = self.derived.term3;
+        // coupler: composite inertia and column q_coupler of M
         let term4 = self.derived.term4;
-        // crank: composite inertia and column q_crank of M
         let term5 = self.derived.term5;
+        // crank: composite inertia and column q_crank of M
         let term6 = self.derived.term6;
+        let term7 = self.derived.term7;
         // energy
-        let vel_com_crank_y = q_crank_dot * term5;
-        let pos_com_crank_y = s_q_crank * term5;
-        let vel_com_coupler_y = vel_coupler_y + omega_coupler_z * term3;
-        let pos_com_coupler_y = pos_coupler_y + s_q_crank_q_coupler * term3;
-        let vel_com_rocker_y = q_rocker_dot * term1;
-        let pos_com_rocker_y = s_q_rocker * term1;
+        let vel_com_crank_y = q_crank_dot * term6;
+        let pos_com_crank_y = s_q_crank * term6;
+        let vel_com_coupler_y = vel_coupler_y + omega_coupler_z * term4;
+        let pos_com_coupler_y = pos_coupler_y + s_q_crank_q_coupler * term4;
+        let vel_com_rocker_y = q_rocker_dot * term2;
+        let pos_com_rocker_y = s_q_rocker * term2;
         let kinetic = 0.5
             * (m_rocker * (vel_com_rocker_y * vel_com_rocker_y)
-                + (q_rocker_dot * (q_rocker_dot * term2)
+                + (q_rocker_dot * (q_rocker_dot * term3)
                     + (m_coupler
                         * (vel_coupler_x * vel_coupler_x
                             + vel_com_coupler_y * vel_com_coupler_y)
-                        + (q_crank_dot * (q_crank_dot * term6)
+                        + (q_crank_dot * (q_crank_dot * term7)
                             + m_crank * (vel_com_crank_y * vel_com_crank_y)
-                            + omega_coupler_z * (omega_coupler_z * term4)))));
+                            + omega_coupler_z * (omega_coupler_z * term5)))));
         let gravity = m_rocker * (g * pos_com_rocker_y)
             + (m_crank * (g * pos_com_crank_y) + m_coupler * (g * pos_com_coupler_y));
         let spring = 0.0;
@@ -1245,7 +1247,6 @@ impl rt::Dynamics for Model {
         let a = self.derived.a;
         let b = self.derived.b;
         let c_2 = self.derived.c;
-        let d = self.derived.d;
         // crank: joint q_crank, rotation, velocities and accelerations
         let (s_q_crank, c_q_crank) = rt::sin_cos_memo(q_crank, &mut cache[0..3]);
         // coupler: joint q_coupler, rotation, velocities and accelerations
@@ -1265,9 +1266,10 @@ impl rt::Dynamics for Model {
         let loop_pin_a_arm_q_crank_y = pos_coupler_y + loop_pin_a_segment_q_coupler_y;
         let loop_pin_b_segment_q_rocker_x = c_2 * c_q_rocker;
         let loop_pin_b_segment_q_rocker_y = c_2 * s_q_rocker;
-        let loop_pin_gap_x = loop_pin_a_arm_q_crank_x
-            - (d + loop_pin_b_segment_q_rocker_x);
         let loop_pin_gap_y = loop_pin_a_arm_q_crank_y - loop_pin_b_segment_q_rocker_y;
+        let term1 = self.derived.term1;
+        let loop_pin_gap_x = term1
+            + (loop_pin_a_arm_q_crank_x - loop_pin_b_segment_q_rocker_x);
         h[0] = loop_pin_gap_x;
         h[1] = loop_pin_gap_y;
         j[0] = -loop_pin_a_arm_q_crank_y;
@@ -1343,9 +1345,9 @@ impl rt::Dynamics for Model {
         let momentum_moment_q_coupler_q_crank_z = inertia_coupler_zz
             + a * momentum_q_coupler_q_crank_y;
         // crank: composite inertia and column q_crank of M
-        let term7 = self.derived.term7;
-        let term9 = self.derived.term9;
-        let inertia_crank_zz = term9 + a * (term7 + 2.0 * momentum_q_coupler_q_crank_y);
+        let term8 = self.derived.term8;
+        let term10 = self.derived.term10;
+        let inertia_crank_zz = term10 + a * (term8 + 2.0 * momentum_q_coupler_q_crank_y);
         // coupler: inertial loads and joint q_coupler load (backward recursion)
         let neg_centripetal_force_coupler_x = omega_coupler_sq * first_moment_coupler_x;
         let moment_of_acc_coupler_z = first_moment_coupler_x * acc_coupler_y;
@@ -1362,7 +1364,7 @@ impl rt::Dynamics for Model {
         let weight_arm_crank_x = self.derived.weight_arm_crank_x;
         let weight_moment_crank_z = weight_moment_coupler_z
             + minus_g_crank_y * weight_arm_crank_x;
-        let term8 = self.derived.term8;
+        let term9 = self.derived.term9;
         out.mass[0] = inertia_crank_zz;
         out.mass[1] = momentum_moment_q_coupler_q_crank_z;
         out.mass[2] = 0.0;
@@ -1375,7 +1377,7 @@ impl rt::Dynamics for Model {
         out.inertial[0] = moment_coupler_in_parent_z;
         out.inertial[1] = moment_of_acc_coupler_z;
         out.inertial[2] = 0.0;
-        out.applied[0] = weight_moment_crank_z + term8;
+        out.applied[0] = weight_moment_crank_z + term9;
         out.applied[1] = weight_moment_coupler_z;
         out.applied[2] = weight_moment_rocker_z;
         out.bias[0] = neg_loop_pin_b_centripetal_q_rocker_x
@@ -1415,7 +1417,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("load_power", [0, 1, 0, 0, 0, 0]),
     ("loop_points", [4, 6, 0, 6, 0, 0]),
     ("damper_power", [0, 0, 0, 0, 0, 0]),
-    ("position_terms", [9, 6, 0, 6, 0, 0]),
+    ("position_terms", [8, 6, 0, 6, 0, 0]),
     ("velocity_terms", [13, 35, 0, 0, 0, 0]),
-    ("derive", [7, 22, 0, 0, 0, 0]),
+    ("derive", [8, 22, 0, 0, 0, 0]),
 ];

@@ -21,7 +21,7 @@
 
 use crate::expr::scalar::dot_list;
 use crate::expr::{Graph, Id};
-use crate::kinematics::{BodyKinematics, Symbols, V3, vec3};
+use crate::kinematics::{BodyKinematics, Rotation, Symbols, V3, vec3};
 use crate::model::{Contact, Field, JointKind, Model};
 
 /// The follower of one contact in the cam frame.
@@ -180,8 +180,17 @@ fn path_to_root(model: &Model, body: Option<usize>) -> Vec<usize> {
 
 /// A point fixed on a body, moving relative to an ancestor taken as fixed.
 pub(crate) struct PointMotion {
-    /// Ground position.
+    /// Ground position: `base + arm`.
     pub position: V3,
+    /// The ground position of the joint point of the path's root (its anchor, moved by any
+    /// sliding joints the segments cross at the root; the point itself for the ground).
+    pub base: V3,
+    /// The point relative to `base`: the sum of `segments`, each O(the body's size)
+    /// however far the mechanism sits from the ground's origin.
+    pub arm: V3,
+    /// The terms of `arm`, tip first: each a vector fixed in a body turned by that body's
+    /// rotation.
+    pub segments: Vec<Segment>,
     /// ∂p/∂q_j (ground) for the joints that move it relative to the ancestor.
     pub columns: Vec<Option<V3>>,
     /// Velocity-product part of its acceleration relative to the ancestor.
@@ -190,6 +199,17 @@ pub(crate) struct PointMotion {
     pub omega: V3,
     /// Velocity-product part of that angular velocity's rate.
     pub alpha: V3,
+}
+
+/// One term of a point's arm: `rotation` applied to `local`, which is `value`.
+#[derive(Clone)]
+pub(crate) struct Segment {
+    /// The body's rotation, body → ground.
+    pub rotation: Rotation,
+    /// The vector in the body's frame.
+    pub local: V3,
+    /// rotation · local, ground coordinates.
+    pub value: V3,
 }
 
 /// What names the labels of a point's terms (`A` for the follower of contact A, `A_cam` for
@@ -258,12 +278,18 @@ pub(crate) fn point_motion(
     let mut done = zero3;
     let mut accel = coriolis;
     let mut columns = vec![None; n];
+    let mut segments = Vec::new();
     for &j in &path {
         let k = &kin[j];
         let coordinate = &model.bodies[j].joint.coordinate;
         let column = match model.bodies[j].joint.kind {
             JointKind::Revolute => {
                 let seg = k.rotation.apply(g, pending);
+                segments.push(Segment {
+                    rotation: k.rotation.clone(),
+                    local: pending,
+                    value: seg,
+                });
                 if moving[j] {
                     vec3::label(g, seg, &format!("{name}_segment_{coordinate}"));
                     let a_s = vec3::cross(g, alpha[j], seg);
@@ -292,12 +318,15 @@ pub(crate) fn point_motion(
         }
     }
     // The root's segment is fixed in the ground.
-    let position = match path.last() {
-        Some(_) => vec3::add(g, pending, done),
-        None => local,
+    let (position, base, arm) = match path.last() {
+        Some(_) => (vec3::add(g, pending, done), pending, done),
+        None => (local, local, zero3),
     };
     PointMotion {
         position,
+        base,
+        arm,
+        segments,
         columns,
         convective: accel,
         omega: w,

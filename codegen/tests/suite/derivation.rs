@@ -321,3 +321,46 @@ fn assembly_halves_a_newton_step_that_leaves_where_the_surface_is_defined() {
     let x = 0.5 * 0.1f64.sin();
     assert!((q[2] - (0.25 - x * x).sqrt()).abs() < 1e-12, "z = {}", q[2]);
 }
+
+#[test]
+fn loop_gaps_are_the_difference_of_their_points_whichever_side_holds_a_pair() {
+    // The gap is formed from anchors and pairs of equal links ((K7) of docs/method.md §11.4),
+    // the points from the whole paths: they must agree. The parallelogram's coupler pairs
+    // with the ground link on side A as written and on side B with the sides exchanged;
+    // n_four_bar has 40 such loops with angles of every size.
+    let parallelogram = include_str!("../../../tests/loop_models/parallelogram.ron");
+    let written = r#"a: (body: "coupler", point: ("d", 0.0, 0.0)), b: (body: "rocker", point: ("a", 0.0, 0.0))"#;
+    let exchanged = r#"a: (body: "rocker", point: ("a", 0.0, 0.0)), b: (body: "coupler", point: ("d", 0.0, 0.0))"#;
+    assert!(parallelogram.contains(written));
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let models = [
+        camchain_codegen::schema::parse_model(parallelogram, std::path::Path::new("p.ron")),
+        camchain_codegen::schema::parse_model(
+            &parallelogram.replace(written, exchanged),
+            std::path::Path::new("p.ron"),
+        ),
+        camchain_codegen::schema::load_model(&dir.join("n_four_bar.ron")),
+    ];
+    for model in models {
+        let model = model.unwrap_or_else(|e| panic!("{e}"));
+        let d = Derivation::new(&model);
+        let n = model.n();
+        let mut rng = Rng(7);
+        for _ in 0..20 {
+            let q = rng.vec(n, -40.0, 40.0);
+            let qd = vec![0.0; n];
+            for l in &d.loops {
+                let [a, b] = l.points.map(|p| d.eval(&p, 0.0, &q, &qd));
+                for (k, row) in l.rows.iter().take(2).enumerate() {
+                    let h = d.eval(&[row.h], 0.0, &q, &qd)[0];
+                    let gap = a[k] - b[k];
+                    assert!(
+                        (h - gap).abs() < 1e-12 * (1.0 + a[k].abs()),
+                        "{}: h {h} against the points' difference {gap}",
+                        model.name
+                    );
+                }
+            }
+        }
+    }
+}

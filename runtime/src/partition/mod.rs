@@ -32,7 +32,7 @@ pub use choice::{
 pub use multipliers::normal_force;
 pub use newton::{
     NEWTON_MAX_ITERATIONS, NEWTON_RESIDUAL_TOLERANCE, NEWTON_SLACK_PER_RTOL,
-    NEWTON_STALL_TOLERANCE, NEWTON_STEP_TOLERANCE,
+    NEWTON_STALL_TOLERANCE, NEWTON_STEP_TOLERANCE, ROW_SHRINK,
 };
 pub use sets::Partition;
 pub use workspace::Workspace;

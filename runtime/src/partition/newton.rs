@@ -34,6 +34,10 @@ pub(super) const STALL_CONDITIONING: f64 = 0.05;
 /// correction is at most this times rtol·(1 + ‖v‖∞) ([`Workspace::set_newton_slack`]).
 pub const NEWTON_SLACK_PER_RTOL: f64 = 1e-2;
 
+/// A row of J whose ‖J_k‖∞ has fallen below this fraction of its largest in the run marks a
+/// singular position near ([`Workspace::rows_shrunk`]).
+pub const ROW_SHRINK: f64 = 0.05;
+
 /// Newton (15) gives up after this many corrections.
 pub const NEWTON_MAX_ITERATIONS: usize = 25;
 
@@ -245,9 +249,31 @@ impl Workspace {
     /// correction makes the residual quadratically small (~1e-24) for the price of a
     /// subtraction (it was computed by [`Self::solve_positions`]'s convergence test). The
     /// J, cache and h kept in the workspace are those of the iterate before it, 1e-12
-    /// away, which the velocity and acceleration levels tolerate.
+    /// away, which the velocity and acceleration levels tolerate, except near a singular
+    /// position, where the caller evaluates them again ([`Self::rows_shrunk`]).
     pub fn polish_positions(&mut self, dependent: &[usize]) {
         self.apply_correction(dependent);
+    }
+
+    /// True when a row of the J last evaluated has shrunk below [`ROW_SHRINK`] of its largest
+    /// ‖J_k‖∞ so far (which this updates): a singular position is near, where a loop's rows
+    /// scale with |sin θ| (docs/method.md §11.4). There the J of the iterate before
+    /// [`Self::polish_positions`] is off by the polish correction relative to |sin θ|, which
+    /// the velocity and acceleration levels amplify to ~ω² Δ / sin² θ: J is evaluated again
+    /// at the polished q instead.
+    pub fn rows_shrunk(&mut self) -> bool {
+        let (nc, n) = (self.nc, self.n);
+        if self.row_peaks.len() != nc {
+            self.row_peaks = vec![0.0; nc];
+        }
+        let mut shrunk = false;
+        for (k, peak) in self.row_peaks.iter_mut().enumerate() {
+            let (s, e) = self.band.jacobian_rows.row(k, n);
+            let norm = max_abs(&self.jacobian[k * n + s..k * n + e]);
+            *peak = peak.max(norm);
+            shrunk |= norm < ROW_SHRINK * *peak;
+        }
+        shrunk
     }
 
     /// J_v⁻¹ h (J_v factored, h evaluated) into the scratch vector, not applied yet;

@@ -58,6 +58,8 @@ pub struct Workspace {
     pub(super) length_scale: f64,
     /// A next correction at most this times (1 + ‖v‖∞) ends Newton too (0: strict).
     pub(super) newton_slack: f64,
+    /// Each solved row's largest ‖J_k‖∞ seen so far ([`Self::rows_shrunk`]).
+    pub(super) row_peaks: Vec<f64>,
     /// The articulated-body route's buffers ([`Self::use_articulated`]).
     pub(super) articulated: ArticulatedBuffers,
 }
@@ -100,6 +102,7 @@ impl Workspace {
             drive: vec![0.0; n],
             length_scale: 1.0,
             newton_slack: 0.0,
+            row_peaks: Vec::new(),
             articulated: Default::default(),
         }
     }
@@ -110,6 +113,7 @@ impl Workspace {
     pub fn select_rows(&mut self, m: usize, rows: &[usize]) {
         self.m = m;
         self.rows = rows.to_vec();
+        self.row_peaks.clear();
         if m == self.nc {
             // Written by `position_terms` again: zero where it may not write (its rows'
             // extents, `Dynamics::jacobian_rows`).

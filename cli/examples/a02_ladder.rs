@@ -1,0 +1,59 @@
+//! IFToMM A02 (`n_four_bar`, N = 40, 20 s, DOP853) at rtol = atol = 10^e for the exponents
+//! given (default -8 -9 -10 -11): the largest error of B0 against the exact reduction
+//! (`cli/src/bench/a02.rs`), the minimum wall time of 3 runs, steps, rejections and
+//! right-hand sides. `cargo run --release -p camchain-cli --example a02_ladder -- -8 -10`.
+
+#[path = "../src/bench/a02.rs"]
+mod a02;
+
+use camchain_runtime::Simulate;
+use std::time::Instant;
+
+fn main() {
+    let exponents: Vec<i32> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("an integer exponent"))
+        .collect();
+    let exponents = if exponents.is_empty() {
+        vec![-8, -9, -10, -11]
+    } else {
+        exponents
+    };
+    let model = camchain_models::by_name("n_four_bar").expect("built in");
+    println!("| rtol = atol | B0 error | at t | wall time | steps | rejected | right-hand sides |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|");
+    for e in exponents {
+        let tolerance = 10f64.powi(e);
+        let mut settings = model.info().defaults.clone();
+        (settings.rtol, settings.atol) = (tolerance, tolerance);
+        let mut best = f64::INFINITY;
+        let mut last = None;
+        for _ in 0..3 {
+            let start = Instant::now();
+            let state = model.assemble(0.0).expect("assembles");
+            let run = model.simulate(state, &settings);
+            best = best.min(start.elapsed().as_secs_f64());
+            last = Some(run);
+        }
+        match last.expect("ran") {
+            Ok(run) => {
+                let (error, at) = a02::largest_error(&run);
+                println!(
+                    "| {tolerance:.0e} | {error:.2e} m | {at:.2} s | {best:.3} s | {} | {} | {} |",
+                    run.stats.steps, run.stats.rejected, run.stats.rhs_evaluations
+                );
+            }
+            Err(f) => {
+                let (error, at) = a02::largest_error(&f.partial);
+                println!(
+                    "| {tolerance:.0e} | failed at t = {:.3} s ({}); B0 error so far {error:.2e} m at {at:.2} s | {best:.3} s | {} | {} | {} |",
+                    f.partial.samples.last().map_or(0.0, |s| s.t),
+                    f.error,
+                    f.partial.stats.steps,
+                    f.partial.stats.rejected,
+                    f.partial.stats.rhs_evaluations
+                );
+            }
+        }
+    }
+}
