@@ -72,7 +72,14 @@ fn sines_and_cosines_are_computed_once_per_angle() {
 }
 
 /// Every model file of the repository, generated with the default options.
-fn every_model() -> Vec<(String, camchain_codegen::emit::Generated)> {
+/// Every model file's generated code, generated once for the tests that read it.
+fn every_model() -> &'static [(String, camchain_codegen::emit::Generated)] {
+    static GENERATED: std::sync::OnceLock<Vec<(String, camchain_codegen::emit::Generated)>> =
+        std::sync::OnceLock::new();
+    GENERATED.get_or_init(generate_every_model)
+}
+
+fn generate_every_model() -> Vec<(String, camchain_codegen::emit::Generated)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .expect("models/")
