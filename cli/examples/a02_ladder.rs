@@ -7,19 +7,30 @@
 mod a02;
 
 use camchain_runtime::Simulate;
+use std::process::ExitCode;
 use std::time::Instant;
 
-fn main() {
-    let exponents: Vec<i32> = std::env::args()
-        .skip(1)
-        .map(|a| a.parse().expect("an integer exponent"))
-        .collect();
+fn main() -> ExitCode {
+    let mut exponents = Vec::new();
+    for a in std::env::args().skip(1) {
+        match a.parse::<i32>() {
+            Ok(e) if (-15..=0).contains(&e) => exponents.push(e),
+            _ => {
+                eprintln!("error: `{a}` is not a tolerance exponent (an integer from -15 to 0)");
+                eprintln!("usage: a02_ladder [EXPONENT ...]   (rtol = atol = 10^EXPONENT)");
+                return ExitCode::from(2);
+            }
+        }
+    }
     let exponents = if exponents.is_empty() {
         vec![-8, -9, -10, -11]
     } else {
         exponents
     };
-    let model = camchain_models::by_name("n_four_bar").expect("built in");
+    let Some(model) = camchain_models::by_name("n_four_bar") else {
+        eprintln!("error: n_four_bar is not among the built-in models");
+        return ExitCode::FAILURE;
+    };
     println!("| rtol = atol | B0 error | at t | wall time | steps | rejected | right-hand sides |");
     println!("|---:|---:|---:|---:|---:|---:|---:|");
     for e in exponents {
@@ -30,12 +41,21 @@ fn main() {
         let mut last = None;
         for _ in 0..3 {
             let start = Instant::now();
-            let state = model.assemble(0.0).expect("assembles");
+            let state = match model.assemble(0.0) {
+                Ok(state) => state,
+                Err(e) => {
+                    eprintln!("error: n_four_bar does not assemble: {e}");
+                    return ExitCode::FAILURE;
+                }
+            };
             let run = model.simulate(state, &settings);
             best = best.min(start.elapsed().as_secs_f64());
             last = Some(run);
         }
-        match last.expect("ran") {
+        let Some(last) = last else {
+            continue;
+        };
+        match last {
             Ok(run) => {
                 let (error, at) = a02::largest_error(&run);
                 println!(
@@ -56,4 +76,5 @@ fn main() {
             }
         }
     }
+    ExitCode::SUCCESS
 }
