@@ -30,7 +30,7 @@ mod cargo;
 #[path = "../tests/common/chain.rs"]
 mod chain;
 
-use cargo::cargo_build;
+use cargo::{cargo_build, new_crate};
 
 use camchain_codegen::{EmitOptions, Formulation};
 use std::fmt::Write;
@@ -172,14 +172,7 @@ fn write_crate(
     modules: &[(&str, &str)],
     runtime: &Path,
 ) -> Result<PathBuf, String> {
-    let dir = out.join("crates").join(name);
-    std::fs::create_dir_all(dir.join("src")).map_err(|e| e.to_string())?;
-    let manifest = format!(
-        "[package]\nname = \"formulations_{name}\"\nversion = \"0.0.0\"\nedition = \"2024\"\n\
-         [dependencies]\ncamchain-runtime = {{ path = {:?} }}\n[workspace]\n",
-        runtime.display().to_string()
-    );
-    std::fs::write(dir.join("Cargo.toml"), manifest).map_err(|e| e.to_string())?;
+    let dir = new_crate(out, name, &format!("formulations_{name}"), runtime)?;
     let mut main = String::new();
     for (module, code) in modules {
         std::fs::write(dir.join(format!("src/{module}.rs")), code).map_err(|e| e.to_string())?;

@@ -18,7 +18,7 @@ mod cargo;
 #[path = "../tests/common/chain.rs"]
 mod chain;
 
-use cargo::cargo_build;
+use cargo::{cargo_build, new_crate};
 
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -136,14 +136,12 @@ fn run(out: &Path, build: bool) -> Result<(), String> {
 
 /// A crate `scaling_chainN` whose main times the generated functions.
 fn write_crate(out: &Path, n: usize, code: &str, runtime: &Path) -> Result<PathBuf, String> {
-    let dir = out.join("crates").join(format!("chain{n}"));
-    std::fs::create_dir_all(dir.join("src")).map_err(|e| e.to_string())?;
-    let manifest = format!(
-        "[package]\nname = \"scaling_chain{n}\"\nversion = \"0.0.0\"\nedition = \"2024\"\n\
-         [dependencies]\ncamchain-runtime = {{ path = {:?} }}\n[workspace]\n",
-        runtime.display().to_string()
-    );
-    std::fs::write(dir.join("Cargo.toml"), manifest).map_err(|e| e.to_string())?;
+    let dir = new_crate(
+        out,
+        &format!("chain{n}"),
+        &format!("scaling_chain{n}"),
+        runtime,
+    )?;
     let main = if code.is_empty() {
         "fn main() {}\n".to_string()
     } else {

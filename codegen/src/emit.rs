@@ -52,7 +52,7 @@ mod wrapper;
 pub use articulated::{Choice, Formulation};
 use contacts::{contact_kinematics_dispatch, contact_kinematics_helpers, contact_kinematics_specs};
 use docs::ConstraintDocs;
-use function::{Extras, emit_method, sparse_rows};
+use function::{Extras, SparseArray, emit_method, sparse_rows};
 use fused::{FusedTerms, all_roots, function_count, fused_count};
 use header::{header, op_count_table};
 use implicit::implicit_helpers;
@@ -233,12 +233,22 @@ pub fn generate_from(
     // M and J of many zeros (chained loops) are written by the fused pair within their
     // rows' extents only, which the model declares (`Dynamics::mass_rows`, `jacobian_rows`).
     let n = model.n();
-    let fused_rows = |name: &str, array: &str| {
-        let (spec, _) = fused_specs.iter().find(|(s, _)| s.name == name)?;
-        sparse_rows(&d.graph, &spec.outputs, array, n)
+    let sparse_of = |name: &str| -> Vec<SparseArray> {
+        let array = if name == "position_terms" {
+            "j"
+        } else {
+            "out.mass"
+        };
+        fused_specs
+            .iter()
+            .filter(|(s, _)| s.name == name)
+            .filter_map(|(s, _)| sparse_rows(&d.graph, &s.outputs, array, n))
+            .map(|rows| (array, n, rows))
+            .collect()
     };
-    let mass_rows = fused_rows("velocity_terms", "out.mass");
-    let jacobian_rows = fused_rows("position_terms", "j");
+    let (mass_sparse, jacobian_sparse) = (sparse_of("velocity_terms"), sparse_of("position_terms"));
+    let rows_of = |s: &[SparseArray]| s.first().map(|(_, _, rows)| rows.clone());
+    let (mass_rows, jacobian_rows) = (rows_of(&mass_sparse), rows_of(&jacobian_sparse));
     let cleared: Vec<&str> = [("m", &mass_rows), ("j", &jacobian_rows)]
         .into_iter()
         .filter(|(_, rows)| rows.is_some())
@@ -294,9 +304,9 @@ pub fn generate_from(
         } else {
             Vec::new()
         };
-        let sparse: &[(&str, usize)] = match spec.name.as_str() {
-            "position_terms" => &[("j", n)],
-            _ => &[("out.mass", n)],
+        let sparse: &[SparseArray] = match spec.name.as_str() {
+            "position_terms" => &jacobian_sparse,
+            _ => &mass_sparse,
         };
         let extras = Extras {
             memo,

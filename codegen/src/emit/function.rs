@@ -45,7 +45,7 @@ pub(super) fn emit_function_full(
 }
 
 /// An output array written within its rows' extents: name, columns, each row's [start, end).
-type SparseArray<'a> = (&'a str, usize, Vec<(usize, usize)>);
+pub(super) type SparseArray<'a> = (&'a str, usize, Vec<(usize, usize)>);
 
 /// What a method of `Model` may have beyond its specification.
 #[derive(Default)]
@@ -54,9 +54,9 @@ pub(super) struct Extras<'a> {
     pub(super) memo: &'a [TrigMemo],
     /// Where the Newton solves of implicit variables start (their kept solutions).
     pub(super) warm: &'a [(Id, String)],
-    /// Output arrays (name, columns) written only within their rows' extents
-    /// ([`sparse_rows`]; the caller's buffer is zero outside).
-    pub(super) sparse: &'a [(&'a str, usize)],
+    /// Output arrays written only within their rows' extents, as [`sparse_rows`] gives
+    /// them (the caller's buffer is zero outside): the same extents the model declares.
+    pub(super) sparse: &'a [SparseArray<'a>],
     /// Where the module of a method of at least [`parts::OWN_MODULE_OPS`] operations goes
     /// (outside the `impl` block); `None`: the body stays in the method.
     pub(super) items: Option<&'a mut String>,
@@ -134,12 +134,7 @@ fn emit_with(
     let mut after = String::new();
     let mut fields = String::new();
     // Arrays written within their rows' extents only: neither cleared nor written outside.
-    let extents: Vec<SparseArray> = sparse
-        .iter()
-        .filter_map(|&(a, columns)| {
-            sparse_rows(g, &spec.outputs, a, columns).map(|rows| (a, columns, rows))
-        })
-        .collect();
+    let extents = sparse;
     let mut filled = zero_filled_arrays(g, &spec.outputs);
     filled.retain(|a| !extents.iter().any(|(s, _, _)| s == a));
     for array in &filled {
@@ -457,8 +452,10 @@ mod tests {
             outputs,
             tail: String::new(),
         };
+        let rows = sparse_rows(&d.graph, &spec.outputs, "m", 10).expect("sparse");
+        let sparse = [("m", 10, rows)];
         let extras = Extras {
-            sparse: &[("m", 10)],
+            sparse: &sparse,
             ..Default::default()
         };
         let (text, _) = emit_with(&d, &spec, "", false, &[], extras);

@@ -58,7 +58,7 @@ pub(super) fn moved(
 
 /// `text` with the receiver `self` renamed `this`: as a word of its own, not a field or a
 /// path segment, outside string literals.
-pub(super) fn receiver_renamed(text: &str) -> String {
+fn receiver_renamed(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     for (start, end) in words(text) {
@@ -75,7 +75,7 @@ pub(super) fn receiver_renamed(text: &str) -> String {
 
 /// The identifiers `text` reads: words not after `.` (fields, methods) or `::` (paths), nor
 /// inside string literals; numbers skipped whole (`1e-3`, `0.5_f64`).
-pub(super) fn identifiers(text: &str) -> Vec<String> {
+fn identifiers(text: &str) -> Vec<String> {
     words(text)
         .into_iter()
         .map(|(start, end)| text[start..end].to_string())
