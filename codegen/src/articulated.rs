@@ -66,6 +66,20 @@ pub struct ArticulatedTerms {
     pub mass_product: Vec<Id>,
 }
 
+impl ArticulatedTerms {
+    /// Every expression the terms hold (the inputs, variables, left out).
+    pub(crate) fn roots_mut(&mut self) -> impl Iterator<Item = &mut Id> {
+        let pairs = self
+            .accelerations
+            .iter_mut()
+            .chain(&mut self.drive_loads)
+            .chain(&mut self.response)
+            .chain(&mut self.response_loads)
+            .map(|(_, id)| id);
+        pairs.chain(&mut self.mass_product)
+    }
+}
+
 /// A spatial force: moment about the frame's origin, force.
 #[derive(Debug, Clone, Copy)]
 struct Force {

@@ -142,10 +142,10 @@ impl Derivation {
 
     fn limited(model: &Model, limit: usize) -> Self {
         let mut d = Self::uncollected_in(model, Graph::with_node_limit(limit));
+        d.derive_articulated(model);
         if !d.graph.exhausted() {
             d.collect_linear();
         }
-        d.derive_articulated(model);
         d
     }
 
@@ -241,7 +241,12 @@ impl Derivation {
             group_of.push(group);
         });
         let mut collected = roots.clone();
-        linear::collect_linear(&mut self.graph, &mut collected);
+        // The sweeps ride on the rewritten kinematics (when F is rewritten, below), so that
+        // the articulated route shares its velocities and accelerations with the contacts'
+        // and loops' terms instead of holding a second copy; the rewriting is that of the
+        // other terms alone.
+        let mut ridden: Vec<Id> = self.articulated.roots_mut().map(|id| *id).collect();
+        linear::collect_linear_with(&mut self.graph, &mut collected, &mut ridden);
         let groups = group_of.iter().copied().max().map_or(0, |g| g + 1);
         let mut keep_new = vec![false; groups];
         for (group, keep) in keep_new.iter_mut().enumerate() {
@@ -255,6 +260,12 @@ impl Derivation {
             let before = self.graph.op_count(&pick(&roots)).total();
             let after = self.graph.op_count(&pick(&collected)).total();
             *keep = after <= before;
+        }
+        // Group 1 is F, the kinematics' main user.
+        if keep_new.get(1) == Some(&true) {
+            for (id, new) in self.articulated.roots_mut().zip(ridden) {
+                *id = new;
+            }
         }
         let mut it = roots.into_iter().zip(collected);
         self.visit_roots(|group, id| {

@@ -21,12 +21,29 @@ use std::collections::BTreeMap;
 
 /// Rewrites `roots` (and everything below them) with their linear combinations collected.
 pub fn collect_linear(g: &mut Graph, roots: &mut [Id]) {
-    let last = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
+    collect_linear_with(g, roots, &mut []);
+}
+
+/// [`collect_linear`] on `roots`, and `riders` moved onto the rewritten nodes: an
+/// expression of `riders` refers to the nodes `roots` are rewritten into, and a node only
+/// the riders need is rebuilt over them unchanged (its operations stay the same). The
+/// rewriting itself, use counts included, is that of `roots` alone, so riding never changes
+/// what `roots` become.
+pub fn collect_linear_with(g: &mut Graph, roots: &mut [Id], riders: &mut [Id]) {
+    let last = roots
+        .iter()
+        .chain(riders.iter())
+        .map(|r| r.index() + 1)
+        .max()
+        .unwrap_or(0);
     let uses = use_counts(g, roots, last);
+    let ridden = g.reachable(riders);
     let mut image: Vec<Id> = Vec::with_capacity(last);
     for i in 0..last {
         let id = g.id_from_index(i);
-        let rebuilt = if uses[i] == 0 {
+        let rebuilt = if uses[i] == 0 && ridden.get(i).copied().unwrap_or(false) {
+            g.rebuild_as(id, |g| g.rebuild_with(id, |c| image[c.index()]))
+        } else if uses[i] == 0 {
             id // not needed by any root: left as it is
         } else if is_linear(g, id) {
             let mut form = LinearForm::default();
@@ -41,7 +58,7 @@ pub fn collect_linear(g: &mut Graph, roots: &mut [Id]) {
         };
         image.push(rebuilt);
     }
-    for r in roots.iter_mut() {
+    for r in roots.iter_mut().chain(riders.iter_mut()) {
         *r = image[r.index()];
     }
 }

@@ -408,12 +408,6 @@ impl rt::Dynamics for Model {
         let first_moment_body3_in_parent_x = first_moment_body3_x + 2.0 * offset_body3_x;
         let first_moment_body2_x = 0.025 + first_moment_body3_in_parent_x;
         let momentum_q2_q1_y = c_q2 * first_moment_body2_x - s_q2 * neg_momentum_q4_q3_x;
-        let inertia_body2_zz = offset_body3_x
-            * (first_moment_body3_x + first_moment_body3_in_parent_x)
-            + (0.09 * c_q4 + 0.34625);
-        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
-        // body1: composite inertia and column q1 of M
-        let inertia_body1_zz = inertia_body2_zz + (0.6 * momentum_q2_q1_y + 0.3475);
         // body4: inertial loads and joint q4 load (backward recursion)
         let neg_centripetal_force_body4_x = 0.15 * omega_body4_sq;
         let moment_of_acc_body4_z = 0.15 * acc_body4_y;
@@ -445,6 +439,13 @@ impl rt::Dynamics for Model {
             + c_q1_q2 * (19.62 * offset_body3_x + 4.65975);
         // body1: gravity load of the subtree on joint q1
         let weight_moment_body1_z = 8.829 * c_q1 + weight_moment_body2_z;
+        // body2: composite inertia and column q2 of M
+        let inertia_body2_zz = offset_body3_x
+            * (first_moment_body3_x + first_moment_body3_in_parent_x)
+            + (0.09 * c_q4 + 0.34625);
+        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
+        // body1: composite inertia and column q1 of M
+        let inertia_body1_zz = inertia_body2_zz + (0.6 * momentum_q2_q1_y + 0.3475);
         m[0] = inertia_body1_zz;
         m[1] = momentum_moment_q2_q1_z;
         m[2] = momentum_moment_q3_q1_z;
@@ -951,12 +952,6 @@ impl rt::Dynamics for Model {
         let first_moment_body2_x = 0.025 + first_moment_body3_in_parent_x;
         let momentum_q2_q1_y = rel_rot_body2_11 * first_moment_body2_x
             - neg_rel_rot_body2_12 * neg_momentum_q4_q3_x;
-        let inertia_body2_zz = offset_body3_x
-            * (first_moment_body3_x + first_moment_body3_in_parent_x)
-            + (0.34625 + 0.09 * rel_rot_body4_11);
-        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
-        // body1: composite inertia and column q1 of M
-        let inertia_body1_zz = inertia_body2_zz + (0.3475 + 0.6 * momentum_q2_q1_y);
         // body4: inertial loads and joint q4 load (backward recursion)
         let neg_centripetal_force_body4_x = 0.15 * omega_body4_sq;
         let moment_of_acc_body4_z = 0.15 * acc_body4_y;
@@ -989,6 +984,13 @@ impl rt::Dynamics for Model {
             + c_q1_q2 * (19.62 * offset_body3_x + 4.65975);
         // body1: gravity load of the subtree on joint q1
         let weight_moment_body1_z = 8.829 * c_q1 + weight_moment_body2_z;
+        // body2: composite inertia and column q2 of M
+        let inertia_body2_zz = offset_body3_x
+            * (first_moment_body3_x + first_moment_body3_in_parent_x)
+            + (0.34625 + 0.09 * rel_rot_body4_11);
+        let momentum_moment_q2_q1_z = 0.3 * momentum_q2_q1_y + inertia_body2_zz;
+        // body1: composite inertia and column q1 of M
+        let inertia_body1_zz = inertia_body2_zz + (0.3475 + 0.6 * momentum_q2_q1_y);
         out.mass[0] = inertia_body1_zz;
         out.mass[1] = momentum_moment_q2_q1_z;
         out.mass[2] = momentum_moment_q3_q1_z;
