@@ -17,9 +17,10 @@
 //! - `derivative`, the constrained reduced right-hand side (Newton on the dependent
 //!   coordinate, velocities, accelerations, λ), at 8 states 1 ms apart along the model's run
 //!   taken in turn (so every call computes its sines and cosines);
-//! - the unconstrained forward dynamics at the same states: `position_terms` +
-//!   `articulated_terms` (articulated), `position_terms` + `velocity_terms` and an LDLᵀ
-//!   solve of M q̈ = −(F + Q) (dense).
+//! - the unconstrained forward dynamics, on the same chain without its contact (the
+//!   mechanism Pinocchio's `aba` is timed on), generated again on both routes, at 8 states of
+//!   its own run: `position_terms` + `articulated_terms` (articulated), `position_terms` +
+//!   `velocity_terms` and an LDLᵀ solve of M q̈ = −(F + Q) (dense).
 //!
 //! Medians of 31 batches (each ≥ 2 ms of the thread's CPU time, which leaves out the time
 //! it was preempted, as `scripts/bench/pinocchio` does) in ns per call. Also the operation counts and the
@@ -80,22 +81,39 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
     let warm = write_crate(&out, "warm", &[], &runtime)?;
     cargo_build(&warm, &target, native)?;
     let mut md = String::from(
-        "| family | N | auto chooses | dense ops (velocity_terms) | articulated ops (terms + response) | rhs dense [ns] | rhs articulated [ns] | dense / articulated | unconstrained dense [ns] | unconstrained articulated [ns] |\n\
-         |---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| family | N | auto chooses | dense ops (velocity_terms) | articulated ops (terms + response) | rhs dense [ns] | rhs articulated [ns] | dense / articulated | unconstrained ops (articulated) | unconstrained dense [ns] | unconstrained articulated [ns] |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     let mut csv = String::from(
-        "family,n,auto,dense_ops,articulated_ops,response_ops,rhs_dense_ns,rhs_articulated_ns,free_dense_ns,free_articulated_ns\n",
+        "family,n,auto,dense_ops,articulated_ops,response_ops,rhs_dense_ns,rhs_articulated_ns,free_ops,free_dense_ns,free_articulated_ns\n",
     );
     for &n in sizes {
-        for (family, text) in [
-            ("spatial", chain::chain_ron(n)),
-            ("planar", chain::planar_contact_ron(n)),
+        for (family, text, free_text) in [
+            ("spatial", chain::chain_ron(n), chain::free_chain_ron(n)),
+            (
+                "planar",
+                chain::planar_contact_ron(n),
+                chain::planar_chain_ron(n),
+            ),
         ] {
             let name = format!("{family}{n}");
             let file = out.join(format!("{name}.ron"));
             std::fs::write(&file, &text).map_err(|e| e.to_string())?;
             let model =
                 camchain_codegen::schema::parse_model(&text, &file).map_err(|e| e.to_string())?;
+            let free_file = out.join(format!("{name}_free.ron"));
+            std::fs::write(&free_file, &free_text).map_err(|e| e.to_string())?;
+            let free = camchain_codegen::schema::parse_model(&free_text, &free_file)
+                .map_err(|e| e.to_string())?;
+            let generate_free = |formulation| {
+                let options = EmitOptions {
+                    runtime_path: "::camchain_runtime".to_string(),
+                    formulation,
+                    ..Default::default()
+                };
+                let path = free_file.display().to_string();
+                camchain_codegen::emit::generate_with(&free, &path, &options)
+            };
             let generate = |formulation| {
                 let options = EmitOptions {
                     runtime_path: "::camchain_runtime".to_string(),
@@ -118,10 +136,19 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
             } else {
                 "dense"
             };
+            let (free_dense, free_articulated) = (
+                generate_free(Formulation::Dense)?,
+                generate_free(Formulation::Articulated)?,
+            );
             let dir = write_crate(
                 &out,
                 &name,
-                &[("dense", &dense.code), ("articulated", &articulated.code)],
+                &[
+                    ("dense", &dense.code),
+                    ("articulated", &articulated.code),
+                    ("free_dense", &free_dense.code),
+                    ("free_articulated", &free_articulated.code),
+                ],
                 &runtime,
             )?;
             cargo_build(&dir, &target, native)?;
@@ -147,14 +174,15 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
                 ops(&articulated, "articulated_terms"),
                 ops(&articulated, "articulated_response"),
             );
+            let free_ops = ops(&free_articulated, "articulated_terms");
             let _ = writeln!(
                 md,
-                "| {family} | {n} | {chosen} | {d_ops} | {a_ops} + {r_ops} | {rd:.0} | {ra:.0} | {:.2}× | {fd:.0} | {fa:.0} |",
+                "| {family} | {n} | {chosen} | {d_ops} | {a_ops} + {r_ops} | {rd:.0} | {ra:.0} | {:.2}× | {free_ops} | {fd:.0} | {fa:.0} |",
                 rd / ra
             );
             let _ = writeln!(
                 csv,
-                "{family},{n},{chosen},{d_ops},{a_ops},{r_ops},{rd:.1},{ra:.1},{fd:.1},{fa:.1}"
+                "{family},{n},{chosen},{d_ops},{a_ops},{r_ops},{rd:.1},{ra:.1},{free_ops},{fd:.1},{fa:.1}"
             );
             eprintln!("{name}: done");
         }
@@ -324,12 +352,14 @@ fn free_articulated<'a>(model: &'a dyn Dynamics, states: &'a [State]) -> impl Fn
 fn main() {
     let dense = dense::Model;
     let articulated = articulated::Model;
+    let (unconstrained_dense, unconstrained) = (free_dense::Model, free_articulated::Model);
+    let free_states = states(&unconstrained);
     let states = states(&articulated);
     let mut fns: Vec<Box<dyn FnMut()>> = vec![
         Box::new(rhs(&dense, &states)),
         Box::new(rhs(&articulated, &states)),
-        Box::new(free_dense(&dense, &states)),
-        Box::new(free_articulated(&articulated, &states)),
+        Box::new(free_dense(&unconstrained_dense, &free_states)),
+        Box::new(free_articulated(&unconstrained, &free_states)),
     ];
     let mut samples = vec![Vec::new(); fns.len()];
     for _ in 0..31 {

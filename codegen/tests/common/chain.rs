@@ -6,6 +6,17 @@
 
 /// The RON text of the N-body chain.
 pub fn chain_ron(n: usize) -> String {
+    spatial_chain(n, true)
+}
+
+/// The chain of [`chain_ron`] without its marker and contact: the unconstrained mechanism
+/// that Pinocchio's `aba` is timed on (`scripts/bench/pinocchio`).
+#[allow(dead_code)] // used by the formulations example, not by every test binary
+pub fn free_chain_ron(n: usize) -> String {
+    spatial_chain(n, false)
+}
+
+fn spatial_chain(n: usize, contact: bool) -> String {
     let mut bodies = String::new();
     for i in 0..n {
         let (kind, axis) = match i % 4 {
@@ -31,13 +42,20 @@ pub fn chain_ron(n: usize) -> String {
              anchor: {anchor}, coordinate: \"q{i}\", spring: (stiffness: 10.0, damping: 0.5, rest: 0.0))),\n"
         ));
     }
+    let tip = if contact {
+        format!(
+            "    markers: [(name: \"tip\", body: \"b{last}\", position: (0.2, 0.0, 0.0))],\n    \
+             contacts: [(marker: \"tip\", profile: \"0.1*x.sin() - 0.05*x*x\", frame: (origin: \
+             (0.0, 0.0, 0.0), x_axis: (1.0, 0.0, 0.0), y_axis: (0.0, 0.6, 0.8)))],\n",
+            last = n - 1
+        )
+    } else {
+        String::new()
+    };
     format!(
         "(\n    name: \"chain{n}\",\n    description: \"Scaling study: {n}-body chain.\",\n    \
-         gravity: (0.0, 0.0, -9.81),\n    bodies: [\n{bodies}    ],\n    markers: [(name: \"tip\", \
-         body: \"b{last}\", position: (0.2, 0.0, 0.0))],\n    contacts: [(marker: \"tip\", profile: \
-         \"0.1*x.sin() - 0.05*x*x\", frame: (origin: (0.0, 0.0, 0.0), x_axis: (1.0, 0.0, 0.0), \
-         y_axis: (0.0, 0.6, 0.8)))],\n    simulation: (t_end: 1.0, dt_out: 0.01),\n)\n",
-        last = n - 1
+         gravity: (0.0, 0.0, -9.81),\n    bodies: [\n{bodies}    ],\n{tip}    \
+         simulation: (t_end: 1.0, dt_out: 0.01),\n)\n"
     )
 }
 
