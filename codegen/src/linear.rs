@@ -364,4 +364,48 @@ mod tests {
         // Closed form 0.3·1 − 0.3·2 + 0.6·3; a value of order 1, a few roundings apart.
         assert!((v - (0.3 - 0.6 + 1.8)).abs() < 1e-15);
     }
+
+    /// A rider sees the roots' rewritten nodes and leaves the roots' rewriting alone: the
+    /// same roots rewritten with and without it are the same nodes, the rider's own node
+    /// (which only it needs) is rebuilt over the rewritten sum, and its value is unchanged.
+    #[test]
+    fn riders_use_the_rewritten_nodes_and_change_nothing_else() {
+        let build = |g: &mut Graph| {
+            let x = g.var("x");
+            let k = g.constant(0.3);
+            let sx = g.sin(x);
+            // s = 0.3·sin x + 0.3·(sin x + 0.3): collected to 0.6·sin x + 0.09.
+            let inner = g.add(sx, k);
+            let a = g.mul(k, sx);
+            let b = g.mul(k, inner);
+            let s = g.add(a, b);
+            let root = g.cos(s);
+            let rider = g.mul(s, s);
+            (root, rider, s)
+        };
+        let mut alone = Graph::new();
+        let (root, _, _) = build(&mut alone);
+        let mut roots = [root];
+        collect_linear(&mut alone, &mut roots);
+        let mut g = Graph::new();
+        let (root, rider, s) = build(&mut g);
+        let (mut with, mut riders) = ([root], [rider]);
+        collect_linear_with(&mut g, &mut with, &mut riders);
+        assert_eq!(
+            g.op_count(&with).total(),
+            alone.op_count(&roots).total(),
+            "the roots' rewriting depends on the roots alone"
+        );
+        // The rider is s² over the rewritten s: cos's argument, shared.
+        let Node::Call(crate::profile::Func::Cos, arg) = g.node(with[0]) else {
+            panic!("the root is still a cosine")
+        };
+        assert_eq!(g.node(riders[0]), Node::Mul(arg, arg));
+        assert_ne!(arg, s, "s was rewritten");
+        for v in [-0.7, 0.4, 2.2] {
+            let (before, after) = (g.eval(&[rider], &[v])[0], g.eval(&riders, &[v])[0]);
+            // The same square of a reassociated sum of order 1: a few roundings apart.
+            assert!((before - after).abs() <= 1e-15 * (1.0 + before.abs()));
+        }
+    }
 }
