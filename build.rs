@@ -13,10 +13,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if std::env::var_os("CARGO_FEATURE_RANDOM_MODELS").is_some() {
         let out = std::path::PathBuf::from(std::env::var("OUT_DIR")?).join("random_models");
         // The articulated-body sweeps: tests/suite/random_compiled.rs compares them with the
-        // numeric reference and runs them against the reference's simulations.
+        // numeric reference and runs them against the reference's simulations. Written with
+        // `mul_add`, as a build for a processor with FMA writes them, so that this text is
+        // checked on every machine (without FMA enabled, `mul_add` calls the C library's
+        // exact `fma`: the same values, slower).
         camchain_build::Config::new()
             .out_dir(out)
             .formulation(camchain_build::Formulation::Articulated)
+            .fused_multiply_add(true)
             .include_file("random_models.rs")
             .compile_models(&["tests/random_models"])?;
         // The contact kinds the built-in models do not use (tests/suite/contacts_compiled.rs).

@@ -168,7 +168,10 @@ impl Config {
     pub fn new() -> Self {
         Config {
             out_dir: None,
-            options: EmitOptions::default(),
+            options: EmitOptions {
+                fused_multiply_add: target_has_fma(),
+                ..EmitOptions::default()
+            },
             module_names: BTreeMap::new(),
             include_file: None,
             embed_source: false,
@@ -209,6 +212,17 @@ impl Config {
     /// the other's. A model file's `simulation: (formulation: …)` takes precedence.
     pub fn formulation(&mut self, formulation: Formulation) -> &mut Self {
         self.options.formulation = formulation;
+        self
+    }
+
+    /// Whether the generated methods write products summed with another term as
+    /// `a.mul_add(b, c)` ([`EmitOptions::fused_multiply_add`]). Default: when the crate is
+    /// compiled for a processor with FMA instructions (`-C target-cpu=native` on a recent
+    /// x86-64, `-C target-feature=+fma`; cargo tells the build script through
+    /// `CARGO_CFG_TARGET_FEATURE`), where each fused pair is one instruction and one rounding;
+    /// elsewhere `mul_add` would be a call of the C library's `fma`.
+    pub fn fused_multiply_add(&mut self, fused: bool) -> &mut Self {
+        self.options.fused_multiply_add = fused;
         self
     }
 
@@ -675,3 +689,9 @@ impl fmt::Debug for Error {
 }
 
 impl std::error::Error for Error {}
+
+/// Whether the build script's target has FMA instructions enabled at compile time (cargo
+/// sets `CARGO_CFG_TARGET_FEATURE` for build scripts: the target's features, comma-separated).
+fn target_has_fma() -> bool {
+    std::env::var("CARGO_CFG_TARGET_FEATURE").is_ok_and(|f| f.split(',').any(|x| x == "fma"))
+}

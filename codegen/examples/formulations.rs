@@ -109,6 +109,8 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
                 let options = EmitOptions {
                     runtime_path: "::camchain_runtime".to_string(),
                     formulation,
+                    // Native builds have FMA (as `camchain_build::Config` finds it).
+                    fused_multiply_add: native,
                     ..Default::default()
                 };
                 let path = free_file.display().to_string();
@@ -118,6 +120,8 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
                 let options = EmitOptions {
                     runtime_path: "::camchain_runtime".to_string(),
                     formulation,
+                    // Native builds have FMA (as `camchain_build::Config` finds it).
+                    fused_multiply_add: native,
                     ..Default::default()
                 };
                 camchain_codegen::emit::generate_with(&model, &file.display().to_string(), &options)

@@ -134,6 +134,15 @@ pub struct EmitOptions {
     /// default the one with the smaller estimated operation count per right-hand side (the
     /// header shows both estimates).
     pub formulation: Formulation,
+    /// Whether `Model`'s methods write a product summed with another term as
+    /// `a.mul_add(b, c)` (one rounding instead of two). Off by default: without the
+    /// processor's FMA instructions enabled at compile time (`-C target-cpu=native` on a
+    /// recent x86-64, `-C target-feature=+fma`), `mul_add` is a call of the C library's `fma`.
+    /// `camchain_build::Config` turns it on when the target has them (its build script sees
+    /// `CARGO_CFG_TARGET_FEATURE`), where it saves an instruction per product: 10–15 % of a
+    /// long chain's right-hand side (BENCHMARKS.md). Rust never fuses `a * b + c` itself, as
+    /// C compilers do by default.
+    pub fused_multiply_add: bool,
 }
 
 impl Default for EmitOptions {
@@ -148,6 +157,7 @@ impl Default for EmitOptions {
             code_limit: MAX_CODE_BYTES,
             simulation_methods: true,
             formulation: Formulation::Auto,
+            fused_multiply_add: false,
         }
     }
 }
@@ -278,6 +288,7 @@ pub fn generate_from(
                 let extras = Extras {
                     warm,
                     items: Some(&mut part_items),
+                    fused_multiply_add: options.fused_multiply_add,
                     ..Default::default()
                 };
                 emit_method(&d, spec, &derived("self."), extras)
@@ -313,6 +324,7 @@ pub fn generate_from(
             warm: &warm,
             sparse,
             items: Some(&mut part_items),
+            fused_multiply_add: options.fused_multiply_add,
         };
         let (text, count) = emit_method(&d, spec, &given, extras);
         functions.push_str(&text);
@@ -352,6 +364,7 @@ pub fn generate_from(
         for (spec, given) in &aba_specs {
             let extras = Extras {
                 items: Some(&mut part_items),
+                fused_multiply_add: options.fused_multiply_add,
                 ..Default::default()
             };
             let (text, count) = emit_method(&d, spec, given, extras);
@@ -372,6 +385,7 @@ pub fn generate_from(
             articulated::mass_times_spec(&d, &fused.mass, &fused.cache_given(), &derived("self."));
         let extras = Extras {
             items: Some(&mut part_items),
+            fused_multiply_add: options.fused_multiply_add,
             ..Default::default()
         };
         let (text, count) = emit_method(&d, &spec, &given, extras);

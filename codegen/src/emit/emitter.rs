@@ -51,6 +51,8 @@ pub(super) struct Emitter<'g> {
     table_calls: HashMap<(u32, Id), String>,
     /// The bound result of each surface's call, by (surface, x, y), likewise.
     grid_calls: HashMap<(u32, Id, Id), String>,
+    /// Sums with a product written `a.mul_add(b, c)`.
+    pub(super) fused_multiply_add: bool,
 }
 
 impl<'g> Emitter<'g> {
@@ -109,6 +111,7 @@ impl<'g> Emitter<'g> {
             solves_read_derived: false,
             table_calls: HashMap::new(),
             grid_calls: HashMap::new(),
+            fused_multiply_add: false,
         }
     }
 
@@ -531,6 +534,11 @@ impl<'g> Emitter<'g> {
     }
 
     fn render_add(&self, a: Id, b: Id) -> (String, u8) {
+        if self.fused_multiply_add {
+            if let Some(text) = self.render_fused(a, b) {
+                return (text, 4);
+            }
+        }
         let neg = |x: Id| match self.g.node(x) {
             Node::Neg(y) if !self.names.contains_key(&x) => Some(y),
             _ => None,
@@ -546,6 +554,44 @@ impl<'g> Emitter<'g> {
             },
         };
         (text, 1)
+    }
+
+    /// `a + b` as `x.mul_add(y, c)` when one side is a product not bound to a name
+    /// (`±x · y`), the other being the addend c (the second side's product first). Constant
+    /// factors are the multiplier, so that the receiver is a name: `s.mul_add(0.2, c)`.
+    fn render_fused(&self, a: Id, b: Id) -> Option<String> {
+        let product = |x: Id| -> Option<(Id, Id, bool)> {
+            if self.names.contains_key(&x) {
+                return None;
+            }
+            match self.g.node(x) {
+                Node::Mul(p, q) => Some((p, q, false)),
+                Node::Neg(y) if !self.names.contains_key(&y) => match self.g.node(y) {
+                    Node::Mul(p, q) => Some((p, q, true)),
+                    _ => None,
+                },
+                _ => None,
+            }
+        };
+        let ((p, q, negative), addend) = match (product(b), product(a)) {
+            (Some(f), _) => (f, a),
+            (None, Some(f)) => (f, b),
+            (None, None) => return None,
+        };
+        let (x, y) = match self.g.as_const(p) {
+            Some(_) if !self.names.contains_key(&p) => (q, p),
+            _ => (p, q),
+        };
+        let multiplier = match (self.g.as_const(y), negative) {
+            (Some(v), true) if !self.names.contains_key(&y) => lit(-v),
+            (_, true) => format!("-{}", self.print(y, 3)),
+            (_, false) => self.print(y, 0),
+        };
+        Some(format!(
+            "{}.mul_add({multiplier}, {})",
+            self.receiver(x),
+            self.print(addend, 0)
+        ))
     }
 
     fn receiver(&self, a: Id) -> String {

@@ -60,6 +60,9 @@ pub(super) struct Extras<'a> {
     /// Where the module of a method of at least [`parts::OWN_MODULE_OPS`] operations goes
     /// (outside the `impl` block); `None`: the body stays in the method.
     pub(super) items: Option<&'a mut String>,
+    /// Products summed with another term written `a.mul_add(b, c)`
+    /// ([`crate::EmitOptions::fused_multiply_add`]).
+    pub(super) fused_multiply_add: bool,
 }
 
 /// A method of `Model` as [`emit_function_full`] emits it, with `extras`.
@@ -85,6 +88,7 @@ fn emit_with(
         warm,
         sparse,
         items,
+        fused_multiply_add,
     } = extras;
     let g = &d.graph;
     let roots: Vec<Id> = spec.outputs.iter().map(|(_, id)| *id).collect();
@@ -92,6 +96,7 @@ fn emit_with(
     let count = g.op_count_until(&roots, &given_set);
     let items = items.filter(|_| method && count.total() >= parts::OWN_MODULE_OPS);
     let mut body = Emitter::new(g, &spec.outputs, given, &d.symbols.params);
+    body.fused_multiply_add = fused_multiply_add;
     for m in memo {
         body.memo.insert(m.sin, *m);
         body.memo.insert(m.cos, *m);

@@ -283,6 +283,41 @@ fn a_large_method_body_gets_a_module_of_its_own() {
     }
 }
 
+/// With `fused_multiply_add` (a build for a processor with FMA), sums with a product are
+/// written `x.mul_add(y, c)`: the paper's model gets them, its operation counts are those of
+/// the plain code (the graph is the same), and the code is valid Rust; without the option
+/// (the built-in models' copies) there are none. The values of code written this way are
+/// checked where it is compiled: the random models, built with the option, against the
+/// numeric recursion (`tests/suite/random_compiled.rs`).
+#[test]
+fn fused_multiply_add_writes_mul_add_and_counts_the_same() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/paper_concave.ron");
+    let text = std::fs::read_to_string(&path).expect("the paper's model");
+    let generate = |fused_multiply_add| {
+        let options = camchain_codegen::EmitOptions {
+            fused_multiply_add,
+            ..Default::default()
+        };
+        camchain_codegen::generate_source(&text, &path, &options).expect("generates")
+    };
+    let (plain, fused) = (generate(false), generate(true));
+    assert!(!plain.code.contains(".mul_add("));
+    let velocity = fused
+        .code
+        .split("\n    fn velocity_terms(")
+        .nth(1)
+        .expect("the method");
+    assert!(
+        velocity.contains(".mul_add("),
+        "velocity_terms fuses its sums"
+    );
+    assert_eq!(plain.op_counts, fused.op_counts);
+    syn::parse_file(&fused.code).expect("valid Rust");
+    for (file, g) in every_model() {
+        assert!(!g.code.contains(".mul_add("), "{file}: fused by default");
+    }
+}
+
 /// M and J of many zeros (A02's 81 × 81 M is 98 % zeros) are written by the fused pair within
 /// their rows' extents only, and the model declares the extents (`mass_rows`,
 /// `jacobian_rows`): a right-hand side neither clears nor scans n² entries. The paper's
