@@ -97,35 +97,25 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
             ),
         ] {
             let name = format!("{family}{n}");
-            let file = out.join(format!("{name}.ron"));
-            std::fs::write(&file, &text).map_err(|e| e.to_string())?;
-            let model =
-                camchain_codegen::schema::parse_model(&text, &file).map_err(|e| e.to_string())?;
-            let free_file = out.join(format!("{name}_free.ron"));
-            std::fs::write(&free_file, &free_text).map_err(|e| e.to_string())?;
-            let free = camchain_codegen::schema::parse_model(&free_text, &free_file)
-                .map_err(|e| e.to_string())?;
-            let generate_free = |formulation| {
-                let options = EmitOptions {
-                    runtime_path: "::camchain_runtime".to_string(),
-                    formulation,
-                    // Native builds have FMA (as `camchain_build::Config` finds it).
-                    fused_multiply_add: native,
-                    ..Default::default()
-                };
-                let path = free_file.display().to_string();
-                camchain_codegen::emit::generate_with(&free, &path, &options)
+            // The model file written out, parsed, and a function generating it on a route.
+            let model_of = |file: PathBuf, text: &str| -> Result<_, String> {
+                std::fs::write(&file, text).map_err(|e| e.to_string())?;
+                let model = camchain_codegen::schema::parse_model(text, &file)
+                    .map_err(|e| e.to_string())?;
+                Ok(move |formulation| {
+                    let options = EmitOptions {
+                        runtime_path: "::camchain_runtime".to_string(),
+                        formulation,
+                        // Native builds have FMA (as `camchain_build::Config` finds it).
+                        fused_multiply_add: native,
+                        ..Default::default()
+                    };
+                    let path = file.display().to_string();
+                    camchain_codegen::emit::generate_with(&model, &path, &options)
+                })
             };
-            let generate = |formulation| {
-                let options = EmitOptions {
-                    runtime_path: "::camchain_runtime".to_string(),
-                    formulation,
-                    // Native builds have FMA (as `camchain_build::Config` finds it).
-                    fused_multiply_add: native,
-                    ..Default::default()
-                };
-                camchain_codegen::emit::generate_with(&model, &file.display().to_string(), &options)
-            };
+            let generate = model_of(out.join(format!("{name}.ron")), &text)?;
+            let generate_free = model_of(out.join(format!("{name}_free.ron")), &free_text)?;
             let ops = |g: &camchain_codegen::Generated, f: &str| {
                 g.op_counts
                     .iter()
