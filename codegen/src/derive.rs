@@ -107,6 +107,10 @@ pub struct TooLarge {
     pub bodies: usize,
 }
 
+/// The term group of F in [`Derivation::visit_roots`]: the kinematics' main user, whose
+/// rewriting the articulated sweeps follow.
+const INERTIAL_GROUP: usize = 1;
+
 impl Derivation {
     /// Derives every term of `model` (with the linear combinations collected).
     ///
@@ -261,8 +265,7 @@ impl Derivation {
             let after = self.graph.op_count(&pick(&collected)).total();
             *keep = after <= before;
         }
-        // Group 1 is F, the kinematics' main user.
-        if keep_new.get(1) == Some(&true) {
+        if keep_new.get(INERTIAL_GROUP) == Some(&true) {
             for (id, new) in self.articulated.roots_mut().zip(ridden) {
                 *id = new;
             }
@@ -280,7 +283,7 @@ impl Derivation {
     fn visit_roots(&mut self, mut f: impl FnMut(usize, &mut Id)) {
         let dy = &mut self.dynamics;
         dy.mass.iter_mut().flatten().for_each(|id| f(0, id));
-        dy.inertial.iter_mut().for_each(|id| f(1, id));
+        dy.inertial.iter_mut().for_each(|id| f(INERTIAL_GROUP, id));
         dy.applied.iter_mut().for_each(|id| f(2, id));
         let e = &mut self.energy;
         for id in [
