@@ -35,6 +35,7 @@ mod fused;
 mod header;
 mod implicit;
 mod info;
+mod lengths;
 mod literals;
 mod methods;
 mod model_type;

@@ -457,6 +457,7 @@ impl rt::Dynamics for Model {
     }
     /// M(q), eq. (13), row-major.
     fn mass_matrix(&self, _q: &[f64], m: &mut [f64]) {
+        assert!(m.len() >= 4);
         // run-time parameters (values stored when they are set)
         let m_2 = self.derived.m;
         m[0] = 0.0012;
@@ -466,11 +467,15 @@ impl rt::Dynamics for Model {
     }
     /// F(q, q̇), eq. (13).
     fn inertial_forces(&self, _q: &[f64], _qd: &[f64], f: &mut [f64]) {
+        assert!(f.len() >= 2);
         f[0] = 0.0;
         f[1] = 0.0;
     }
     /// Q(q, q̇, t), eq. (13): gravity, springs, dampers.
     fn applied_forces(&self, _t: f64, q: &[f64], qd: &[f64], applied: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(applied.len() >= 2);
         let lift = q[1];
         let lift_dot = qd[1];
         // run-time parameters (values stored when they are set)
@@ -493,6 +498,11 @@ impl rt::Dynamics for Model {
         f: &mut [f64],
         applied: &mut [f64],
     ) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(m.len() >= 4);
+        assert!(f.len() >= 2);
+        assert!(applied.len() >= 2);
         let lift = q[1];
         let lift_dot = qd[1];
         // run-time parameters (values stored when they are set)
@@ -514,6 +524,8 @@ impl rt::Dynamics for Model {
     }
     /// h(q), one row per equation: contact `roller` (a roller on the profile's nearest point), h = D − ρ, eq. (C7).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(! h.is_empty());
         let cam_angle = q[0];
         let lift = q[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
@@ -586,6 +598,8 @@ impl rt::Dynamics for Model {
     }
     /// J = ∂h/∂q, row-major nc×n: contact `roller` (a roller on the profile's nearest point), J = n·∂P/∂q, eq. (C8).
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(j.len() >= 2);
         let cam_angle = q[0];
         let lift = q[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
@@ -653,6 +667,9 @@ impl rt::Dynamics for Model {
     }
     /// c of J q̈ + c = 0: contact `roller` (a roller on the profile's nearest point), eq. (C9).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(! c.is_empty());
         let cam_angle = q[0];
         let lift = q[1];
         let cam_angle_dot = qd[0];
@@ -773,6 +790,10 @@ impl rt::Dynamics for Model {
     }
     /// J and c sharing one evaluation of the kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(j.len() >= 2);
+        assert!(! c.is_empty());
         let cam_angle = q[0];
         let lift = q[1];
         let cam_angle_dot = qd[0];
@@ -895,6 +916,9 @@ impl rt::Dynamics for Model {
     }
     /// Where and how every contact touches: the contact point in ground and cam coordinates, the follower point, the normal, the force scale, the profile's parameter and curvature there, the follower's direction of motion, the sliding speed.
     fn contact_geometry(&self, q: &[f64], qd: &[f64], out: &mut [rt::ContactGeometry]) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(! out.is_empty());
         let cam_angle = q[0];
         let lift = q[1];
         let cam_angle_dot = qd[0];
@@ -1029,6 +1053,9 @@ impl rt::Dynamics for Model {
     }
     /// q, q̇, q̈ of the driven coordinates at time t.
     fn prescribed(&self, t: f64, q: &mut [f64], qd: &mut [f64], qdd: &mut [f64]) {
+        assert!(! q.is_empty());
+        assert!(! qd.is_empty());
+        assert!(! qdd.is_empty());
         // run-time parameters (values stored when they are set)
         let omega = self.derived.omega;
         q[0] = t * omega;
@@ -1037,6 +1064,8 @@ impl rt::Dynamics for Model {
     }
     /// Kinetic energy from the body velocities; gravity and spring potentials.
     fn energy(&self, q: &[f64], qd: &[f64]) -> rt::Energy {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
         let lift = q[1];
         let cam_angle_dot = qd[0];
         let lift_dot = qd[1];
@@ -1061,6 +1090,7 @@ impl rt::Dynamics for Model {
     }
     /// Σ c q̇², the power the joint dampers dissipate.
     fn damper_power(&self, qd: &[f64]) -> f64 {
+        assert!(qd.len() >= 2);
         let lift_dot = qd[1];
         // run-time parameters (values stored when they are set)
         let c_2 = self.derived.c;
@@ -1074,6 +1104,10 @@ impl rt::Dynamics for Model {
         j: &mut [f64],
         cache: &mut [f64],
     ) {
+        assert!(q.len() >= 2);
+        assert!(cache.len() >= 17);
+        assert!(! h.is_empty());
+        assert!(j.len() >= 2);
         let cam_angle = q[0];
         let lift = q[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
@@ -1171,6 +1205,13 @@ impl rt::Dynamics for Model {
         cache: &[f64],
         out: rt::VelocityTerms<'_>,
     ) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(cache.len() >= 17);
+        assert!(out.mass.len() >= 4);
+        assert!(out.inertial.len() >= 2);
+        assert!(out.applied.len() >= 2);
+        assert!(! out.bias.is_empty());
         let lift = q[1];
         let cam_angle_dot = qd[0];
         let lift_dot = qd[1];
@@ -1308,6 +1349,10 @@ fn contact_kinematics_0(
     qd: &[f64],
     out: &mut rt::ContactKinematics,
 ) {
+    assert!(q.len() >= 2);
+    assert!(qd.len() >= 2);
+    assert!(out.j1.len() >= 2);
+    assert!(out.j2.len() >= 2);
     let cam_angle = q[0];
     let lift = q[1];
     let cam_angle_dot = qd[0];

@@ -768,6 +768,8 @@ impl rt::Dynamics for Model {
     }
     /// M(q), eq. (13), row-major.
     fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(m.len() >= 9);
         let q_coupler = q[1];
         // run-time parameters (values stored when they are set)
         let a = self.derived.a;
@@ -797,6 +799,9 @@ impl rt::Dynamics for Model {
     }
     /// F(q, q̇), eq. (13).
     fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
+        assert!(q.len() >= 2);
+        assert!(qd.len() >= 2);
+        assert!(f.len() >= 3);
         let q_coupler = q[1];
         let q_crank_dot = qd[0];
         let q_coupler_dot = qd[1];
@@ -826,6 +831,8 @@ impl rt::Dynamics for Model {
     }
     /// Q(q, q̇, t), eq. (13): gravity, springs, dampers.
     fn applied_forces(&self, _t: f64, q: &[f64], _qd: &[f64], applied: &mut [f64]) {
+        assert!(q.len() >= 3);
+        assert!(applied.len() >= 3);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -867,6 +874,11 @@ impl rt::Dynamics for Model {
         f: &mut [f64],
         applied: &mut [f64],
     ) {
+        assert!(q.len() >= 3);
+        assert!(qd.len() >= 2);
+        assert!(m.len() >= 9);
+        assert!(f.len() >= 3);
+        assert!(applied.len() >= 3);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -939,6 +951,8 @@ impl rt::Dynamics for Model {
     }
     /// h(q), one row per equation: loop `pin` (x, y), the cut joint's equations h = X·Y, eq. (K1).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
+        assert!(q.len() >= 3);
+        assert!(h.len() >= 2);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -974,6 +988,8 @@ impl rt::Dynamics for Model {
     }
     /// J = ∂h/∂q, row-major nc×n: loop `pin` (x, y), J = X_q·Y + X·Y_q, eq. (K2).
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
+        assert!(q.len() >= 3);
+        assert!(j.len() >= 6);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1009,6 +1025,9 @@ impl rt::Dynamics for Model {
     }
     /// c of J q̈ + c = 0: loop `pin` (x, y), eq. (K3).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
+        assert!(q.len() >= 3);
+        assert!(qd.len() >= 3);
+        assert!(c.len() >= 2);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1059,6 +1078,10 @@ impl rt::Dynamics for Model {
     }
     /// J and c sharing one evaluation of the kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
+        assert!(q.len() >= 3);
+        assert!(qd.len() >= 3);
+        assert!(j.len() >= 6);
+        assert!(c.len() >= 2);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1126,6 +1149,8 @@ impl rt::Dynamics for Model {
     fn prescribed(&self, _t: f64, _q: &mut [f64], _qd: &mut [f64], _qdd: &mut [f64]) {}
     /// Kinetic energy from the body velocities; gravity and spring potentials.
     fn energy(&self, q: &[f64], qd: &[f64]) -> rt::Energy {
+        assert!(q.len() >= 3);
+        assert!(qd.len() >= 3);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1187,6 +1212,7 @@ impl rt::Dynamics for Model {
     }
     /// Σ τ q̇, the power of the applied joint loads.
     fn load_power(&self, _t: f64, _q: &[f64], qd: &[f64]) -> f64 {
+        assert!(! qd.is_empty());
         let q_crank_dot = qd[0];
         // run-time parameters (values stored when they are set)
         let torque = self.derived.torque;
@@ -1194,6 +1220,7 @@ impl rt::Dynamics for Model {
     }
     /// The points A and B of every loop's cut joint, ground coordinates.
     fn loop_points(&self, q: &[f64], out: &mut [[f64; 3]]) {
+        assert!(q.len() >= 3);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1240,6 +1267,9 @@ impl rt::Dynamics for Model {
         j: &mut [f64],
         cache: &mut [f64],
     ) {
+        assert!(q.len() >= 3);
+        assert!(h.len() >= 2);
+        assert!(j.len() >= 6);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1288,6 +1318,12 @@ impl rt::Dynamics for Model {
         cache: &[f64],
         out: rt::VelocityTerms<'_>,
     ) {
+        assert!(qd.len() >= 3);
+        assert!(cache.len() >= 9);
+        assert!(out.mass.len() >= 9);
+        assert!(out.inertial.len() >= 3);
+        assert!(out.applied.len() >= 3);
+        assert!(out.bias.len() >= 2);
         let q_crank_dot = qd[0];
         let q_coupler_dot = qd[1];
         let q_rocker_dot = qd[2];

@@ -210,6 +210,8 @@ impl rt::Dynamics for Model {
     }
     /// M(q), eq. (13), row-major.
     fn mass_matrix(&self, q: &[f64], m: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(m.len() >= 16);
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
@@ -259,6 +261,9 @@ impl rt::Dynamics for Model {
     }
     /// F(q, q̇), eq. (13).
     fn inertial_forces(&self, q: &[f64], qd: &[f64], f: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(f.len() >= 4);
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
@@ -319,6 +324,9 @@ impl rt::Dynamics for Model {
     }
     /// Q(q, q̇, t), eq. (13): gravity, springs, dampers.
     fn applied_forces(&self, _t: f64, q: &[f64], qd: &[f64], applied: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(applied.len() >= 4);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -360,6 +368,11 @@ impl rt::Dynamics for Model {
         f: &mut [f64],
         applied: &mut [f64],
     ) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(m.len() >= 16);
+        assert!(f.len() >= 4);
+        assert!(applied.len() >= 4);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -475,6 +488,8 @@ impl rt::Dynamics for Model {
     }
     /// h(q), one row per equation: contact `A` (a knife edge on y = f(x)), h = f2 − f3(f1), eq. (3).
     fn constraint(&self, q: &[f64], h: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(! h.is_empty());
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -508,6 +523,8 @@ impl rt::Dynamics for Model {
     }
     /// J = ∂h/∂q, row-major nc×n: contact `A` (a knife edge on y = f(x)), J = J2 − f3′ J1, eq. (5b).
     fn constraint_jacobian(&self, q: &[f64], j: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(j.len() >= 4);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -544,6 +561,9 @@ impl rt::Dynamics for Model {
     }
     /// c of J q̈ + c = 0: contact `A` (a knife edge on y = f(x)), eqs. (7, 8).
     fn constraint_bias(&self, q: &[f64], qd: &[f64], c: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(! c.is_empty());
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -602,6 +622,10 @@ impl rt::Dynamics for Model {
     }
     /// J and c sharing one evaluation of the kinematics.
     fn constraint_terms(&self, q: &[f64], qd: &[f64], j: &mut [f64], c: &mut [f64]) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(j.len() >= 4);
+        assert!(! c.is_empty());
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -664,6 +688,9 @@ impl rt::Dynamics for Model {
     }
     /// Where and how every contact touches: the contact point in ground and cam coordinates, the follower point, the normal, the force scale, the profile's parameter and curvature there, the follower's direction of motion, the sliding speed.
     fn contact_geometry(&self, q: &[f64], qd: &[f64], out: &mut [rt::ContactGeometry]) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(! out.is_empty());
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -749,6 +776,8 @@ impl rt::Dynamics for Model {
     fn prescribed(&self, _t: f64, _q: &mut [f64], _qd: &mut [f64], _qdd: &mut [f64]) {}
     /// Kinetic energy from the body velocities; gravity and spring potentials.
     fn energy(&self, q: &[f64], qd: &[f64]) -> rt::Energy {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -812,6 +841,7 @@ impl rt::Dynamics for Model {
     }
     /// Σ c q̇², the power the joint dampers dissipate.
     fn damper_power(&self, qd: &[f64]) -> f64 {
+        assert!(qd.len() >= 4);
         let q2_dot = qd[1];
         let q3_dot = qd[2];
         let q4_dot = qd[3];
@@ -825,6 +855,9 @@ impl rt::Dynamics for Model {
         j: &mut [f64],
         cache: &mut [f64],
     ) {
+        assert!(q.len() >= 4);
+        assert!(! h.is_empty());
+        assert!(j.len() >= 4);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -870,6 +903,13 @@ impl rt::Dynamics for Model {
         cache: &[f64],
         out: rt::VelocityTerms<'_>,
     ) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(cache.len() >= 9);
+        assert!(out.mass.len() >= 16);
+        assert!(out.inertial.len() >= 4);
+        assert!(out.applied.len() >= 4);
+        assert!(! out.bias.is_empty());
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
@@ -1033,6 +1073,12 @@ impl rt::Dynamics for Model {
         cache: &[f64],
         out: rt::ArticulatedTerms<'_>,
     ) {
+        assert!(q.len() >= 4);
+        assert!(qd.len() >= 4);
+        assert!(cache.len() >= 9);
+        assert!(out.qdd.len() >= 4);
+        assert!(! out.bias.is_empty());
+        assert!(out.factors.len() >= 18);
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
@@ -1236,6 +1282,9 @@ impl rt::Dynamics for Model {
         qdd: &mut [f64],
         _drive: &mut [f64],
     ) {
+        assert!(factors.len() >= 18);
+        assert!(tau.len() >= 4);
+        assert!(qdd.len() >= 4);
         // body2: joint q2, rotation, velocities and accelerations
         let rel_rot_body2_11 = factors[1];
         let neg_rel_rot_body2_12 = factors[2];
@@ -1325,6 +1374,10 @@ impl rt::Dynamics for Model {
 #[allow(clippy::approx_constant, clippy::excessive_precision)]
 /// Geometry of contact `A` and its follower point's cam-frame kinematics, into `out` (J1 and J2 of length 4).
 fn contact_kinematics_0(q: &[f64], qd: &[f64], out: &mut rt::ContactKinematics) {
+    assert!(q.len() >= 4);
+    assert!(qd.len() >= 4);
+    assert!(out.j1.len() >= 4);
+    assert!(out.j2.len() >= 4);
     let q1 = q[0];
     let q2 = q[1];
     let q3 = q[2];

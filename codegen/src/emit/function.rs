@@ -3,6 +3,7 @@
 //! many zeros cleared with one `fill`).
 
 use super::emitter::Emitter;
+use super::lengths;
 use super::names::{Names, is_identifier};
 use super::parts;
 use super::spec::{FIELD, FIELDS, FunctionSpec, RETURN};
@@ -178,6 +179,8 @@ fn emit_with(
     code.push_str(prelude);
     code.push_str(&bindings);
     code.push_str(&after);
+    let slices: Vec<(&str, &str)> = spec.params.iter().map(|p| (p.name, p.ty)).collect();
+    code.insert_str(0, &lengths::length_check(&code, &slices));
     let params: Vec<(String, &str, bool)> = spec
         .params
         .iter()
@@ -362,7 +365,12 @@ mod tests {
             .collect();
         assert_eq!(lines[0], "/// A test.");
         assert_eq!(lines[1], "fn f(q: &[f64], _qd: &[f64], out: &mut [f64]) {");
-        assert_eq!(&lines[2..4], ["let q1 = q[0];", "let q2 = q[1];"]);
+        // One length check for the slices read and written at constant indices.
+        assert_eq!(
+            &lines[2..4],
+            ["assert!(q.len() >= 2);", "assert!(out.len() >= 2);"]
+        );
+        assert_eq!(&lines[4..6], ["let q1 = q[0];", "let q2 = q[1];"]);
         assert_eq!(
             lines.iter().filter(|l| l.contains("q1 + q2")).count(),
             1,

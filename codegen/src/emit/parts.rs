@@ -83,7 +83,7 @@ fn identifiers(text: &str) -> Vec<String> {
 }
 
 /// The byte ranges of the words [`identifiers`] returns.
-fn words(text: &str) -> Vec<(usize, usize)> {
+pub(super) fn words(text: &str) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
     let bytes = text.as_bytes();
     let mut i = 0;
