@@ -700,10 +700,10 @@ pub fn sin_cos_memo(angle: f64, slot: &mut [f64]) -> (f64, f64) {
         if stored.to_bits() == angle.to_bits() && (*sin * *sin + *cos * *cos - 1.0).abs() < 1e-12 {
             return (*sin, *cos);
         }
-        let (s, c) = angle.sin_cos();
+        let (s, c) = crate::trig::sin_cos(angle);
         (*stored, *sin, *cos) = (angle, s, c);
         (s, c)
     } else {
-        angle.sin_cos()
+        crate::trig::sin_cos(angle)
     }
 }

@@ -79,6 +79,7 @@ pub mod spline;
 #[cfg(feature = "engine")]
 pub mod stepping;
 pub mod surface_spline;
+pub mod trig;
 #[cfg(feature = "engine")]
 pub mod unilateral;
 
