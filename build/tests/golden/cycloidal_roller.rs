@@ -20,7 +20,7 @@
 // | `energy` | 2 | 8 | 0 | 0 | 0 | 1 | 11 |
 // | `damper_power` | 0 | 1 | 0 | 0 | 0 | 1 | 2 |
 // | `position_terms` | 23 | 34 | 5 | 4 | 2 | 4 | 72 |
-// | `velocity_terms` | 51 | 73 | 5 | 0 | 0 | 2 | 131 |
+// | `velocity_terms` | 33 | 44 | 5 | 0 | 0 | 2 | 84 |
 // | `contact_kinematics_0` | 53 | 76 | 9 | 4 | 2 | 5 | 149 |
 // | `roller_parameter_residual` | 44 | 54 | 6 | 2 | 1 | 4 | 111 |
 // | `roller_parameter_objective` | 9 | 12 | 1 | 2 | 1 | 2 | 27 |
@@ -1105,7 +1105,7 @@ impl rt::Dynamics for Model {
         cache: &mut [f64],
     ) {
         assert!(q.len() >= 2);
-        assert!(cache.len() >= 17);
+        assert!(cache.len() >= 40);
         assert!(! h.is_empty());
         assert!(j.len() >= 2);
         let cam_angle = q[0];
@@ -1117,7 +1117,7 @@ impl rt::Dynamics for Model {
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
         let roller_parameter = rt::contact::solve(
             rt::contact::warm_or(
-                cache[6],
+                cache[8],
                 || rt::contact::pitch_parameter(
                     neg_roller_j2_cam_angle,
                     roller_j1_cam_angle,
@@ -1148,32 +1148,42 @@ impl rt::Dynamics for Model {
         let roller_law_at = eval_roller_law(-roller_parameter);
         let roller_law_d1 = roller_law_at[1];
         let roller_law = roller_law_at[0];
-        let cache_9_t1 = 0.052500000000000005 + roller_law;
-        let cache_10_t1 = (cache_9_t1 * cache_9_t1 + roller_law_d1 * roller_law_d1)
-            .sqrt();
-        let cache_13_t1 = 1.0 / cache_10_t1;
-        let roller_cx_t1 = roller_law_d1 * cache_13_t1;
+        let cache_19_t1 = 0.052500000000000005 + roller_law;
+        let roller_law_d1_sq = roller_law_d1 * roller_law_d1;
+        let cache_14_t1 = (cache_19_t1 * cache_19_t1 + roller_law_d1_sq).sqrt();
+        let cache_18_t1 = 1.0 / cache_14_t1;
+        let roller_cx_t1 = roller_law_d1 * cache_18_t1;
         let roller_cx_t2 = 0.0125 * roller_cx_t1;
         let roller_cx_t3 = c_roller_parameter * roller_cx_t2;
         let roller_cy_t1 = roller_cx_t2 * s_roller_parameter;
         let roller_law_d2 = roller_law_at[2];
-        let roller_dcx_t1 = 1.0 / (2.0 * cache_10_t1);
-        let roller_dcx_t2 = cache_13_t1 / cache_10_t1;
-        let roller_cy_t2 = cache_9_t1 * (1.0 - 0.0125 * cache_13_t1);
-        let roller_cx_t4 = s_roller_parameter * roller_cy_t2;
-        let roller_cx = roller_cx_t3 - roller_cx_t4;
-        let roller_dcx_t3 = roller_dcx_t2
-            * (roller_dcx_t1 * (roller_law_d1 * (2.0 * (cache_9_t1 + roller_law_d2))));
-        let roller_dcx_t4 = 0.0125
-            * (roller_law_d1 * roller_dcx_t3 - cache_13_t1 * roller_law_d2);
-        let roller_cy_t3 = c_roller_parameter * roller_cy_t2;
-        let roller_dcy_t1 = roller_law_d1
-            + 0.0125 * (cache_9_t1 * roller_dcx_t3 - roller_cx_t1);
-        let roller_dcx = c_roller_parameter * roller_dcx_t4 - roller_cy_t1
-            - (roller_cy_t3 - s_roller_parameter * roller_dcy_t1);
-        let roller_cy = roller_cy_t1 + roller_cy_t3;
-        let roller_dcy = roller_cx_t3 + s_roller_parameter * roller_dcx_t4
-            - (roller_cx_t4 + c_roller_parameter * roller_dcy_t1);
+        let cache_17_t1 = 2.0 * cache_14_t1;
+        let cache_21_t1 = 1.0 / cache_17_t1;
+        let cache_22_t1 = cache_18_t1 / cache_14_t1;
+        let cache_33_t1 = cache_19_t1 * (1.0 - 0.0125 * cache_18_t1);
+        let cache_33_t2 = s_roller_parameter * cache_33_t1;
+        let roller_cx = roller_cx_t3 - cache_33_t2;
+        let cache_20_t1 = 2.0 * (cache_19_t1 + roller_law_d2);
+        let cache_21_t2 = roller_law_d1 * cache_20_t1;
+        let cache_22_t2 = cache_21_t1 * cache_21_t2;
+        let cache_23_t1 = cache_22_t1 * cache_22_t2;
+        let cache_24_t1 = roller_law_d1 * cache_23_t1;
+        let cache_25_t1 = cache_24_t1 - cache_18_t1 * roller_law_d2;
+        let cache_25_t2 = 0.0125 * cache_25_t1;
+        let cache_26_t1 = c_roller_parameter * cache_25_t2;
+        let roller_dcx_t1 = cache_26_t1 - roller_cy_t1;
+        let cache_28_t1 = c_roller_parameter * cache_33_t1;
+        let cache_27_t1 = roller_law_d1
+            + 0.0125 * (cache_19_t1 * cache_23_t1 - roller_cx_t1);
+        let cache_28_t2 = s_roller_parameter * cache_27_t1;
+        let roller_dcx_t2 = cache_28_t1 - cache_28_t2;
+        let roller_dcx = roller_dcx_t1 - roller_dcx_t2;
+        let cache_31_t1 = s_roller_parameter * cache_25_t2;
+        let roller_dcy_t1 = roller_cx_t3 + cache_31_t1;
+        let cache_33_t3 = c_roller_parameter * cache_27_t1;
+        let roller_dcy_t2 = cache_33_t2 + cache_33_t3;
+        let roller_cy = roller_cy_t1 + cache_28_t1;
+        let roller_dcy = roller_dcy_t1 - roller_dcy_t2;
         let roller_offset_x = neg_roller_j2_cam_angle - roller_cx;
         let roller_offset_y = roller_j1_cam_angle - roller_cy;
         let speed_sq = roller_dcx * roller_dcx + roller_dcy * roller_dcy;
@@ -1184,17 +1194,40 @@ impl rt::Dynamics for Model {
         h[0] = roller_distance - 0.0125;
         j[0] = roller_j1_cam_angle * roller_ty + neg_roller_j2_cam_angle * roller_tx;
         j[1] = s_cam_angle * roller_ty - c_cam_angle * roller_tx;
-        cache[6] = roller_parameter;
-        cache[7] = roller_law_d1;
-        cache[8] = roller_law;
-        cache[9] = cache_10_t1;
-        cache[10] = cache_13_t1;
-        cache[11] = roller_law_d2;
-        cache[12] = roller_dcx_t1;
-        cache[13] = roller_dcx_t2;
-        cache[14] = roller_tx_t1;
-        cache[15] = roller_tx;
-        cache[16] = roller_ty;
+        cache[6] = roller_j1_cam_angle;
+        cache[7] = neg_roller_j2_cam_angle;
+        cache[8] = roller_parameter;
+        cache[9] = roller_law_d1;
+        cache[10] = roller_law;
+        cache[11] = cache_19_t1;
+        cache[12] = roller_law_d1_sq;
+        cache[13] = cache_14_t1;
+        cache[14] = cache_18_t1;
+        cache[15] = roller_law_d2;
+        cache[16] = cache_17_t1;
+        cache[17] = cache_21_t1;
+        cache[18] = cache_22_t1;
+        cache[19] = cache_20_t1;
+        cache[20] = cache_21_t2;
+        cache[21] = cache_22_t2;
+        cache[22] = cache_23_t1;
+        cache[23] = cache_24_t1;
+        cache[24] = cache_25_t1;
+        cache[25] = cache_26_t1;
+        cache[26] = roller_dcx_t1;
+        cache[27] = cache_28_t2;
+        cache[28] = roller_dcx_t2;
+        cache[29] = roller_dcx;
+        cache[30] = cache_31_t1;
+        cache[31] = roller_dcy_t1;
+        cache[32] = cache_33_t3;
+        cache[33] = roller_dcy_t2;
+        cache[34] = roller_dcy;
+        cache[35] = speed_sq;
+        cache[36] = roller_tx_t1;
+        cache[37] = roller_tx;
+        cache[38] = roller_ty;
+        cache[39] = roller_distance;
     }
     /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
@@ -1207,7 +1240,7 @@ impl rt::Dynamics for Model {
     ) {
         assert!(q.len() >= 2);
         assert!(qd.len() >= 2);
-        assert!(cache.len() >= 17);
+        assert!(cache.len() >= 40);
         assert!(out.mass.len() >= 4);
         assert!(out.inertial.len() >= 2);
         assert!(out.applied.len() >= 2);
@@ -1224,8 +1257,8 @@ impl rt::Dynamics for Model {
         let s_cam_angle = cache[1];
         let omega_camshaft_sq = cam_angle_dot * cam_angle_dot;
         // contact roller: the follower seen from the cam, h, J, c
-        let roller_j1_cam_angle = lift * c_cam_angle;
-        let neg_roller_j2_cam_angle = lift * s_cam_angle;
+        let roller_j1_cam_angle = cache[6];
+        let neg_roller_j2_cam_angle = cache[7];
         let roller_convective_x = 2.0 * (cam_angle_dot * lift_dot);
         let neg_roller_convective_y = lift * omega_camshaft_sq;
         let roller_conv1 = c_cam_angle * roller_convective_x
@@ -1233,78 +1266,65 @@ impl rt::Dynamics for Model {
         let neg_roller_conv2 = s_cam_angle * roller_convective_x
             + c_cam_angle * neg_roller_convective_y;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
-        let roller_ddcy_t1 = cache[6];
+        let roller_ddcy_t1 = cache[8];
         let c_roller_parameter = cache[5];
         let roller_law_at = eval_roller_law(-roller_ddcy_t1);
-        let roller_law_d1 = cache[7];
-        let roller_law = cache[8];
-        let roller_cy_t1 = 0.052500000000000005 + roller_law;
-        let roller_ddcy_t2 = cache[9];
-        let roller_cx_t1 = cache[10];
-        let roller_cx_t2 = roller_law_d1 * roller_cx_t1;
-        let roller_cx_t3 = 0.0125 * roller_cx_t2;
-        let roller_cx_t4 = c_roller_parameter * roller_cx_t3;
+        let roller_law_d1 = cache[9];
+        let roller_ddcy_t2 = cache[11];
+        let roller_law_d1_sq = cache[12];
+        let roller_ddcy_t3 = cache[13];
+        let roller_ddcy_t4 = cache[14];
         let s_roller_parameter = cache[4];
-        let roller_cy_t2 = roller_cx_t3 * s_roller_parameter;
-        let roller_law_d2 = cache[11];
-        let roller_dcx_t1 = cache[12];
-        let roller_dcx_t2 = cache[13];
+        let roller_law_d2 = cache[15];
+        let roller_ddcy_t5 = cache[16];
+        let roller_ddcy_t6 = cache[17];
+        let roller_ddcy_t7 = cache[18];
         let roller_law_d3 = roller_law_at[3];
-        let roller_cy_t3 = roller_cy_t1 * (1.0 - 0.0125 * roller_cx_t1);
-        let roller_cx_t5 = s_roller_parameter * roller_cy_t3;
-        let roller_cx = roller_cx_t4 - roller_cx_t5;
-        let roller_dcx_t3 = 2.0 * (roller_cy_t1 + roller_law_d2);
-        let roller_dcx_t4 = roller_law_d1 * roller_dcx_t3;
-        let roller_dcx_t5 = roller_dcx_t1 * roller_dcx_t4;
-        let roller_dcx_t6 = roller_dcx_t2 * roller_dcx_t5;
-        let roller_dcx_t7 = roller_law_d1 * roller_dcx_t6;
-        let roller_dcx_t8 = roller_dcx_t7 - roller_cx_t1 * roller_law_d2;
-        let roller_dcx_t9 = 0.0125 * roller_dcx_t8;
-        let roller_dcx_t10 = c_roller_parameter * roller_dcx_t9;
-        let roller_dcx_t11 = roller_dcx_t10 - roller_cy_t2;
-        let roller_cy_t4 = c_roller_parameter * roller_cy_t3;
-        let roller_dcy_t1 = roller_law_d1
-            + 0.0125 * (roller_cy_t1 * roller_dcx_t6 - roller_cx_t2);
-        let roller_ddcy_t3 = s_roller_parameter * roller_dcy_t1;
-        let roller_dcx = roller_dcx_t11 - (roller_cy_t4 - roller_ddcy_t3);
-        let roller_dcy_t2 = s_roller_parameter * roller_dcx_t9;
-        let roller_dcy_t3 = roller_cx_t4 + roller_dcy_t2;
-        let roller_ddcy_t4 = roller_dcx_t2
-            * (roller_dcx_t4
-                * (roller_dcx_t1 / (2.0 * roller_ddcy_t2) * (2.0 * roller_dcx_t5))
-                - roller_dcx_t1
-                    * (roller_law_d2 * roller_dcx_t3
-                        + 2.0
-                            * (roller_law_d1 * roller_law_d1
-                                + roller_law_d1 * roller_law_d3)))
-            + roller_dcx_t5
-                * (roller_dcx_t6 / roller_ddcy_t2
-                    + roller_dcx_t2 / roller_ddcy_t2 * roller_dcx_t5);
-        let roller_ddcy_t5 = 0.0125
-            * (roller_cx_t1 * roller_law_d3 + roller_law_d1 * roller_ddcy_t4)
-            - 0.025 * (roller_law_d2 * roller_dcx_t6);
-        let roller_dcy_t4 = c_roller_parameter * roller_dcy_t1;
-        let roller_dcy_t5 = roller_cx_t5 + roller_dcy_t4;
-        let roller_ddcy_t6 = 0.0125
-            * (roller_cy_t1 * roller_ddcy_t4 - roller_dcx_t7 - roller_dcx_t8)
+        let roller_ddcy_t8 = cache[19];
+        let roller_ddcy_t9 = cache[20];
+        let roller_ddcy_t10 = cache[21];
+        let roller_ddcy_t11 = cache[22];
+        let roller_ddcy_t12 = cache[23];
+        let roller_ddcy_t13 = cache[24];
+        let roller_ddcy_t14 = cache[25];
+        let roller_ddcy_t15 = cache[26];
+        let roller_ddcy_t16 = cache[27];
+        let roller_ddcy_t17 = cache[28];
+        let roller_dcx = cache[29];
+        let roller_ddcx_t1 = cache[30];
+        let roller_ddcx_t2 = cache[31];
+        let roller_ddcy_t18 = roller_ddcy_t7
+            * (roller_ddcy_t9
+                * (roller_ddcy_t6 / roller_ddcy_t5 * (2.0 * roller_ddcy_t10))
+                - roller_ddcy_t6
+                    * (roller_law_d2 * roller_ddcy_t8
+                        + 2.0 * (roller_law_d1_sq + roller_law_d1 * roller_law_d3)))
+            + roller_ddcy_t10
+                * (roller_ddcy_t11 / roller_ddcy_t3
+                    + roller_ddcy_t7 / roller_ddcy_t3 * roller_ddcy_t10);
+        let roller_ddcy_t19 = 0.0125
+            * (roller_ddcy_t4 * roller_law_d3 + roller_law_d1 * roller_ddcy_t18)
+            - 0.025 * (roller_law_d2 * roller_ddcy_t11);
+        let roller_ddcx_t3 = cache[32];
+        let roller_ddcx_t4 = cache[33];
+        let roller_ddcy_t20 = 0.0125
+            * (roller_ddcy_t2 * roller_ddcy_t18 - roller_ddcy_t12 - roller_ddcy_t13)
             - roller_law_d2;
-        let roller_ddcx = s_roller_parameter * roller_ddcy_t6
-            + (roller_dcy_t5 + (c_roller_parameter * roller_ddcy_t5 + roller_dcy_t4))
-            - roller_dcy_t2 - roller_dcy_t3;
-        let roller_cy = roller_cy_t2 + roller_cy_t4;
-        let roller_dcy = roller_dcy_t3 - roller_dcy_t5;
-        let roller_ddcy = roller_ddcy_t3
-            + (s_roller_parameter * roller_ddcy_t5 + (roller_dcx_t10 + roller_dcx_t11))
-            - (roller_cy_t4 - roller_ddcy_t3) - c_roller_parameter * roller_ddcy_t6;
-        let roller_offset_x = neg_roller_j2_cam_angle - roller_cx;
-        let roller_offset_y = roller_j1_cam_angle - roller_cy;
-        let speed_sq = roller_dcx * roller_dcx + roller_dcy * roller_dcy;
-        let neg_roller_kappa_t1 = cache[14];
-        let roller_tx = cache[15];
-        let roller_ty = cache[16];
+        let roller_ddcx = s_roller_parameter * roller_ddcy_t20
+            + (roller_ddcx_t4 + (c_roller_parameter * roller_ddcy_t19 + roller_ddcx_t3))
+            - roller_ddcx_t1 - roller_ddcx_t2;
+        let roller_dcy = cache[34];
+        let roller_ddcy = roller_ddcy_t16
+            + (s_roller_parameter * roller_ddcy_t19
+                + (roller_ddcy_t14 + roller_ddcy_t15)) - roller_ddcy_t17
+            - c_roller_parameter * roller_ddcy_t20;
+        let speed_sq = cache[35];
+        let neg_roller_kappa_t1 = cache[36];
+        let roller_tx = cache[37];
+        let roller_ty = cache[38];
         let neg_roller_kappa = (roller_dcx * roller_ddcy - roller_ddcx * roller_dcy)
             / (speed_sq * neg_roller_kappa_t1);
-        let roller_distance = roller_offset_x * roller_ty - roller_offset_y * roller_tx;
+        let roller_distance = cache[39];
         let roller_along = roller_x_rate * roller_tx
             + (lift_dot * c_cam_angle - cam_angle_dot * neg_roller_j2_cam_angle)
                 * roller_ty;
@@ -1326,7 +1346,7 @@ impl rt::Dynamics for Model {
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
     fn cache_len(&self) -> usize {
-        17
+        40
     }
     /// f1, f2, J1, J2 and the convective terms of contact `k` into `out` (unchanged for an unknown k).
     fn contact_kinematics_into(
@@ -1633,7 +1653,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("energy", [2, 8, 0, 0, 0, 1]),
     ("damper_power", [0, 1, 0, 0, 0, 1]),
     ("position_terms", [23, 34, 5, 4, 2, 4]),
-    ("velocity_terms", [51, 73, 5, 0, 0, 2]),
+    ("velocity_terms", [33, 44, 5, 0, 0, 2]),
     ("contact_kinematics_0", [53, 76, 9, 4, 2, 5]),
     ("roller_parameter_residual", [44, 54, 6, 2, 1, 4]),
     ("roller_parameter_objective", [9, 12, 1, 2, 1, 2]),

@@ -22,7 +22,7 @@
 // | `loop_points` | 4 | 6 | 0 | 6 | 0 | 0 | 16 |
 // | `damper_power` | 0 | 0 | 0 | 0 | 0 | 0 | 0 |
 // | `position_terms` | 8 | 6 | 0 | 6 | 0 | 0 | 20 |
-// | `velocity_terms` | 13 | 35 | 0 | 0 | 0 | 0 | 48 |
+// | `velocity_terms` | 13 | 29 | 0 | 0 | 0 | 0 | 42 |
 // | `derive` | 8 | 22 | 0 | 0 | 0 | 0 | 30 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
@@ -1270,6 +1270,7 @@ impl rt::Dynamics for Model {
         assert!(q.len() >= 3);
         assert!(h.len() >= 2);
         assert!(j.len() >= 6);
+        assert!(cache.len() >= 15);
         let q_crank = q[0];
         let q_coupler = q[1];
         let q_rocker = q[2];
@@ -1308,6 +1309,12 @@ impl rt::Dynamics for Model {
         j[3] = loop_pin_a_arm_q_crank_x;
         j[4] = loop_pin_a_segment_q_coupler_x;
         j[5] = -loop_pin_b_segment_q_rocker_x;
+        cache[9] = pos_coupler_x;
+        cache[10] = pos_coupler_y;
+        cache[11] = loop_pin_a_segment_q_coupler_x;
+        cache[12] = loop_pin_a_segment_q_coupler_y;
+        cache[13] = loop_pin_b_segment_q_rocker_x;
+        cache[14] = loop_pin_b_segment_q_rocker_y;
     }
     /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
@@ -1319,7 +1326,7 @@ impl rt::Dynamics for Model {
         out: rt::VelocityTerms<'_>,
     ) {
         assert!(qd.len() >= 3);
-        assert!(cache.len() >= 9);
+        assert!(cache.len() >= 15);
         assert!(out.mass.len() >= 9);
         assert!(out.inertial.len() >= 3);
         assert!(out.applied.len() >= 3);
@@ -1329,8 +1336,6 @@ impl rt::Dynamics for Model {
         let q_rocker_dot = qd[2];
         // run-time parameters (values stored when they are set)
         let a = self.derived.a;
-        let b = self.derived.b;
-        let c_2 = self.derived.c;
         let g = self.derived.g;
         // crank: joint q_crank, rotation, velocities and accelerations
         let c_q_crank = cache[2];
@@ -1343,8 +1348,8 @@ impl rt::Dynamics for Model {
         let c_q_crank_q_coupler = cache[5];
         let s_q_crank_q_coupler = cache[4];
         let minus_g_coupler_y = g * c_q_crank_q_coupler;
-        let pos_coupler_x = a * c_q_crank;
-        let pos_coupler_y = a * s_q_crank;
+        let pos_coupler_x = cache[9];
+        let pos_coupler_y = cache[10];
         let omega_coupler_sq = omega_coupler_z * omega_coupler_z;
         let rel_rot_coupler_11 = c_q_crank * c_q_crank_q_coupler
             + s_q_crank * s_q_crank_q_coupler;
@@ -1353,20 +1358,19 @@ impl rt::Dynamics for Model {
         let acc_coupler_y = neg_centripetal_coupler_x * neg_rel_rot_coupler_12;
         // rocker: joint q_rocker, rotation, velocities and accelerations
         let c_q_rocker = cache[8];
-        let s_q_rocker = cache[7];
         let minus_g_rocker_y = g * c_q_rocker;
         let omega_rocker_sq = q_rocker_dot * q_rocker_dot;
         // loop pin: the cut revolute joint, h, J, c
-        let loop_pin_a_segment_q_coupler_x = b * c_q_crank_q_coupler;
-        let loop_pin_a_segment_q_coupler_y = b * s_q_crank_q_coupler;
+        let loop_pin_a_segment_q_coupler_x = cache[11];
+        let loop_pin_a_segment_q_coupler_y = cache[12];
         let neg_loop_pin_a_centripetal_q_coupler_x = omega_coupler_sq
             * loop_pin_a_segment_q_coupler_x;
         let neg_loop_pin_a_centripetal_q_coupler_y = omega_coupler_sq
             * loop_pin_a_segment_q_coupler_y;
         let neg_loop_pin_a_centripetal_q_crank_x = omega_crank_sq * pos_coupler_x;
         let neg_loop_pin_a_centripetal_q_crank_y = omega_crank_sq * pos_coupler_y;
-        let loop_pin_b_segment_q_rocker_x = c_2 * c_q_rocker;
-        let loop_pin_b_segment_q_rocker_y = c_2 * s_q_rocker;
+        let loop_pin_b_segment_q_rocker_x = cache[13];
+        let loop_pin_b_segment_q_rocker_y = cache[14];
         let neg_loop_pin_b_centripetal_q_rocker_x = omega_rocker_sq
             * loop_pin_b_segment_q_rocker_x;
         let neg_loop_pin_b_centripetal_q_rocker_y = omega_rocker_sq
@@ -1425,7 +1429,7 @@ impl rt::Dynamics for Model {
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
     fn cache_len(&self) -> usize {
-        9
+        15
     }
     /// No contact: nothing to write.
     fn contact_kinematics_into(
@@ -1454,6 +1458,6 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("loop_points", [4, 6, 0, 6, 0, 0]),
     ("damper_power", [0, 0, 0, 0, 0, 0]),
     ("position_terms", [8, 6, 0, 6, 0, 0]),
-    ("velocity_terms", [13, 35, 0, 0, 0, 0]),
+    ("velocity_terms", [13, 29, 0, 0, 0, 0]),
     ("derive", [8, 22, 0, 0, 0, 0]),
 ];

@@ -20,7 +20,7 @@
 // | `energy` | 30 | 35 | 0 | 7 | 0 | 3 | 75 |
 // | `damper_power` | 2 | 3 | 0 | 0 | 0 | 3 | 8 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
-// | `velocity_terms` | 68 | 83 | 0 | 0 | 0 | 1 | 152 |
+// | `velocity_terms` | 60 | 75 | 0 | 0 | 0 | 1 | 136 |
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 // | `derive` | 0 | 3 | 0 | 0 | 0 | 0 | 3 |
 //
@@ -1249,6 +1249,7 @@ impl rt::Dynamics for Model {
         assert!(q.len() >= 4);
         assert!(! h.is_empty());
         assert!(j.len() >= 4);
+        assert!(cache.len() >= 19);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -1284,6 +1285,16 @@ impl rt::Dynamics for Model {
         j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
         j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
+        cache[9] = step_body2_x;
+        cache[10] = step_body2_y;
+        cache[11] = a_segment_q4_x;
+        cache[12] = a_segment_q4_y;
+        cache[13] = a_segment_q2_x;
+        cache[14] = a_segment_q2_y;
+        cache[15] = a_arm_q2_y;
+        cache[16] = a_arm_q1_y;
+        cache[17] = a_x;
+        cache[18] = a_slope;
     }
     /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
@@ -1296,7 +1307,7 @@ impl rt::Dynamics for Model {
     ) {
         assert!(q.len() >= 4);
         assert!(qd.len() >= 4);
-        assert!(cache.len() >= 9);
+        assert!(cache.len() >= 19);
         assert!(out.mass.len() >= 16);
         assert!(out.inertial.len() >= 4);
         assert!(out.applied.len() >= 4);
@@ -1324,8 +1335,8 @@ impl rt::Dynamics for Model {
         let omega_body2_z = q1_dot + q2_dot;
         let c_q1_q2 = cache[5];
         let s_q1_q2 = cache[4];
-        let step_body2_x = 0.3 * c_q1;
-        let step_body2_y = 0.3 * s_q1;
+        let step_body2_x = cache[9];
+        let step_body2_y = cache[10];
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         let rel_rot_body2_11 = c_q1 * c_q1_q2 + s_q1 * s_q1_q2;
         let neg_rel_rot_body2_12 = c_q1 * s_q1_q2 - s_q1 * c_q1_q2;
@@ -1352,27 +1363,24 @@ impl rt::Dynamics for Model {
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
         let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
-        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
-        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q4_x = cache[11];
+        let a_segment_q4_y = cache[12];
         let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
         let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
-        let a_segment_q2_x_t1 = q3 + 0.4;
-        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
-        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_x = cache[13];
+        let a_segment_q2_y = cache[14];
         let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
         let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
-        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
-        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q2_y = cache[15];
         let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
         let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
         let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
             + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
         let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y
             - neg_a_centripetal_q2_y - neg_a_centripetal_q1_y;
-        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
-        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
-        let a_x = 0.38 + a_arm_q1_x;
-        let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
+        let a_arm_q1_y = cache[16];
+        let a_x = cache[17];
+        let a_slope = cache[18];
         let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
@@ -1460,7 +1468,7 @@ impl rt::Dynamics for Model {
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
     fn cache_len(&self) -> usize {
-        9
+        19
     }
     /// f1, f2, J1, J2 and the convective terms of contact `k` into `out` (unchanged for an unknown k).
     fn contact_kinematics_into(
@@ -1614,7 +1622,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("energy", [30, 35, 0, 7, 0, 3]),
     ("damper_power", [2, 3, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
-    ("velocity_terms", [68, 83, 0, 0, 0, 1]),
+    ("velocity_terms", [60, 75, 0, 0, 0, 1]),
     ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
     ("derive", [0, 3, 0, 0, 0, 0]),
 ];

@@ -20,8 +20,8 @@
 // | `energy` | 30 | 35 | 0 | 7 | 0 | 3 | 75 |
 // | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
-// | `velocity_terms` | 68 | 80 | 0 | 0 | 0 | 1 | 149 |
-// | `articulated_terms` | 100 | 124 | 3 | 0 | 0 | 1 | 228 |
+// | `velocity_terms` | 60 | 72 | 0 | 0 | 0 | 1 | 133 |
+// | `articulated_terms` | 92 | 116 | 3 | 0 | 0 | 1 | 212 |
 // | `articulated_response` | 24 | 31 | 0 | 0 | 0 | 0 | 55 |
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
@@ -858,6 +858,7 @@ impl rt::Dynamics for Model {
         assert!(q.len() >= 4);
         assert!(! h.is_empty());
         assert!(j.len() >= 4);
+        assert!(cache.len() >= 19);
         let q1 = q[0];
         let q2 = q[1];
         let q3 = q[2];
@@ -893,6 +894,16 @@ impl rt::Dynamics for Model {
         j[1] = a_arm_q2_x + a_arm_q2_y * a_slope;
         j[2] = s_q1_q2 - c_q1_q2 * a_slope;
         j[3] = a_segment_q4_x + a_segment_q4_y * a_slope;
+        cache[9] = step_body2_x;
+        cache[10] = step_body2_y;
+        cache[11] = a_segment_q4_x;
+        cache[12] = a_segment_q4_y;
+        cache[13] = a_segment_q2_x;
+        cache[14] = a_segment_q2_y;
+        cache[15] = a_arm_q2_y;
+        cache[16] = a_arm_q1_y;
+        cache[17] = a_x;
+        cache[18] = a_slope;
     }
     /// M, F, Q (13) and c (see `constraint_bias`) in one pass, reading `cache` as `position_terms` left it at the same q.
     fn velocity_terms(
@@ -905,7 +916,7 @@ impl rt::Dynamics for Model {
     ) {
         assert!(q.len() >= 4);
         assert!(qd.len() >= 4);
-        assert!(cache.len() >= 9);
+        assert!(cache.len() >= 19);
         assert!(out.mass.len() >= 16);
         assert!(out.inertial.len() >= 4);
         assert!(out.applied.len() >= 4);
@@ -926,8 +937,8 @@ impl rt::Dynamics for Model {
         let omega_body2_z = q1_dot + q2_dot;
         let c_q1_q2 = cache[5];
         let s_q1_q2 = cache[4];
-        let step_body2_x = 0.3 * c_q1;
-        let step_body2_y = 0.3 * s_q1;
+        let step_body2_x = cache[9];
+        let step_body2_y = cache[10];
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         let rel_rot_body2_11 = c_q1 * c_q1_q2 + s_q1 * s_q1_q2;
         let neg_rel_rot_body2_12 = c_q1 * s_q1_q2 - s_q1 * c_q1_q2;
@@ -954,27 +965,24 @@ impl rt::Dynamics for Model {
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
         let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
-        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
-        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q4_x = cache[11];
+        let a_segment_q4_y = cache[12];
         let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
         let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
-        let a_segment_q2_x_t1 = q3 + 0.4;
-        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
-        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_x = cache[13];
+        let a_segment_q2_y = cache[14];
         let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
         let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
-        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
-        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q2_y = cache[15];
         let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
         let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
         let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
             + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
         let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y
             - neg_a_centripetal_q2_y - neg_a_centripetal_q1_y;
-        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
-        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
-        let a_x = 0.38 + a_arm_q1_x;
-        let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
+        let a_arm_q1_y = cache[16];
+        let a_x = cache[17];
+        let a_slope = cache[18];
         let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
@@ -1062,7 +1070,7 @@ impl rt::Dynamics for Model {
     }
     /// Entries of the cache `position_terms` fills for `velocity_terms`.
     fn cache_len(&self) -> usize {
-        9
+        19
     }
     /// The articulated-body sweeps (docs/method.md §14): q̈ of the free coordinates without constraint forces (the driven ones' q̈ read from `out.qdd`), the driven coordinates' rows of M q̈ + F + Q, c, and the factors the response reads.
     fn articulated_terms(
@@ -1075,7 +1083,7 @@ impl rt::Dynamics for Model {
     ) {
         assert!(q.len() >= 4);
         assert!(qd.len() >= 4);
-        assert!(cache.len() >= 9);
+        assert!(cache.len() >= 19);
         assert!(out.qdd.len() >= 4);
         assert!(! out.bias.is_empty());
         assert!(out.factors.len() >= 18);
@@ -1097,8 +1105,8 @@ impl rt::Dynamics for Model {
         let s_q1_q2 = cache[4];
         let minus_g_body2_x = 9.81 * s_q1_q2;
         let minus_g_body2_y = 9.81 * c_q1_q2;
-        let step_body2_x = 0.3 * c_q1;
-        let step_body2_y = 0.3 * s_q1;
+        let step_body2_x = cache[9];
+        let step_body2_y = cache[10];
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         let rel_rot_body2_11 = c_q1 * c_q1_q2 + s_q1 * s_q1_q2;
         let neg_rel_rot_body2_12 = c_q1 * s_q1_q2 - s_q1 * c_q1_q2;
@@ -1129,27 +1137,24 @@ impl rt::Dynamics for Model {
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
         let a_coriolis_y = c_q1_q2 * neg_a_coriolis_x_t1;
-        let a_segment_q4_x = 0.3 * c_q4_q1_q2;
-        let a_segment_q4_y = 0.3 * s_q4_q1_q2;
+        let a_segment_q4_x = cache[11];
+        let a_segment_q4_y = cache[12];
         let neg_a_centripetal_q4_x = omega_body4_sq * a_segment_q4_x;
         let neg_a_centripetal_q4_y = omega_body4_sq * a_segment_q4_y;
-        let a_segment_q2_x_t1 = q3 + 0.4;
-        let a_segment_q2_x = c_q1_q2 * a_segment_q2_x_t1;
-        let a_segment_q2_y = s_q1_q2 * a_segment_q2_x_t1;
+        let a_segment_q2_x = cache[13];
+        let a_segment_q2_y = cache[14];
         let neg_a_centripetal_q2_x = omega_body2_sq * a_segment_q2_x;
         let neg_a_centripetal_q2_y = omega_body2_sq * a_segment_q2_y;
-        let a_arm_q2_x = a_segment_q4_x + a_segment_q2_x;
-        let a_arm_q2_y = a_segment_q4_y + a_segment_q2_y;
+        let a_arm_q2_y = cache[15];
         let neg_a_centripetal_q1_x = omega_body1_sq * step_body2_x;
         let neg_a_centripetal_q1_y = omega_body1_sq * step_body2_y;
         let neg_a_convective_x = neg_a_coriolis_x + neg_a_centripetal_q4_x
             + neg_a_centripetal_q2_x + neg_a_centripetal_q1_x;
         let a_convective_y = a_coriolis_y - neg_a_centripetal_q4_y
             - neg_a_centripetal_q2_y - neg_a_centripetal_q1_y;
-        let a_arm_q1_x = step_body2_x + a_arm_q2_x;
-        let a_arm_q1_y = step_body2_y + a_arm_q2_y;
-        let a_x = 0.38 + a_arm_q1_x;
-        let a_slope = a_x * (1.0 + 1.5 * a_x) - 0.595;
+        let a_arm_q1_y = cache[16];
+        let a_x = cache[17];
+        let a_slope = cache[18];
         let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
@@ -1505,8 +1510,8 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("energy", [30, 35, 0, 7, 0, 3]),
     ("damper_power", [2, 0, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
-    ("velocity_terms", [68, 80, 0, 0, 0, 1]),
-    ("articulated_terms", [100, 124, 3, 0, 0, 1]),
+    ("velocity_terms", [60, 72, 0, 0, 0, 1]),
+    ("articulated_terms", [92, 116, 3, 0, 0, 1]),
     ("articulated_response", [24, 31, 0, 0, 0, 0]),
     ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
 ];

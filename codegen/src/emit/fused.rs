@@ -83,19 +83,24 @@ impl FusedTerms {
         let in_position = g.reachable(&roots(&position));
         let in_velocity =
             g.reachable(&[roots(&velocity), roots(&articulated), roots(&mass)].concat());
+        let velocity_roots = [roots(&velocity), roots(&articulated), roots(&mass)].concat();
+        let frontier = shared_frontier(g, &in_position, &in_velocity, &velocity_roots);
         let cached = (0..g.len())
             .filter(|&i| in_position[i] && in_velocity[i])
-            .map(|i| id_at(g, i))
-            .filter(|&id| {
-                matches!(
-                    g.node(id),
-                    Node::Call(..)
-                        | Node::Powf(..)
-                        | Node::Div(..)
-                        | Node::Table(..)
-                        | Node::Grid(..)
-                ) || g.implicit_of(id).is_some()
+            .filter(|&i| {
+                let id = id_at(g, i);
+                frontier[i]
+                    || matches!(
+                        g.node(id),
+                        Node::Call(..)
+                            | Node::Powf(..)
+                            | Node::Div(..)
+                            | Node::Table(..)
+                            | Node::Grid(..)
+                    )
+                    || g.implicit_of(id).is_some()
             })
+            .map(|i| id_at(g, i))
             .collect();
         let memo = trig_pairs(g, &in_position, &d.symbols.params);
         FusedTerms {
@@ -199,6 +204,39 @@ impl FusedTerms {
     }
 }
 
+/// The values both levels compute that the velocity level reads directly: each operation
+/// node the position level computes that is a velocity-level output or an operand of a
+/// velocity-level node the position level does not compute (through negations, which cost
+/// nothing). Read from the cache, they leave everything beneath them to the position level:
+/// a long chain's tip rotation, its contact point and the cam's profile there are computed
+/// once per right-hand side instead of twice.
+fn shared_frontier(
+    g: &crate::expr::Graph,
+    in_position: &[bool],
+    in_velocity: &[bool],
+    velocity_roots: &[Id],
+) -> Vec<bool> {
+    let shared = |id: Id| in_position[id.index()] && in_velocity[id.index()];
+    let mut frontier = vec![false; g.len()];
+    let mut mark = |mut id: Id| {
+        while let Node::Neg(a) = g.node(id) {
+            id = a;
+        }
+        if shared(id) && matches!(g.node(id), Node::Add(..) | Node::Mul(..) | Node::Powi(..)) {
+            frontier[id.index()] = true;
+        }
+    };
+    for &root in velocity_roots {
+        mark(root);
+    }
+    for i in (0..g.len()).filter(|&i| in_velocity[i] && !in_position[i]) {
+        for c in g.children(id_at(g, i)) {
+            mark(c);
+        }
+    }
+    frontier
+}
+
 /// Operation count of a function's outputs (what it computes when emitted on its own), the
 /// nodes of `given` read rather than computed.
 pub(super) fn function_count(
@@ -256,6 +294,41 @@ mod tests {
         assert_eq!(specs[0].0.name, "position_terms");
         assert_eq!(specs[1].0.name, "velocity_terms");
         assert!(!specs[0].0.params.iter().any(|p| p.always_used));
+    }
+
+    #[test]
+    fn the_velocity_level_computes_nothing_the_position_level_computes() {
+        // Every operation of both levels is read from the cache by the second: with the
+        // cached nodes given, what the velocity level still computes is disjoint from the
+        // position level but for constants, variables and negations (which cost nothing).
+        for name in ["paper_concave", "cycloidal_roller", "four_bar"] {
+            let (_, mut d) = derived(name);
+            let fused = FusedTerms::new(&mut d, None);
+            let g = &d.graph;
+            let position: Vec<Id> = fused.position.iter().map(|o| o.1).collect();
+            let velocity: Vec<Id> = fused.velocity.iter().map(|o| o.1).collect();
+            let given: HashSet<Id> = fused.cache_given().iter().map(|(id, _)| *id).collect();
+            let in_position = g.reachable(&position);
+            let computed = g.reachable_until(&velocity, &given);
+            let recomputed: Vec<usize> = (0..g.len())
+                .filter(|&i| computed[i] && in_position[i])
+                .filter(|&i| !given.contains(&id_at(g, i)))
+                .filter(|&i| {
+                    !matches!(
+                        g.node(id_at(g, i)),
+                        Node::Const(_) | Node::Var(_) | Node::Neg(_)
+                    )
+                })
+                .collect();
+            assert!(
+                recomputed.is_empty(),
+                "{name}: {} nodes computed twice",
+                recomputed.len()
+            );
+            // And the cache does hold sums and products, not only function values.
+            let arithmetic = |id: &Id| matches!(g.node(*id), Node::Add(..) | Node::Mul(..));
+            assert!(fused.cached.iter().any(arithmetic), "{name}");
+        }
     }
 
     #[test]
