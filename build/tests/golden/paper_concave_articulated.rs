@@ -21,12 +21,12 @@
 // | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
 // | `velocity_terms` | 60 | 72 | 0 | 0 | 0 | 1 | 133 |
-// | `articulated_terms` | 92 | 116 | 3 | 0 | 0 | 1 | 212 |
+// | `articulated_terms` | 94 | 111 | 3 | 0 | 0 | 1 | 209 |
 // | `articulated_response` | 24 | 31 | 0 | 0 | 0 | 0 | 55 |
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
 // Forward dynamics: the articulated-body sweeps (as asked). Estimated operations per right-hand side:
-// dense 238, articulated 459 (the position level, common to both, not included).
+// dense 238, articulated 456 (the position level, common to both, not included).
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -1173,15 +1173,13 @@ impl rt::Dynamics for Model {
         let neg_qdd_q3_t2 = neg_qdd_q4_t1 - 1.2244897959183674 * neg_qdd_q4_t3;
         // body3: articulated inertia and bias force (joint q3)
         let neg_qdd_q1_t1 = minus_g_body2_y + acc_body3_y;
-        let articulated_d_q3_t1 = 0.8163265306122449 * neg_rel_rot_body4_12;
-        let factors_6_t1 = rel_rot_body4_11 * neg_rel_rot_body4_12
-            - rel_rot_body4_11 * articulated_d_q3_t1;
-        let factors_12_t1 = neg_rel_rot_body4_12 * neg_rel_rot_body4_12
-            + rel_rot_body4_11 * (0.8163265306122449 * rel_rot_body4_11);
-        let factors_9_t1 = 0.3 * factors_6_t1;
-        let articulated_d_q3 = 1.0
-            + (rel_rot_body4_11 * rel_rot_body4_11
-                + neg_rel_rot_body4_12 * articulated_d_q3_t1);
+        let factors_5_t1 = rel_rot_body4_11 * neg_rel_rot_body4_12;
+        let articulated_d_q3_t1 = 0.18367346938775508
+            * (0.5 - neg_rel_rot_body4_12 * neg_rel_rot_body4_12);
+        let factors_11_t1 = 0.18367346938775508 * factors_5_t1;
+        let factors_12_t1 = 0.9081632653061225 - articulated_d_q3_t1;
+        let factors_9_t1 = 0.055102040816326525 * factors_5_t1;
+        let articulated_d_q3 = 1.9081632653061225 + articulated_d_q3_t1;
         let neg_qdd_q1_t2 = neg_rel_rot_body4_12 * neg_qdd_q3_t1
             + rel_rot_body4_11 * neg_qdd_q3_t2;
         let neg_qdd_q3_t3 = minus_g_body2_x - neg_acc_body3_x
@@ -1191,8 +1189,9 @@ impl rt::Dynamics for Model {
         let neg_qdd_q3_t4 = q3_dot + 40.0 * q3 + neg_qdd_q3_t3;
         let articulated_d_q2_t1 = factors_9_t1 * factors_9_t2;
         let neg_qdd_q1_t3 = articulated_d_q3 * factors_9_t2;
-        let factors_12_t2 = factors_6_t1 * factors_9_t2;
-        let factors_12_t3 = 1.0 + factors_12_t1 - factors_6_t1 * factors_12_t2;
+        let factors_12_t2 = factors_11_t1 * factors_9_t2;
+        let factors_12_t3 = 1.9081632653061225 - articulated_d_q3_t1
+            - factors_11_t1 * factors_12_t2;
         let factors_12_t4 = 0.15 + 0.3 * factors_12_t1 - factors_9_t1 * factors_12_t2;
         let neg_qdd_q1_t4 = neg_qdd_q1_t1 + neg_qdd_q1_t2
             - neg_qdd_q3_t4 * factors_12_t2;
@@ -1212,14 +1211,14 @@ impl rt::Dynamics for Model {
         let qdd_q2_t1 = q2_dot + 15.0 * q2 + neg_qdd_q1_t6;
         let neg_qdd_q1_t7 = articulated_d_q2 * factors_15_t1;
         let articulated_d_q1_t1 = factors_16_t1 * factors_15_t1;
+        let articulated_d_q1_t2 = 0.5 + factors_12_t3
+            - factors_16_t1 * articulated_d_q1_t1;
         // body1: articulated inertia and bias force (joint q1)
         let articulated_d_q1 = 0.1225
             + 0.09
-                * (neg_rel_rot_body2_12 * (0.5 * neg_rel_rot_body2_12)
-                    + rel_rot_body2_11
-                        * (rel_rot_body2_11
-                            * (0.5 + factors_12_t3
-                                - factors_16_t1 * articulated_d_q1_t1)));
+                * (0.5 * (0.5 + articulated_d_q1_t2)
+                    - (0.5 - neg_rel_rot_body2_12 * neg_rel_rot_body2_12)
+                        * (0.5 - articulated_d_q1_t2));
         let neg_qdd_q1_t8 = 1.0 / articulated_d_q1;
         // body1: acceleration of joint q1 (forward sweep)
         let neg_qdd_q1 = (1.4715 * c_q1
@@ -1244,7 +1243,7 @@ impl rt::Dynamics for Model {
         let neg_qdd_q3 = factors_9_t2
             * (neg_qdd_q3_t4
                 + (factors_9_t1 * neg_qdd_q3_t6
-                    + (factors_6_t1 * neg_qdd_q3_t7
+                    + (factors_11_t1 * neg_qdd_q3_t7
                         - articulated_d_q3 * neg_qdd_q3_t5)));
         // body4: acceleration of joint q4 (forward sweep)
         let neg_qdd_q4 = 8.16326530612245
@@ -1265,7 +1264,7 @@ impl rt::Dynamics for Model {
         out.factors[2] = neg_rel_rot_body2_12;
         out.factors[3] = rel_rot_body4_11;
         out.factors[4] = neg_rel_rot_body4_12;
-        out.factors[5] = factors_6_t1;
+        out.factors[5] = factors_11_t1;
         out.factors[6] = factors_9_t1;
         out.factors[7] = articulated_d_q3;
         out.factors[8] = factors_9_t2;
@@ -1511,7 +1510,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("damper_power", [2, 0, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
     ("velocity_terms", [60, 72, 0, 0, 0, 1]),
-    ("articulated_terms", [92, 116, 3, 0, 0, 1]),
+    ("articulated_terms", [94, 111, 3, 0, 0, 1]),
     ("articulated_response", [24, 31, 0, 0, 0, 0]),
     ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
 ];

@@ -167,3 +167,59 @@ fn the_mass_product_is_m_times_x() {
         }
     }
 }
+
+#[test]
+fn a_turn_about_a_coordinate_axis_by_the_double_angle_is_r_m_rt() {
+    use crate::expr::Graph;
+    use crate::kinematics::Rotation;
+    let phi = 0.7;
+    for k in 0..3 {
+        for sign in [1.0, -1.0] {
+            let mut g = Graph::new();
+            let angle = g.var("phi");
+            let mut axis = [0.0; 3];
+            axis[k] = sign;
+            let r = Rotation::Axis { axis, angle }.matrix(&mut g);
+            let (turned, c, s) = super::plane_rotation(&mut g, &r).expect("a coordinate axis");
+            assert_eq!(turned, k);
+            for symmetric in [false, true] {
+                let value = |a: usize, b: usize| {
+                    let (a, b) = if symmetric {
+                        (a.min(b), a.max(b))
+                    } else {
+                        (a, b)
+                    };
+                    number(7, 3 * a + b)
+                };
+                let m = [0, 1, 2].map(|a| [0, 1, 2].map(|b| g.constant(value(a, b))));
+                let out = super::rotate_in_plane(&mut g, &m, k, (c, s), symmetric);
+                let roots: Vec<Id> = out
+                    .iter()
+                    .flatten()
+                    .chain(r.iter().flatten())
+                    .copied()
+                    .collect();
+                let values = g.eval(&roots, &[phi]);
+                let got = DMatrix::from_row_slice(3, 3, &values[..9]);
+                let rot = DMatrix::from_row_slice(3, 3, &values[9..]);
+                let m = DMatrix::from_fn(3, 3, value);
+                let want = &rot * m * rot.transpose();
+                // Both are sums of a few products of numbers below 1: round-off ~1e-16.
+                assert!(
+                    (got - &want).amax() < 1e-14,
+                    "axis {k}, sign {sign}, {symmetric}"
+                );
+            }
+        }
+    }
+    // A skew axis is not a turn in a coordinate plane.
+    let mut g = Graph::new();
+    let angle = g.var("phi");
+    let a = std::f64::consts::FRAC_1_SQRT_2;
+    let r = Rotation::Axis {
+        axis: [a, a, 0.0],
+        angle,
+    }
+    .matrix(&mut g);
+    assert!(super::plane_rotation(&mut g, &r).is_none());
+}
