@@ -74,6 +74,16 @@ fn exponent(x: f64) -> i64 {
     ((x.to_bits() >> 52) & 0x7ff) as i64
 }
 
+/// One more round of the reduction of `e_rem_pio2.c`: r − f·part with the rounding error
+/// carried in w, for the next part of π/2 and its tail; returns (r, w, r − w).
+#[inline(always)]
+fn next_round(f: f64, t: f64, part: f64, tail: f64) -> (f64, f64, f64) {
+    let w = f * part;
+    let r = t - w;
+    let w = f * tail - ((t - r) - w);
+    (r, w, r - w)
+}
+
 /// (sin x, cos x).
 #[inline]
 pub fn sin_cos(x: f64) -> (f64, f64) {
@@ -93,18 +103,10 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let j = exponent(x);
     if j - exponent(y0) > 16 {
         // Cancellation: a second round, good to 118 bits.
-        let t = r;
-        w = f * PIO2_2;
-        r = t - w;
-        w = f * PIO2_2T - ((t - r) - w);
-        y0 = r - w;
+        (r, w, y0) = next_round(f, r, PIO2_2, PIO2_2T);
         if j - exponent(y0) > 49 {
             // A third, good to 151 bits: every double up to the bound.
-            let t = r;
-            w = f * PIO2_3;
-            r = t - w;
-            w = f * PIO2_3T - ((t - r) - w);
-            y0 = r - w;
+            (r, w, y0) = next_round(f, r, PIO2_3, PIO2_3T);
         }
     }
     let y1 = (r - y0) - w;
