@@ -81,9 +81,8 @@ impl FusedTerms {
         let mass = response.split_off(lengths[1]);
         let g = &d.graph;
         let in_position = g.reachable(&roots(&position));
-        let in_velocity =
-            g.reachable(&[roots(&velocity), roots(&articulated), roots(&mass)].concat());
         let velocity_roots = [roots(&velocity), roots(&articulated), roots(&mass)].concat();
+        let in_velocity = g.reachable(&velocity_roots);
         let frontier = shared_frontier(g, &in_position, &in_velocity, &velocity_roots);
         let cached = (0..g.len())
             .filter(|&i| in_position[i] && in_velocity[i])
