@@ -211,7 +211,7 @@ fn write_crate(
 
 /// The measuring program: both modules' models, the same states, batches interleaved.
 const TIMING: &str = r#"
-use camchain_runtime::{Dynamics, Simulate, State, VelocityTerms, ArticulatedTerms};
+use camchain_runtime::{Dynamics, Simulate, State, VelocityTerms, ArticulatedTerms, SolvedRow};
 use std::hint::black_box;
 
 fn states(model: &dyn Simulate) -> Vec<State> {
@@ -337,7 +337,7 @@ fn free_articulated<'a>(model: &'a dyn Dynamics, states: &'a [State]) -> impl Fn
         let s = &states[k % states.len()];
         k += 1;
         model.position_terms(&s.q, &mut h, &mut j, &mut cache);
-        let out = ArticulatedTerms { qdd: &mut qdd, drive: &mut drive, bias: &mut c, factors: &mut factors };
+        let out = ArticulatedTerms { qdd: &mut qdd, drive: &mut drive, bias: &mut c, factors: &mut factors, row: &[], solved: &mut SolvedRow::default() };
         model.articulated_terms(s.t, &s.q, &s.qd, &cache, out);
         black_box(&qdd);
     }

@@ -64,6 +64,18 @@ pub struct ArticulatedTerms {
     pub mass_x: Vec<Id>,
     /// M(q) x, one entry per coordinate.
     pub mass_product: Vec<Id>,
+    /// A model with one constraint row solves it within the sweeps (docs/method.md §14.6):
+    /// that row of J, one variable per coordinate, given at run time (empty for other
+    /// models).
+    pub row: Vec<Id>,
+    /// 1 when the row is given and solved, 0 when not (q̈ then without its force): a variable.
+    pub row_weight: Option<Id>,
+    /// (λ, J_f M_ff⁻¹ J_fᵀ) of the row.
+    pub row_solution: Option<(Id, Id)>,
+    /// (coordinate, q̈): every free coordinate's acceleration with the row's force.
+    pub solved_accelerations: Vec<(usize, Id)>,
+    /// (coordinate, load): every driven coordinate's row of M q̈ + F + Q + Jᵀ λ.
+    pub solved_drive_loads: Vec<(usize, Id)>,
 }
 
 impl ArticulatedTerms {
@@ -75,8 +87,11 @@ impl ArticulatedTerms {
             .chain(&mut self.drive_loads)
             .chain(&mut self.response)
             .chain(&mut self.response_loads)
+            .chain(&mut self.solved_accelerations)
+            .chain(&mut self.solved_drive_loads)
             .map(|(_, id)| id);
-        pairs.chain(&mut self.mass_product)
+        let solution = self.row_solution.iter_mut().flat_map(|(l, d)| [l, d]);
+        pairs.chain(&mut self.mass_product).chain(solution)
     }
 }
 
@@ -116,12 +131,15 @@ struct Joint {
     bias: Force,
 }
 
-/// Derives the articulated-body terms of `model` on its kinematics.
+/// Derives the articulated-body terms of `model` on its kinematics; with `row_bias`, the c of
+/// the model's one constraint row, that row solved within the sweeps as well
+/// (docs/method.md §14.6).
 pub fn articulated(
     g: &mut Graph,
     model: &Model,
     s: &Symbols,
     kin: &[BodyKinematics],
+    row_bias: Option<Id>,
 ) -> ArticulatedTerms {
     let n = model.n();
     // Nodes the other terms already hold keep their names (the dense code is unchanged).
@@ -222,49 +240,101 @@ pub fn articulated(
         ..Default::default()
     };
     // Forward sweep of the main solve.
-    let mut motion: Vec<Option<Motion>> = vec![None; n];
-    for i in 0..n {
-        let Some(joint) = joints[i] else { break };
-        g.set_section(format!(
+    let main_section = |i: usize| {
+        format!(
             "{}: acceleration of joint {} (forward sweep)",
             model.bodies[i].name, names[i]
-        ));
-        let before = incoming(g, model, kin, &motion, i);
-        let (qdd, after) = joint_acceleration(g, model, kin, i, &joint, before);
-        match joint.d_inverse {
+        )
+    };
+    forward_of(
+        g,
+        model,
+        kin,
+        &joints,
+        main_section,
+        |g, i, joint, qdd, after| match joint.d_inverse {
             Some(_) => {
                 name(g, qdd, format!("qdd_{}", names[i]));
                 out.accelerations.push((i, qdd));
             }
             None => {
-                let rows = transmitted(g, model, kin, i, &joint, after);
+                let rows = transmitted(g, model, kin, i, joint, after);
                 let passive = passive_load(g, model, s, i);
                 let load = g.add(rows, passive);
                 name(g, load, format!("drive_load_{}", names[i]));
                 out.drive_loads.push((i, load));
             }
-        }
-        motion[i] = Some(after);
-    }
+        },
+    );
     // The response: the same sweeps with τ and nothing else.
-    let mut responses: Vec<Option<Force>> = vec![None; n];
+    let section = "response to a generalised force";
+    let (rates, passing) = backward_of(g, model, kin, &joints, &tau, section);
+    let response_joints: Vec<Option<Joint>> = (0..n)
+        .map(|i| {
+            let joint = joints[i]?;
+            let zero = g.zero();
+            Some(Joint {
+                rate: rates[i].unwrap_or(zero),
+                bias: passing[i]?,
+                ..joint
+            })
+        })
+        .collect();
+    let response_section =
+        |i: usize| format!("{}: {section} (forward sweep)", model.bodies[i].name);
+    forward_of(
+        g,
+        model,
+        kin,
+        &response_joints,
+        response_section,
+        |g, i, joint, qdd, after| match joint.d_inverse {
+            Some(_) => out.response.push((i, qdd)),
+            None => {
+                let rows = transmitted(g, model, kin, i, joint, after);
+                out.response_loads.push((i, rows));
+            }
+        },
+    );
+    if let Some(c) = row_bias {
+        row::solve_within(g, model, s, kin, &joints, c, &mut out);
+    }
+    (out.mass_x, out.mass_product) = mass_product(g, model, s, kin, &names);
+    out
+}
+
+/// The backward sweep of a generalised force `tau` alone (every velocity, weight, load and
+/// prescribed acceleration zero) on the factors of `joints`: each free joint's rate
+/// u = τ − Sᵀ p and each joint's p before its own (the bias its driven rows read).
+fn backward_of(
+    g: &mut Graph,
+    model: &Model,
+    kin: &[BodyKinematics],
+    joints: &[Option<Joint>],
+    tau: &[Id],
+    section: &str,
+) -> (Vec<Option<Id>>, Vec<Option<Force>>) {
+    let n = joints.len();
+    let kids = children(model);
+    let mut passed: Vec<Option<Force>> = vec![None; n];
     let mut rates: Vec<Option<Id>> = vec![None; n];
+    let mut before: Vec<Option<Force>> = vec![None; n];
     for i in (0..n).rev() {
         let Some(joint) = joints[i] else { break };
         g.set_section(format!(
-            "{}: response to a generalised force (backward sweep)",
+            "{}: {section} (backward sweep)",
             model.bodies[i].name
         ));
         let zero = vec3::zero(g);
         let mut bias = Force { n: zero, f: zero };
         for &c in &kids[i] {
-            if let Some(pc) = responses[c].take() {
+            if let Some(pc) = passed[c].take() {
                 let (n_p, f_p) = force_to_parent(g, &kin[c], pc.n, pc.f);
                 bias = add_force(g, bias, Force { n: n_p, f: f_p });
             }
         }
         let kind = model.bodies[i].joint.kind;
-        let passed = match joint.d_inverse {
+        passed[i] = Some(match joint.d_inverse {
             Some(d_inverse) => {
                 let sp = project(g, kind, kin[i].axis, bias);
                 let rate = g.sub(tau[i], sp);
@@ -274,36 +344,31 @@ pub fn articulated(
                 add_force(g, bias, pushed)
             }
             None => bias,
-        };
-        responses[i] = Some(passed);
-        // Kept for the driven rows of the forward sweep.
-        joints[i] = Some(Joint { bias, ..joint });
+        });
+        before[i] = Some(bias);
     }
-    let mut motion: Vec<Option<Motion>> = vec![None; n];
-    for i in 0..n {
-        let Some(joint) = joints[i] else { break };
-        g.set_section(format!(
-            "{}: response to a generalised force (forward sweep)",
-            model.bodies[i].name
-        ));
+    (rates, before)
+}
+
+/// The forward sweep (root to tip) on `joints`' rates, factors and driven accelerations:
+/// `visit(g, i, joint, q̈_i, δa_i)` for every joint in turn, in the section `section(i)`.
+fn forward_of(
+    g: &mut Graph,
+    model: &Model,
+    kin: &[BodyKinematics],
+    joints: &[Option<Joint>],
+    section: impl Fn(usize) -> String,
+    mut visit: impl FnMut(&mut Graph, usize, &Joint, Id, Motion),
+) {
+    let mut motion: Vec<Option<Motion>> = vec![None; joints.len()];
+    for (i, joint) in joints.iter().enumerate() {
+        let Some(joint) = joint else { break };
+        g.set_section(section(i));
         let before = incoming(g, model, kin, &motion, i);
-        let zero = g.zero();
-        let joint = Joint {
-            rate: rates[i].unwrap_or(zero),
-            ..joint
-        };
-        let (qdd, after) = joint_acceleration(g, model, kin, i, &joint, before);
-        match joint.d_inverse {
-            Some(_) => out.response.push((i, qdd)),
-            None => {
-                let rows = transmitted(g, model, kin, i, &joint, after);
-                out.response_loads.push((i, rows));
-            }
-        }
+        let (qdd, after) = joint_acceleration(g, model, kin, i, joint, before);
+        visit(g, i, joint, qdd, after);
         motion[i] = Some(after);
     }
-    (out.mass_x, out.mass_product) = mass_product(g, model, s, kin, &names);
-    out
 }
 
 /// M(q) x by the recursions without velocities, weights or loads: the accelerations of the
@@ -738,5 +803,6 @@ fn mat_vec(g: &mut Graph, m: &[V3; 3], v: V3) -> V3 {
     crate::dynamics::mat_vec(g, m, v)
 }
 
+mod row;
 #[cfg(test)]
 mod tests;

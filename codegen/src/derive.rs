@@ -168,7 +168,12 @@ impl Derivation {
             return;
         }
         let kin = forward(&mut self.graph, model, &self.symbols);
-        self.articulated = articulated(&mut self.graph, model, &self.symbols, &kin);
+        // A model of one constraint row solves it within the sweeps.
+        let row_bias = match self.constraint_rows().as_slice() {
+            [(_, _, c)] => Some(*c),
+            _ => None,
+        };
+        self.articulated = articulated(&mut self.graph, model, &self.symbols, &kin, row_bias);
     }
 
     fn uncollected_in(model: &Model, mut g: Graph) -> Self {

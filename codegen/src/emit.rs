@@ -379,6 +379,13 @@ pub fn generate_from(
              fn articulated_len(&self) -> usize {{ {} }}",
             factors.max(1)
         );
+        if d.articulated.row_solution.is_some() {
+            let _ = writeln!(
+                functions,
+                "/// `articulated_terms` solves the model's one constraint row when given it.\n\
+                 fn articulated_rows(&self) -> usize {{ 1 }}"
+            );
+        }
     }
     let mut inherent = String::new();
     if mass_by_columns {

@@ -189,6 +189,9 @@ impl Dynamics for Driven {
     fn articulated_len(&self) -> usize {
         self.inner.articulated_len()
     }
+    fn articulated_rows(&self) -> usize {
+        self.inner.articulated_rows()
+    }
     fn articulated_terms(
         &self,
         t: f64,

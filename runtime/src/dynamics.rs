@@ -571,9 +571,18 @@ pub trait Dynamics {
         0
     }
 
+    /// How many constraint rows [`Dynamics::articulated_terms`] solves within its sweeps when
+    /// given them ([`ArticulatedTerms::row`]): 1 for a generated model on the articulated route
+    /// with one constraint row, 0 (the default) otherwise, when the runtime forms each row's
+    /// response with [`Dynamics::articulated_response`].
+    fn articulated_rows(&self) -> usize {
+        0
+    }
+
     /// The articulated-body forward dynamics at (t, q, q̇) without constraint forces (docs/
-    /// method.md §14), reading `cache` as filled by [`Dynamics::position_terms`] at the same
-    /// q: see [`ArticulatedTerms`]. Provided by generated models whose
+    /// method.md §14), or with the model's one row's when given it ([`ArticulatedTerms::row`],
+    /// §14.6), reading `cache` as filled by [`Dynamics::position_terms`] at the same q: see
+    /// [`ArticulatedTerms`]. Provided by generated models whose
     /// [`Dynamics::articulated_len`] is not 0; the default writes NaN.
     fn articulated_terms(
         &self,
@@ -610,7 +619,7 @@ pub trait Dynamics {
 pub struct ArticulatedTerms<'a> {
     /// In: q̈ of the driven coordinates. Out: q̈ of the free ones (independent and
     /// dependent) without constraint forces, i.e. solving the free rows of
-    /// `M q̈ + F + Q = 0` (13).
+    /// `M q̈ + F + Q = 0` (13); with [`ArticulatedTerms::row`] given, with that row's force.
     pub qdd: &'a mut [f64],
     /// Out: the driven coordinates' rows of `M q̈ + F + Q` at those accelerations (the load
     /// the drive supplies before the constraint forces). Other entries are left unchanged.
@@ -620,6 +629,44 @@ pub struct ArticulatedTerms<'a> {
     /// Out: what [`Dynamics::articulated_response`] reads (length
     /// [`Dynamics::articulated_len`]).
     pub factors: &'a mut [f64],
+    /// In, for a model that solves its one constraint row within the sweeps
+    /// ([`Dynamics::articulated_rows`] = 1): that row of J (length n) to solve it, `qdd` and
+    /// `drive` then with the row's force; empty not to (other models ignore it).
+    pub row: &'a [f64],
+    /// Out, for such a model given `row`: its multiplier and J M_ff⁻¹ Jᵀ (both 0 without it).
+    pub solved: &'a mut SolvedRow,
+}
+
+/// The constraint row a model solves within its sweeps ([`ArticulatedTerms::row`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolvedRow {
+    /// λ, eq. (14): M q̈ + F + Q + Jᵀ λ = τ with J q̈ + c = 0.
+    pub lambda: f64,
+    /// J_f M_ff⁻¹ J_fᵀ, positive unless the row vanishes on the free coordinates (a singular
+    /// position).
+    pub delassus: f64,
+}
+
+/// The weight generated code gives the row of [`ArticulatedTerms::row`]: 1 when it holds J's
+/// row of `n` entries, 0 when it is empty.
+///
+/// # Panics
+/// When `row` is neither empty nor `n` entries long: a caller's error.
+#[inline]
+pub fn row_weight(row: &[f64], n: usize) -> f64 {
+    assert!(
+        row.is_empty() || row.len() == n,
+        "the constraint row has {} entries, not {n} (or none)",
+        row.len()
+    );
+    if row.is_empty() { 0.0 } else { 1.0 }
+}
+
+/// Entry `k` of the row of [`ArticulatedTerms::row`] as generated code reads it: 0 when the
+/// row is empty.
+#[inline]
+pub fn row_entry(row: &[f64], k: usize) -> f64 {
+    row.get(k).copied().unwrap_or(0.0)
 }
 
 /// Output buffers of [`Dynamics::velocity_terms`]: M (n×n, row-major), F, Q (n) and c (m).

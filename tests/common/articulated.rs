@@ -4,7 +4,7 @@
 //! error (the residual of the equations the sweeps solve, relative to the size of their
 //! terms), which does not depend on the conditioning of M.
 
-use camchain::runtime::{ArticulatedTerms, Dynamics};
+use camchain::runtime::{ArticulatedTerms, Dynamics, SolvedRow};
 
 /// The largest relative residual of the articulated functions of `generated` in the
 /// equations of `dense` at (q, q̇, t), with prescribed accelerations and a generalised force
@@ -38,6 +38,8 @@ pub fn articulated_residual(
             drive: &mut drive,
             bias: &mut bias,
             factors: &mut factors,
+            row: &[],
+            solved: &mut SolvedRow::default(),
         },
     );
     let (mut mass, mut f, mut applied) = (vec![0.0; n * n], vec![0.0; n], vec![0.0; n]);
@@ -83,5 +85,93 @@ pub fn articulated_residual(
         };
         worst = worst.max(off.abs() / size.max(1.0));
     }
+    if generated.articulated_rows() == 1 {
+        worst = worst.max(solved_row_residual(
+            generated,
+            (q, qd, t),
+            &cache,
+            (&driven, &qdd),
+            (&mass, &f, &applied, c[0]),
+            &j,
+        ));
+    }
     worst
+}
+
+/// The row solved within the sweeps (docs/method.md §14.6) in the dense equations: with
+/// the row J given, M q̈ + F + Q + Jᵀ λ = 0 on the free rows and the drive loads on the
+/// driven ones, J q̈ + c = 0, and J_f M_ff⁻¹ J_fᵀ the response's J_f x (x = M_ff⁻¹ J_fᵀ).
+/// `unconstrained`: q̈ without the row's force (the free entries) and the prescribed q̈ (the
+/// `driven` ones).
+fn solved_row_residual(
+    generated: &dyn Dynamics,
+    (q, qd, t): (&[f64], &[f64], f64),
+    cache: &[f64],
+    (driven, unconstrained): (&[bool], &[f64]),
+    (mass, f, applied, c): (&[f64], &[f64], &[f64], f64),
+    row: &[f64],
+) -> f64 {
+    let n = q.len();
+    let mut qdd: Vec<f64> = (0..n)
+        .map(|i| if driven[i] { unconstrained[i] } else { 0.0 })
+        .collect();
+    let (mut drive, mut bias) = (vec![0.0; n], vec![0.0; 1]);
+    let mut factors = vec![f64::NAN; generated.articulated_len()];
+    let mut solved = SolvedRow::default();
+    generated.articulated_terms(
+        t,
+        q,
+        qd,
+        cache,
+        ArticulatedTerms {
+            qdd: &mut qdd,
+            drive: &mut drive,
+            bias: &mut bias,
+            factors: &mut factors,
+            row,
+            solved: &mut solved,
+        },
+    );
+    let lambda = solved.lambda;
+    let mut worst: f64 = 0.0;
+    for i in 0..n {
+        let m_row = &mass[i * n..(i + 1) * n];
+        let terms: Vec<f64> = m_row.iter().zip(&qdd).map(|(a, b)| a * b).collect();
+        let size = terms.iter().map(|x| x.abs()).sum::<f64>()
+            + f[i].abs()
+            + applied[i].abs()
+            + (row[i] * lambda).abs();
+        let residual = terms.iter().sum::<f64>() + f[i] + applied[i] + row[i] * lambda;
+        let off = if driven[i] {
+            residual - drive[i]
+        } else {
+            residual
+        };
+        worst = worst.max(off.abs() / size.max(1.0));
+    }
+    // J_f M_ff⁻¹ J_fᵀ by the response.
+    let tau: Vec<f64> = (0..n)
+        .map(|i| if driven[i] { 0.0 } else { row[i] })
+        .collect();
+    let (mut x, mut loads) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+    generated.articulated_response(&factors, &tau, &mut x, &mut loads);
+    // The velocity constraint's second derivative, relative to the terms q̈ = q̈⁰ − λ x is
+    // made of (it cancels where the contact force dominates q̈).
+    let terms: Vec<f64> = row.iter().zip(&qdd).map(|(a, b)| a * b).collect();
+    let size = (0..n)
+        .map(|i| {
+            let parts = if driven[i] {
+                unconstrained[i].abs()
+            } else {
+                unconstrained[i].abs() + (lambda * x[i]).abs()
+            };
+            (row[i] * parts).abs()
+        })
+        .sum::<f64>()
+        + c.abs();
+    worst = worst.max((terms.iter().sum::<f64>() + c).abs() / size.max(1.0));
+    let free = || (0..n).filter(|&i| !driven[i]);
+    let delassus: f64 = free().map(|i| tau[i] * x[i]).sum();
+    let size: f64 = free().map(|i| (tau[i] * x[i]).abs()).sum();
+    worst.max((delassus - solved.delassus).abs() / size.max(1e-300))
 }

@@ -32,6 +32,13 @@ fn every_built_in_model_keeps_the_dense_route_and_the_copies_take_the_other() {
     }
     for (name, model) in all_at_run_time::ALL.iter() {
         assert!(model.articulated_len() > 0, "{name}: the articulated route");
+        // A model of one constraint row solves it within its sweeps (docs/method.md §14.6).
+        let one_row = usize::from(model.info().n_constraints() == 1);
+        assert_eq!(
+            model.articulated_rows(),
+            one_row,
+            "{name}: rows solved within"
+        );
     }
 }
 

@@ -27,7 +27,7 @@
 // | `derive` | 1 | 2 | 0 | 0 | 0 | 0 | 3 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
-// dense 157, articulated 242 (the position level, common to both, not included).
+// dense 157, articulated 247 (the position level, common to both, not included).
 //
 // Read at run time: `omega`, `m`, `k`, `free`, `c` (see `Parameters`); `derive` computes what depends on them
 // alone once per parameter set, and the counts above do not include it.
@@ -1266,58 +1266,58 @@ impl rt::Dynamics for Model {
         let neg_roller_conv2 = s_cam_angle * roller_convective_x
             + c_cam_angle * neg_roller_convective_y;
         let roller_x_rate = cam_angle_dot * roller_j1_cam_angle + lift_dot * s_cam_angle;
-        let roller_ddcy_t1 = cache[8];
+        let roller_parameter_2 = cache[8];
         let c_roller_parameter = cache[5];
-        let roller_law_at = eval_roller_law(-roller_ddcy_t1);
+        let roller_law_at = eval_roller_law(-roller_parameter_2);
         let roller_law_d1 = cache[9];
-        let roller_ddcy_t2 = cache[11];
+        let roller_ddcy_t1 = cache[11];
         let roller_law_d1_sq = cache[12];
-        let roller_ddcy_t3 = cache[13];
-        let roller_ddcy_t4 = cache[14];
+        let roller_ddcy_t2 = cache[13];
+        let roller_ddcy_t3 = cache[14];
         let s_roller_parameter = cache[4];
         let roller_law_d2 = cache[15];
-        let roller_ddcy_t5 = cache[16];
-        let roller_ddcy_t6 = cache[17];
-        let roller_ddcy_t7 = cache[18];
+        let roller_ddcy_t4 = cache[16];
+        let roller_ddcy_t5 = cache[17];
+        let roller_ddcy_t6 = cache[18];
         let roller_law_d3 = roller_law_at[3];
-        let roller_ddcy_t8 = cache[19];
-        let roller_ddcy_t9 = cache[20];
-        let roller_ddcy_t10 = cache[21];
-        let roller_ddcy_t11 = cache[22];
-        let roller_ddcy_t12 = cache[23];
-        let roller_ddcy_t13 = cache[24];
-        let roller_ddcy_t14 = cache[25];
-        let roller_ddcy_t15 = cache[26];
-        let roller_ddcy_t16 = cache[27];
-        let roller_ddcy_t17 = cache[28];
+        let roller_ddcy_t7 = cache[19];
+        let roller_ddcy_t8 = cache[20];
+        let roller_ddcy_t9 = cache[21];
+        let roller_ddcy_t10 = cache[22];
+        let roller_ddcy_t11 = cache[23];
+        let roller_ddcy_t12 = cache[24];
+        let roller_ddcy_t13 = cache[25];
+        let roller_ddcy_t14 = cache[26];
+        let roller_ddcy_t15 = cache[27];
+        let roller_ddcy_t16 = cache[28];
         let roller_dcx = cache[29];
         let roller_ddcx_t1 = cache[30];
         let roller_ddcx_t2 = cache[31];
-        let roller_ddcy_t18 = roller_ddcy_t7
-            * (roller_ddcy_t9
-                * (roller_ddcy_t6 / roller_ddcy_t5 * (2.0 * roller_ddcy_t10))
-                - roller_ddcy_t6
-                    * (roller_law_d2 * roller_ddcy_t8
+        let roller_ddcy_t17 = roller_ddcy_t6
+            * (roller_ddcy_t8
+                * (roller_ddcy_t5 / roller_ddcy_t4 * (2.0 * roller_ddcy_t9))
+                - roller_ddcy_t5
+                    * (roller_law_d2 * roller_ddcy_t7
                         + 2.0 * (roller_law_d1_sq + roller_law_d1 * roller_law_d3)))
-            + roller_ddcy_t10
-                * (roller_ddcy_t11 / roller_ddcy_t3
-                    + roller_ddcy_t7 / roller_ddcy_t3 * roller_ddcy_t10);
-        let roller_ddcy_t19 = 0.0125
-            * (roller_ddcy_t4 * roller_law_d3 + roller_law_d1 * roller_ddcy_t18)
-            - 0.025 * (roller_law_d2 * roller_ddcy_t11);
+            + roller_ddcy_t9
+                * (roller_ddcy_t10 / roller_ddcy_t2
+                    + roller_ddcy_t6 / roller_ddcy_t2 * roller_ddcy_t9);
+        let roller_ddcy_t18 = 0.0125
+            * (roller_ddcy_t3 * roller_law_d3 + roller_law_d1 * roller_ddcy_t17)
+            - 0.025 * (roller_law_d2 * roller_ddcy_t10);
         let roller_ddcx_t3 = cache[32];
         let roller_ddcx_t4 = cache[33];
-        let roller_ddcy_t20 = 0.0125
-            * (roller_ddcy_t2 * roller_ddcy_t18 - roller_ddcy_t12 - roller_ddcy_t13)
+        let roller_ddcy_t19 = 0.0125
+            * (roller_ddcy_t1 * roller_ddcy_t17 - roller_ddcy_t11 - roller_ddcy_t12)
             - roller_law_d2;
-        let roller_ddcx = s_roller_parameter * roller_ddcy_t20
-            + (roller_ddcx_t4 + (c_roller_parameter * roller_ddcy_t19 + roller_ddcx_t3))
+        let roller_ddcx = s_roller_parameter * roller_ddcy_t19
+            + (roller_ddcx_t4 + (c_roller_parameter * roller_ddcy_t18 + roller_ddcx_t3))
             - roller_ddcx_t1 - roller_ddcx_t2;
         let roller_dcy = cache[34];
-        let roller_ddcy = roller_ddcy_t16
-            + (s_roller_parameter * roller_ddcy_t19
-                + (roller_ddcy_t14 + roller_ddcy_t15)) - roller_ddcy_t17
-            - c_roller_parameter * roller_ddcy_t20;
+        let roller_ddcy = roller_ddcy_t15
+            + (s_roller_parameter * roller_ddcy_t18
+                + (roller_ddcy_t13 + roller_ddcy_t14)) - roller_ddcy_t16
+            - c_roller_parameter * roller_ddcy_t19;
         let speed_sq = cache[35];
         let neg_roller_kappa_t1 = cache[36];
         let roller_tx = cache[37];

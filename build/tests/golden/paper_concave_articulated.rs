@@ -21,12 +21,12 @@
 // | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
 // | `velocity_terms` | 60 | 72 | 0 | 0 | 0 | 1 | 133 |
-// | `articulated_terms` | 94 | 111 | 3 | 0 | 0 | 1 | 209 |
+// | `articulated_terms` | 119 | 141 | 4 | 0 | 0 | 1 | 265 |
 // | `articulated_response` | 24 | 31 | 0 | 0 | 0 | 0 | 55 |
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
 // Forward dynamics: the articulated-body sweeps (as asked). Estimated operations per right-hand side:
-// dense 238, articulated 456 (the position level, common to both, not included).
+// dense 238, articulated 441 (the position level, common to both, not included).
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -1072,7 +1072,7 @@ impl rt::Dynamics for Model {
     fn cache_len(&self) -> usize {
         19
     }
-    /// The articulated-body sweeps (docs/method.md §14): q̈ of the free coordinates without constraint forces (the driven ones' q̈ read from `out.qdd`), the driven coordinates' rows of M q̈ + F + Q, c, and the factors the response reads.
+    /// The articulated-body sweeps (docs/method.md §14) with the model's constraint row solved within them when `out.row` holds J (§14.6): q̈ of the free coordinates with the row's force (without it when `out.row` is empty; the driven ones' q̈ read from `out.qdd`), the driven coordinates' rows of M q̈ + F + Q + Jᵀ λ, λ, J M_ff⁻¹ Jᵀ, c, and the factors the response reads.
     fn articulated_terms(
         &self,
         _t: f64,
@@ -1158,6 +1158,8 @@ impl rt::Dynamics for Model {
         let a_fxx = 1.0 + 3.0 * a_x;
         let a_x_rate = q3_dot * c_q1_q2 - q1_dot * a_arm_q1_y - q2_dot * a_arm_q2_y
             - q4_dot * a_segment_q4_y;
+        let row_lambda_t1 = a_convective_y + neg_a_convective_x * a_slope
+            - a_fxx * a_x_rate.powi(2);
         // body4: inertial loads and joint q4 load (backward recursion)
         let neg_centripetal_force_body4_x = 0.15 * omega_body4_sq;
         // body3: inertial loads and joint q3 load (backward recursion)
@@ -1165,14 +1167,13 @@ impl rt::Dynamics for Model {
         // body2: inertial loads and joint q2 load (backward recursion)
         let neg_centripetal_force_body2_x = 0.025 * omega_body2_sq;
         // body4: articulated inertia and bias force (joint q4)
-        let neg_qdd_q4_t1 = minus_g_body4_y + acc_body4_y;
-        let neg_qdd_q3_t1 = minus_g_body4_x + acc_body4_x
-            - neg_centripetal_force_body4_x;
-        let neg_qdd_q4_t2 = 0.15 * neg_qdd_q4_t1;
-        let neg_qdd_q4_t3 = q4_dot + 18.0 * q4 + neg_qdd_q4_t2;
-        let neg_qdd_q3_t2 = neg_qdd_q4_t1 - 1.2244897959183674 * neg_qdd_q4_t3;
+        let qdd_3_t1 = minus_g_body4_y + acc_body4_y;
+        let qdd_2_t1 = minus_g_body4_x + acc_body4_x - neg_centripetal_force_body4_x;
+        let qdd_3_t2 = 0.15 * qdd_3_t1;
+        let qdd_3_t3 = q4_dot + 18.0 * q4 + qdd_3_t2;
+        let qdd_2_t2 = qdd_3_t1 - 1.2244897959183674 * qdd_3_t3;
         // body3: articulated inertia and bias force (joint q3)
-        let neg_qdd_q1_t1 = minus_g_body2_y + acc_body3_y;
+        let qdd_1_t1 = minus_g_body2_y + acc_body3_y;
         let factors_5_t1 = rel_rot_body4_11 * neg_rel_rot_body4_12;
         let articulated_d_q3_t1 = 0.18367346938775508
             * (0.5 - neg_rel_rot_body4_12 * neg_rel_rot_body4_12);
@@ -1180,36 +1181,32 @@ impl rt::Dynamics for Model {
         let factors_12_t1 = 0.9081632653061225 - articulated_d_q3_t1;
         let factors_9_t1 = 0.055102040816326525 * factors_5_t1;
         let articulated_d_q3 = 1.9081632653061225 + articulated_d_q3_t1;
-        let neg_qdd_q1_t2 = neg_rel_rot_body4_12 * neg_qdd_q3_t1
-            + rel_rot_body4_11 * neg_qdd_q3_t2;
-        let neg_qdd_q3_t3 = minus_g_body2_x - neg_acc_body3_x
-            - neg_centripetal_force_body3_x
-            + (rel_rot_body4_11 * neg_qdd_q3_t1 - neg_rel_rot_body4_12 * neg_qdd_q3_t2);
+        let qdd_1_t2 = neg_rel_rot_body4_12 * qdd_2_t1 + rel_rot_body4_11 * qdd_2_t2;
+        let qdd_2_t3 = minus_g_body2_x - neg_acc_body3_x - neg_centripetal_force_body3_x
+            + (rel_rot_body4_11 * qdd_2_t1 - neg_rel_rot_body4_12 * qdd_2_t2);
         let factors_9_t2 = 1.0 / articulated_d_q3;
-        let neg_qdd_q3_t4 = q3_dot + 40.0 * q3 + neg_qdd_q3_t3;
-        let articulated_d_q2_t1 = factors_9_t1 * factors_9_t2;
-        let neg_qdd_q1_t3 = articulated_d_q3 * factors_9_t2;
+        let qdd_2_t4 = q3_dot + 40.0 * q3 + qdd_2_t3;
+        let row_rate_q2_t1 = factors_9_t1 * factors_9_t2;
+        let row_rate_q1_t1 = articulated_d_q3 * factors_9_t2;
         let factors_12_t2 = factors_11_t1 * factors_9_t2;
         let factors_12_t3 = 1.9081632653061225 - articulated_d_q3_t1
             - factors_11_t1 * factors_12_t2;
         let factors_12_t4 = 0.15 + 0.3 * factors_12_t1 - factors_9_t1 * factors_12_t2;
-        let neg_qdd_q1_t4 = neg_qdd_q1_t1 + neg_qdd_q1_t2
-            - neg_qdd_q3_t4 * factors_12_t2;
+        let qdd_1_t3 = qdd_1_t1 + qdd_1_t2 - qdd_2_t4 * factors_12_t2;
         // body2: articulated inertia and bias force (joint q2)
-        let neg_qdd_q1_t5 = minus_g_body2_y + acc_body2_y;
+        let qdd_1_t4 = minus_g_body2_y + acc_body2_y;
         let factors_12_t5 = factors_12_t4 + offset_body3_x * factors_12_t3;
         let factors_16_t1 = 0.025 + factors_12_t5;
         let articulated_d_q2 = 0.01125
             + (offset_body3_x * factors_12_t5
-                + (0.1225 + 0.09 * factors_12_t1 - factors_9_t1 * articulated_d_q2_t1
+                + (0.1225 + 0.09 * factors_12_t1 - factors_9_t1 * row_rate_q2_t1
                     + offset_body3_x * factors_12_t4));
-        let neg_qdd_q1_t6 = 0.025 * neg_qdd_q1_t5
-            + (0.15 * neg_qdd_q1_t1
-                + (neg_qdd_q4_t2 - neg_qdd_q4_t3 + 0.3 * neg_qdd_q1_t2)
-                - neg_qdd_q3_t4 * articulated_d_q2_t1 + offset_body3_x * neg_qdd_q1_t4);
+        let qdd_1_t5 = 0.025 * qdd_1_t4
+            + (0.15 * qdd_1_t1 + (qdd_3_t2 - qdd_3_t3 + 0.3 * qdd_1_t2)
+                - qdd_2_t4 * row_rate_q2_t1 + offset_body3_x * qdd_1_t3);
         let factors_15_t1 = 1.0 / articulated_d_q2;
-        let qdd_q2_t1 = q2_dot + 15.0 * q2 + neg_qdd_q1_t6;
-        let neg_qdd_q1_t7 = articulated_d_q2 * factors_15_t1;
+        let qdd_1_t6 = q2_dot + 15.0 * q2 + qdd_1_t5;
+        let row_rate_q1_t2 = articulated_d_q2 * factors_15_t1;
         let articulated_d_q1_t1 = factors_16_t1 * factors_15_t1;
         let articulated_d_q1_t2 = 0.5 + factors_12_t3
             - factors_16_t1 * articulated_d_q1_t1;
@@ -1219,46 +1216,82 @@ impl rt::Dynamics for Model {
                 * (0.5 * (0.5 + articulated_d_q1_t2)
                     - (0.5 - neg_rel_rot_body2_12 * neg_rel_rot_body2_12)
                         * (0.5 - articulated_d_q1_t2));
-        let neg_qdd_q1_t8 = 1.0 / articulated_d_q1;
-        // body1: acceleration of joint q1 (forward sweep)
-        let neg_qdd_q1 = (1.4715 * c_q1
-            + (neg_qdd_q1_t6 - qdd_q2_t1 * neg_qdd_q1_t7
+        let qdd_0_t1 = 1.4715 * c_q1
+            + (qdd_1_t5 - qdd_1_t6 * row_rate_q1_t2
                 + 0.3
                     * (neg_rel_rot_body2_12
-                        * (neg_qdd_q3_t3 - neg_qdd_q3_t4 * neg_qdd_q1_t3
+                        * (qdd_2_t3 - qdd_2_t4 * row_rate_q1_t1
                             + (0.5 * (minus_g_body2_x - neg_acc_body2_x)
                                 - neg_centripetal_force_body2_x))
                         + rel_rot_body2_11
-                            * (neg_qdd_q1_t4 + 0.5 * neg_qdd_q1_t5
-                                - qdd_q2_t1 * articulated_d_q1_t1)))) * neg_qdd_q1_t8;
-        // body2: acceleration of joint q2 (forward sweep)
-        let qdd_q2_t2 = 0.3 * neg_qdd_q1;
-        let neg_qdd_q3_t5 = neg_rel_rot_body2_12 * qdd_q2_t2;
-        let qdd_q2_t3 = rel_rot_body2_11 * qdd_q2_t2;
-        let qdd_q2 = factors_15_t1
-            * (articulated_d_q2 * neg_qdd_q1 + factors_16_t1 * qdd_q2_t3 - qdd_q2_t1);
-        let neg_qdd_q3_t6 = qdd_q2 - neg_qdd_q1;
-        // body3: acceleration of joint q3 (forward sweep)
-        let neg_qdd_q3_t7 = offset_body3_x * neg_qdd_q3_t6 - qdd_q2_t3;
-        let neg_qdd_q3 = factors_9_t2
-            * (neg_qdd_q3_t4
-                + (factors_9_t1 * neg_qdd_q3_t6
-                    + (factors_11_t1 * neg_qdd_q3_t7
-                        - articulated_d_q3 * neg_qdd_q3_t5)));
-        // body4: acceleration of joint q4 (forward sweep)
-        let neg_qdd_q4 = 8.16326530612245
-            * (neg_qdd_q4_t3
-                + (0.1225 * neg_qdd_q3_t6
+                            * (qdd_1_t3 + 0.5 * qdd_1_t4
+                                - qdd_1_t6 * articulated_d_q1_t1)));
+        let qdd_0_t2 = 1.0 / articulated_d_q1;
+        // body4: response to a generalised force (forward sweep)
+        let row_q1 = rt::row_entry(out.row, 0);
+        let row_q2 = rt::row_entry(out.row, 1);
+        let row_q3 = rt::row_entry(out.row, 2);
+        let row_q4 = rt::row_entry(out.row, 3);
+        let row_weight = rt::row_weight(out.row, 4);
+        // body4: the solved row's J (backward sweep)
+        let row_rate_q3_t1 = 1.2244897959183674 * row_q4;
+        // body3: the solved row's J (backward sweep)
+        let row_rate_q3_t2 = row_rate_q3_t1 * neg_rel_rot_body4_12;
+        let row_rate_q2_t2 = row_rate_q3_t1 * rel_rot_body4_11;
+        let row_rate_q3 = row_q3 + row_rate_q3_t2;
+        let row_rate_q2_t3 = row_rate_q2_t2 + factors_12_t2 * row_rate_q3;
+        // body2: the solved row's J (backward sweep)
+        let row_rate_q2_t4 = row_q4 + 0.3 * row_rate_q2_t2 + row_rate_q2_t1 * row_rate_q3
+            + offset_body3_x * row_rate_q2_t3;
+        let row_rate_q2 = row_q2 - row_rate_q2_t4;
+        // body1: the solved row's J (backward sweep)
+        let row_rate_q1 = row_q1
+            - (row_rate_q2_t4 + row_rate_q1_t2 * row_rate_q2
+                + 0.3
+                    * (neg_rel_rot_body2_12
+                        * (row_rate_q1_t1 * row_rate_q3 - row_rate_q3_t2)
+                        + rel_rot_body2_11
+                            * (row_rate_q2_t3 + articulated_d_q1_t1 * row_rate_q2)));
+        // the solved row's multiplier
+        let row_delassus_t1 = 8.16326530612245 * row_q4;
+        let row_delassus_t2 = qdd_0_t2 * row_rate_q1;
+        let row_delassus_t3 = factors_15_t1 * row_rate_q2;
+        let row_delassus_t4 = factors_9_t2 * row_rate_q3;
+        let row_delassus = row_q4 * row_delassus_t1
+            + (row_rate_q1 * row_delassus_t2 + row_rate_q2 * row_delassus_t3
+                + row_rate_q3 * row_delassus_t4);
+        let row_lambda = row_weight
+            * (row_lambda_t1 - qdd_0_t1 * row_delassus_t2 - qdd_1_t6 * row_delassus_t3
+                - qdd_2_t4 * row_delassus_t4 - row_delassus_t1 * qdd_3_t3)
+            / (1.0 - row_weight + row_delassus);
+        // body1: acceleration of joint q1 with the row's force
+        let qdd_0_t3 = qdd_0_t2 * (qdd_0_t1 + row_rate_q1 * row_lambda);
+        // body2: acceleration of joint q2 with the row's force
+        let qdd_1_t7 = 0.3 * qdd_0_t3;
+        let qdd_2_t5 = neg_rel_rot_body2_12 * qdd_1_t7;
+        let qdd_1_t8 = rel_rot_body2_11 * qdd_1_t7;
+        let qdd_2_t6 = factors_15_t1
+            * (articulated_d_q2 * qdd_0_t3 + factors_16_t1 * qdd_1_t8
+                - (qdd_1_t6 + row_rate_q2 * row_lambda));
+        let qdd_2_t7 = qdd_2_t6 - qdd_0_t3;
+        // body3: acceleration of joint q3 with the row's force
+        let qdd_2_t8 = offset_body3_x * qdd_2_t7 - qdd_1_t8;
+        let qdd_2_t9 = factors_9_t2
+            * (qdd_2_t4 + row_rate_q3 * row_lambda
+                + (factors_9_t1 * qdd_2_t7
+                    + (factors_11_t1 * qdd_2_t8 - articulated_d_q3 * qdd_2_t5)));
+        out.qdd[0] = -qdd_0_t3;
+        out.qdd[1] = qdd_2_t6;
+        out.qdd[2] = -qdd_2_t9;
+        out.qdd[3] = -8.16326530612245
+            * (qdd_3_t3 + row_q4 * row_lambda
+                + (0.1225 * qdd_2_t7
                     + 0.15
-                        * (neg_rel_rot_body4_12 * (neg_qdd_q3_t5 + neg_qdd_q3)
-                            + rel_rot_body4_11
-                                * (neg_qdd_q3_t7 + 0.3 * neg_qdd_q3_t6))));
-        out.qdd[0] = -neg_qdd_q1;
-        out.qdd[1] = qdd_q2;
-        out.qdd[2] = -neg_qdd_q3;
-        out.qdd[3] = -neg_qdd_q4;
-        out.bias[0] = a_convective_y + neg_a_convective_x * a_slope
-            - a_fxx * a_x_rate.powi(2);
+                        * (neg_rel_rot_body4_12 * (qdd_2_t5 + qdd_2_t9)
+                            + rel_rot_body4_11 * (qdd_2_t8 + 0.3 * qdd_2_t7))));
+        out.solved.lambda = row_lambda;
+        out.solved.delassus = row_delassus;
+        out.bias[0] = row_lambda_t1;
         out.factors[0] = offset_body3_x;
         out.factors[1] = rel_rot_body2_11;
         out.factors[2] = neg_rel_rot_body2_12;
@@ -1268,15 +1301,15 @@ impl rt::Dynamics for Model {
         out.factors[6] = factors_9_t1;
         out.factors[7] = articulated_d_q3;
         out.factors[8] = factors_9_t2;
-        out.factors[9] = articulated_d_q2_t1;
-        out.factors[10] = neg_qdd_q1_t3;
+        out.factors[9] = row_rate_q2_t1;
+        out.factors[10] = row_rate_q1_t1;
         out.factors[11] = factors_12_t2;
         out.factors[12] = factors_16_t1;
         out.factors[13] = articulated_d_q2;
         out.factors[14] = factors_15_t1;
-        out.factors[15] = neg_qdd_q1_t7;
+        out.factors[15] = row_rate_q1_t2;
         out.factors[16] = articulated_d_q1_t1;
-        out.factors[17] = neg_qdd_q1_t8;
+        out.factors[17] = qdd_0_t2;
     }
     /// M_ff⁻¹ τ on the free coordinates and M_df M_ff⁻¹ τ on the driven ones, from the factors of the last `articulated_terms`.
     fn articulated_response(
@@ -1297,70 +1330,74 @@ impl rt::Dynamics for Model {
         // body4: joint q4, rotation, velocities and accelerations
         let rel_rot_body4_11 = factors[3];
         let neg_rel_rot_body4_12 = factors[4];
-        let qdd_0_t1 = tau[0];
-        let qdd_1_t1 = tau[1];
-        let qdd_2_t1 = tau[2];
-        let qdd_3_t1 = tau[3];
+        let tau_q1 = tau[0];
+        let tau_q2 = tau[1];
+        let tau_q3 = tau[2];
+        let tau_q4 = tau[3];
         // body3: articulated inertia and bias force (joint q3)
-        let qdd_2_t2 = factors[5];
-        let qdd_2_t3 = factors[6];
+        let qdd_2_t1 = factors[5];
+        let qdd_2_t2 = factors[6];
         let articulated_d_q3 = factors[7];
-        let qdd_2_t4 = factors[8];
-        let qdd_1_t2 = factors[9];
-        let qdd_0_t2 = factors[10];
-        let qdd_1_t3 = factors[11];
+        let qdd_2_t3 = factors[8];
+        let qdd_1_t1 = factors[9];
+        let qdd_0_t1 = factors[10];
+        let qdd_1_t2 = factors[11];
         // body2: articulated inertia and bias force (joint q2)
-        let qdd_1_t4 = factors[12];
+        let qdd_1_t3 = factors[12];
         let articulated_d_q2 = factors[13];
-        let qdd_1_t5 = factors[14];
-        let qdd_0_t3 = factors[15];
-        let qdd_0_t4 = factors[16];
+        let qdd_1_t4 = factors[14];
+        let qdd_0_t2 = factors[15];
+        let qdd_0_t3 = factors[16];
         // body1: articulated inertia and bias force (joint q1)
-        let qdd_0_t5 = factors[17];
+        let qdd_0_t4 = factors[17];
         // body4: response to a generalised force (backward sweep)
-        let qdd_2_t5 = 1.2244897959183674 * qdd_3_t1;
+        let qdd_2_t4 = 1.2244897959183674 * tau_q4;
         // body3: response to a generalised force (backward sweep)
-        let qdd_2_t6 = qdd_2_t5 * neg_rel_rot_body4_12;
-        let qdd_1_t6 = qdd_2_t5 * rel_rot_body4_11;
-        let qdd_2_t7 = qdd_2_t1 + qdd_2_t6;
-        let qdd_1_t7 = qdd_1_t6 + qdd_1_t3 * qdd_2_t7;
+        let qdd_2_t5 = qdd_2_t4 * neg_rel_rot_body4_12;
+        let qdd_1_t5 = qdd_2_t4 * rel_rot_body4_11;
+        let qdd_2_t6 = tau_q3 + qdd_2_t5;
+        let qdd_1_t6 = qdd_1_t5 + qdd_1_t2 * qdd_2_t6;
         // body2: response to a generalised force (backward sweep)
-        let qdd_1_t8 = qdd_3_t1 + 0.3 * qdd_1_t6 + qdd_1_t2 * qdd_2_t7
-            + offset_body3_x * qdd_1_t7;
-        let qdd_1_t9 = qdd_1_t1 - qdd_1_t8;
+        let qdd_1_t7 = tau_q4 + 0.3 * qdd_1_t5 + qdd_1_t1 * qdd_2_t6
+            + offset_body3_x * qdd_1_t6;
+        let qdd_1_t8 = tau_q2 - qdd_1_t7;
         // body1: response to a generalised force (forward sweep)
-        let qdd_1_t10 = qdd_0_t5
-            * (qdd_0_t1
-                - (qdd_1_t8 + qdd_0_t3 * qdd_1_t9
+        let qdd_1_t9 = qdd_0_t4
+            * (tau_q1
+                - (qdd_1_t7 + qdd_0_t2 * qdd_1_t8
                     + 0.3
-                        * (neg_rel_rot_body2_12 * (qdd_0_t2 * qdd_2_t7 - qdd_2_t6)
-                            + rel_rot_body2_11 * (qdd_1_t7 + qdd_0_t4 * qdd_1_t9))));
+                        * (neg_rel_rot_body2_12 * (qdd_0_t1 * qdd_2_t6 - qdd_2_t5)
+                            + rel_rot_body2_11 * (qdd_1_t6 + qdd_0_t3 * qdd_1_t8))));
         // body2: response to a generalised force (forward sweep)
-        let qdd_1_t11 = 0.3 * qdd_1_t10;
-        let qdd_2_t8 = neg_rel_rot_body2_12 * qdd_1_t11;
-        let qdd_1_t12 = rel_rot_body2_11 * qdd_1_t11;
-        let qdd_2_t9 = qdd_1_t5
-            * (qdd_1_t9 - (articulated_d_q2 * qdd_1_t10 + qdd_1_t4 * qdd_1_t12));
-        let qdd_2_t10 = qdd_1_t10 + qdd_2_t9;
+        let qdd_1_t10 = 0.3 * qdd_1_t9;
+        let qdd_2_t7 = neg_rel_rot_body2_12 * qdd_1_t10;
+        let qdd_1_t11 = rel_rot_body2_11 * qdd_1_t10;
+        let qdd_2_t8 = qdd_1_t4
+            * (qdd_1_t8 - (articulated_d_q2 * qdd_1_t9 + qdd_1_t3 * qdd_1_t11));
+        let qdd_2_t9 = qdd_1_t9 + qdd_2_t8;
         // body3: response to a generalised force (forward sweep)
-        let qdd_2_t11 = qdd_1_t12 + offset_body3_x * qdd_2_t10;
-        let qdd_3_t2 = qdd_2_t4
-            * (qdd_2_t7
-                - (qdd_2_t3 * qdd_2_t10
-                    + (articulated_d_q3 * qdd_2_t8 + qdd_2_t2 * qdd_2_t11)));
-        qdd[0] = qdd_1_t10;
-        qdd[1] = qdd_2_t9;
-        qdd[2] = qdd_3_t2;
+        let qdd_2_t10 = qdd_1_t11 + offset_body3_x * qdd_2_t9;
+        let qdd_3_t1 = qdd_2_t3
+            * (qdd_2_t6
+                - (qdd_2_t2 * qdd_2_t9
+                    + (articulated_d_q3 * qdd_2_t7 + qdd_2_t1 * qdd_2_t10)));
+        qdd[0] = qdd_1_t9;
+        qdd[1] = qdd_2_t8;
+        qdd[2] = qdd_3_t1;
         qdd[3] = 8.16326530612245
-            * (qdd_3_t1
-                - (0.1225 * qdd_2_t10
+            * (tau_q4
+                - (0.1225 * qdd_2_t9
                     + 0.15
-                        * (rel_rot_body4_11 * (qdd_2_t11 + 0.3 * qdd_2_t10)
-                            - neg_rel_rot_body4_12 * (qdd_2_t8 + qdd_3_t2))));
+                        * (rel_rot_body4_11 * (qdd_2_t10 + 0.3 * qdd_2_t9)
+                            - neg_rel_rot_body4_12 * (qdd_2_t7 + qdd_3_t1))));
     }
     /// Entries of the factors `articulated_terms` writes for `articulated_response`.
     fn articulated_len(&self) -> usize {
         18
+    }
+    /// `articulated_terms` solves the model's one constraint row when given it.
+    fn articulated_rows(&self) -> usize {
+        1
     }
     /// f1, f2, J1, J2 and the convective terms of contact `k` into `out` (unchanged for an unknown k).
     fn contact_kinematics_into(
@@ -1510,7 +1547,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("damper_power", [2, 0, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
     ("velocity_terms", [60, 72, 0, 0, 0, 1]),
-    ("articulated_terms", [94, 111, 3, 0, 0, 1]),
+    ("articulated_terms", [119, 141, 4, 0, 0, 1]),
     ("articulated_response", [24, 31, 0, 0, 0, 0]),
     ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
 ];

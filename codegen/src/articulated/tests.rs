@@ -106,6 +106,69 @@ fn check(name: &str, seed: u64) -> f64 {
     for (g, e) in loads.iter().zip(&rows) {
         worst = worst.max((g - e).abs() / s);
     }
+    if let Some((l, dl)) = a.row_solution {
+        // The row solved within the sweeps, with J and c of the model's own row, against the
+        // Schur complement of the dense system [[M_ff, J_fᵀ], [J_f, 0]].
+        let (_, jacobian, bias) = d.constraint_rows()[0];
+        let j = eval(jacobian);
+        let c = eval(&[bias])[0];
+        for (&var, &v) in a.row.iter().zip(&j) {
+            set(&mut vars, var, v);
+        }
+        set(&mut vars, a.row_weight.expect("with the row"), 1.0);
+        let x0 = &expected;
+        let j_f = DVector::from_fn(free.len(), |r, _| j[free[r]]);
+        let along = lu.solve(&j_f).expect("M_ff is invertible");
+        let delassus = j_f.dot(&along);
+        let driven_part: f64 = driven.iter().map(|&i| j[i] * qdd[i]).sum();
+        let lambda = (j_f.dot(x0) + driven_part + c) / delassus;
+        let solved = x0 - &along * lambda;
+        let eval = |roots: &[Id]| d.graph.eval(roots, &vars);
+        let got = eval(&[l, dl]);
+        worst = worst.max((got[0] - lambda).abs() / lambda.abs().max(1.0));
+        worst = worst.max((got[1] - delassus).abs() / delassus.abs());
+        let got = eval(
+            &a.solved_accelerations
+                .iter()
+                .map(|x| x.1)
+                .collect::<Vec<_>>(),
+        );
+        let s = scale(solved.as_slice());
+        for (r, g) in got.iter().enumerate() {
+            worst = worst.max((g - solved[r]).abs() / s);
+        }
+        for (r, &i) in free.iter().enumerate() {
+            qdd[i] = solved[r];
+        }
+        let loads = eval(&a.solved_drive_loads.iter().map(|x| x.1).collect::<Vec<_>>());
+        let rows: Vec<f64> = driven
+            .iter()
+            .map(|&i| {
+                (0..n).map(|k| mass[(i, k)] * qdd[k]).sum::<f64>() + f[i] + qv[i] + j[i] * lambda
+            })
+            .collect();
+        let s = scale(&rows);
+        for (g, e) in loads.iter().zip(&rows) {
+            worst = worst.max((g - e).abs() / s);
+        }
+        // Without the row (weight 0, J zero): the free accelerations, λ = 0.
+        for &var in &a.row {
+            set(&mut vars, var, 0.0);
+        }
+        set(&mut vars, a.row_weight.expect("with the row"), 0.0);
+        let eval = |roots: &[Id]| d.graph.eval(roots, &vars);
+        assert_eq!(eval(&[l])[0], 0.0, "{name}: λ without the row");
+        let got = eval(
+            &a.solved_accelerations
+                .iter()
+                .map(|x| x.1)
+                .collect::<Vec<_>>(),
+        );
+        let s = scale(x0.as_slice());
+        for (r, g) in got.iter().enumerate() {
+            worst = worst.max((g - x0[r]).abs() / s);
+        }
+    }
     worst
 }
 

@@ -118,11 +118,21 @@ pub(super) fn mass_columns_tail(n: usize) -> String {
 pub(super) fn outputs(d: &Derivation) -> (Outputs, Outputs) {
     let a = &d.articulated;
     let mut main: Vec<(String, Id)> = Vec::new();
-    for &(i, e) in &a.accelerations {
+    // A model of one constraint row returns q̈ with the row's force when given the row (and
+    // without it when not): the free accelerations' own forward sweep is not emitted.
+    let (accelerations, drive_loads) = match a.row_solution {
+        Some(_) => (&a.solved_accelerations, &a.solved_drive_loads),
+        None => (&a.accelerations, &a.drive_loads),
+    };
+    for &(i, e) in accelerations {
         main.push((format!("out.qdd[{i}]"), e));
     }
-    for &(i, e) in &a.drive_loads {
+    for &(i, e) in drive_loads {
         main.push((format!("out.drive[{i}]"), e));
+    }
+    if let Some((lambda, delassus)) = a.row_solution {
+        main.push(("out.solved.lambda".to_string(), lambda));
+        main.push(("out.solved.delassus".to_string(), delassus));
     }
     for (k, row) in d.constraint_rows().iter().enumerate() {
         main.push((format!("out.bias[{k}]"), row.2));
@@ -193,14 +203,17 @@ pub(super) fn choose(d: &Derivation, dense_ops: usize, asked: Formulation) -> Ch
     let response_ops = d.graph.op_count_until(&response_roots, &given).total();
     let main_ops = d.graph.op_count(&main_roots).total();
     // Per row: a response, J times it for every row (2 n m), the combination (2 n); the
-    // multipliers' Cholesky m³ / 3. The sweeps are a chain of dependent operations (each
+    // multipliers' Cholesky m³ / 3. A model of one row solves it within the main function. The sweeps are a chain of dependent operations (each
     // body waits for its child's articulated inertia, a division among them) where the
     // dense route's terms are independent of each other: 40 n more, calibrated on the
     // scaling chains (`codegen/examples/formulations.rs`, BENCHMARKS.md), where the planar
     // chain of 8 bodies runs about as fast both ways and the spatial one of 16 faster
     // articulated.
-    let articulated_ops =
-        main_ops + m * (response_ops + 2 * n * m + 2 * n) + m * m * m / 3 + 40 * n;
+    let per_row = match d.articulated.row_solution {
+        Some(_) => 0,
+        None => m * (response_ops + 2 * n * m + 2 * n) + m * m * m / 3,
+    };
+    let articulated_ops = main_ops + per_row + 40 * n;
     let (articulated, forced) = match asked {
         Formulation::Auto => (articulated_ops < dense, false),
         Formulation::Dense => (false, true),
@@ -241,11 +254,28 @@ pub(super) fn specs(
     for &(i, var) in &d.articulated.driven {
         main_given.push((var, format!("out.qdd[{i}]")));
     }
+    if let Some(weight) = d.articulated.row_weight {
+        let n = d.articulated.row.len();
+        main_given.push((weight, format!("rt::row_weight(out.row, {n})")));
+        for (i, &var) in d.articulated.row.iter().enumerate() {
+            main_given.push((var, format!("rt::row_entry(out.row, {i})")));
+        }
+    }
     let terms = FunctionSpec {
-        doc: "The articulated-body sweeps (docs/method.md §14): q̈ of the free coordinates \
-              without constraint forces (the driven ones' q̈ read from `out.qdd`), the driven \
-              coordinates' rows of M q̈ + F + Q, c, and the factors the response reads."
-            .into(),
+        doc: match d.articulated.row_solution {
+            Some(_) => "The articulated-body sweeps (docs/method.md §14) with the model's \
+                        constraint row solved within them when `out.row` holds J (§14.6): q̈ of \
+                        the free coordinates with the row's force (without it when `out.row` is \
+                        empty; the driven ones' q̈ read from `out.qdd`), the driven coordinates' \
+                        rows of M q̈ + F + Q + Jᵀ λ, λ, J M_ff⁻¹ Jᵀ, c, and the factors the \
+                        response reads."
+                .into(),
+            None => "The articulated-body sweeps (docs/method.md §14): q̈ of the free \
+                     coordinates without constraint forces (the driven ones' q̈ read from \
+                     `out.qdd`), the driven coordinates' rows of M q̈ + F + Q, c, and the factors \
+                     the response reads."
+                .into(),
+        },
         name: "articulated_terms".into(),
         params: vec![
             param("t", "f64"),

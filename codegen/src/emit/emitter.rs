@@ -222,6 +222,14 @@ impl<'g> Emitter<'g> {
             };
             let name = match self.given_field(id) {
                 Some(field) => fresh(&field, &mut taken),
+                // A variable read from an argument (`tau[2]`) under the variable's own name.
+                None if let Node::Var(k) = self.g.node(id) => {
+                    let own = &self.g.var_names()[k as usize];
+                    fresh(
+                        &super::names::sanitize(own.trim_start_matches('_')),
+                        &mut taken,
+                    )
+                }
                 None => self.fresh_name(id, &mut taken),
             };
             // A constant bound to a name is typed: a bare float literal read as a method's

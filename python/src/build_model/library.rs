@@ -13,7 +13,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// The ABI version of `shim.rs.in` (its `camchain_abi()`).
-pub const ABI: u32 = 2;
+pub const ABI: u32 = 3;
 
 type Ptr = *const Handle;
 type P = *const f64;
@@ -52,7 +52,8 @@ struct Api {
     position_terms: unsafe extern "C" fn(Ptr, P, M, M, M),
     velocity_terms: unsafe extern "C" fn(Ptr, f64, P, P, P, M, M, M, M),
     articulated_len: unsafe extern "C" fn(Ptr) -> usize,
-    articulated_terms: unsafe extern "C" fn(Ptr, f64, P, P, P, M, M, M, M),
+    articulated_rows: unsafe extern "C" fn(Ptr) -> usize,
+    articulated_terms: unsafe extern "C" fn(Ptr, f64, P, P, P, M, M, M, M, P, usize, M),
     articulated_response: unsafe extern "C" fn(Ptr, P, P, M, M),
 }
 
@@ -109,6 +110,7 @@ impl Loaded {
             position_terms: get!("position_terms"),
             velocity_terms: get!("velocity_terms"),
             articulated_len: get!("articulated_len"),
+            articulated_rows: get!("articulated_rows"),
             articulated_terms: get!("articulated_terms"),
             articulated_response: get!("articulated_response"),
         };
@@ -487,6 +489,12 @@ impl Dynamics for Compiled {
         len(out.drive, n);
         len(out.bias, m);
         len(out.factors, self.articulated_len());
+        assert!(
+            out.row.is_empty() || out.row.len() == n,
+            "a constraint row of {} for {n} values",
+            out.row.len()
+        );
+        let mut solved = [0.0; 2];
         // SAFETY: every buffer checked for the lengths the library reads and writes.
         unsafe {
             (self.loaded.api.articulated_terms)(
@@ -499,8 +507,18 @@ impl Dynamics for Compiled {
                 out.drive.as_mut_ptr(),
                 out.bias.as_mut_ptr(),
                 out.factors.as_mut_ptr(),
+                out.row.as_ptr(),
+                out.row.len(),
+                solved.as_mut_ptr(),
             )
         }
+        out.solved.lambda = solved[0];
+        out.solved.delassus = solved[1];
+    }
+
+    fn articulated_rows(&self) -> usize {
+        // SAFETY: the handle is live while self is.
+        unsafe { (self.loaded.api.articulated_rows)(self.handle) }
     }
 
     fn articulated_response(

@@ -11,6 +11,10 @@
 //! τ_d = τ⁰_d + Σ_k λ_k (M_df A_k + J_kd)
 //! ```
 //!
+//! A model of one constraint row ([`Dynamics::articulated_rows`] = 1) solves it within its
+//! sweeps instead (§14.6): given J's row, `articulated_terms` returns q̈, λ and the drive
+//! loads with the row's force, and no response is formed here.
+//!
 //! −J A = J_f M_ff⁻¹ J_fᵀ is symmetric positive definite whenever the solved rows are
 //! independent on the free coordinates, which the partition guarantees: it solves only rows
 //! whose J_v, a square block of J_f, is invertible (redundant rows are left out, their
@@ -19,7 +23,7 @@
 
 use super::linalg::{cholesky_factor, cholesky_solve, dot};
 use super::{Partition, Workspace};
-use crate::dynamics::{ArticulatedTerms, Dynamics};
+use crate::dynamics::{ArticulatedTerms, Dynamics, SolvedRow};
 use crate::error::SimError;
 
 impl Workspace {
@@ -51,6 +55,9 @@ impl Workspace {
         b.delassus.resize(nc * nc, 0.0);
         b.tau.resize(n, 0.0);
         let all_rows = self.m == self.nc;
+        // A model of one row solves it within its sweeps when it is solved here (§14.6).
+        let within = self.m == 1 && model.articulated_rows() == 1;
+        let mut solved = SolvedRow::default();
         self.drive.fill(0.0);
         let out = ArticulatedTerms {
             qdd: &mut self.qdd,
@@ -61,8 +68,24 @@ impl Workspace {
                 &mut self.full_bias
             },
             factors: &mut b.factors,
+            row: if within && nc == 1 {
+                &self.jacobian[..n]
+            } else {
+                &[]
+            },
+            solved: &mut solved,
         };
         model.articulated_terms(t, &self.q, &self.qd, &self.cache, out);
+        if within {
+            if nc == 1 {
+                // As the Cholesky factorisation below checks its pivot.
+                if !(solved.delassus > 0.0 && solved.delassus.is_finite()) {
+                    return Err(self.singular(t));
+                }
+                self.lambda[0] = solved.lambda;
+            }
+            return self.accelerations_solved(partition, t);
+        }
         if !all_rows {
             for (k, &row) in self.rows.iter().enumerate() {
                 self.bias[k] = self.full_bias[row];
@@ -106,10 +129,16 @@ impl Workspace {
                 self.drive[d] += lambda * (b.response_drive[k * n + d] + row[d]);
             }
         }
+        self.accelerations_solved(partition, t)
+    }
+
+    /// ü from q̈, and the checks of q̈, λ and the drive loads, once the articulated route has
+    /// solved them.
+    fn accelerations_solved(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
         for (udd, &u) in self.udd.iter_mut().zip(partition.independent()) {
             *udd = self.qdd[u];
         }
-        b.solved = true;
+        self.articulated.solved = true;
         if self.qdd.iter().any(|x| !x.is_finite()) {
             return Err(self.non_finite(t, "q̈"));
         }
