@@ -216,7 +216,7 @@ pub fn articulated(
                 let sp = project(g, kind, axis, bias);
                 let tau_i = g.neg(load);
                 let rate = g.sub(tau_i, sp);
-                let w = scale_force(g, d_inverse, u);
+                let w = per_unit_rate(g, d_inverse, u, kind, model.bodies[i].joint.axis);
                 let mut reduced = subtract_outer(g, &big, u, w);
                 clear_joint_direction(g, &mut reduced, kind, model.bodies[i].joint.axis);
                 let pushed = scale_force(g, rate, w);
@@ -338,7 +338,7 @@ fn backward_of(
             Some(d_inverse) => {
                 let sp = project(g, kind, kin[i].axis, bias);
                 let rate = g.sub(tau[i], sp);
-                let w = scale_force(g, d_inverse, joint.u);
+                let w = per_unit_rate(g, d_inverse, joint.u, kind, model.bodies[i].joint.axis);
                 let pushed = scale_force(g, rate, w);
                 rates[i] = Some(rate);
                 add_force(g, bias, pushed)
@@ -580,6 +580,22 @@ fn project(g: &mut Graph, kind: JointKind, axis: V3, f: Force) -> Id {
         JointKind::Revolute => vec3::dot(g, axis, f.n),
         JointKind::Prismatic => vec3::dot(g, axis, f.f),
     }
+}
+
+/// W = U / D. Along a joint axis that is a coordinate axis ±e_k, D = ±U_k, so W_k is ±1
+/// exactly: written so, the code never forms D · (1 / D).
+fn per_unit_rate(g: &mut Graph, d_inverse: Id, u: Force, kind: JointKind, axis: [f64; 3]) -> Force {
+    let mut w = scale_force(g, d_inverse, u);
+    let k = (0..3)
+        .find(|&k| axis[k].abs() == 1.0 && axis[(k + 1) % 3] == 0.0 && axis[(k + 2) % 3] == 0.0);
+    if let Some(k) = k {
+        let unit = g.constant(axis[k]);
+        match kind {
+            JointKind::Revolute => w.n[k] = unit,
+            JointKind::Prismatic => w.f[k] = unit,
+        }
+    }
+    w
 }
 
 /// I − U Wᵀ (W = U / D), symmetric: only the upper triangles of A and C are computed.

@@ -21,12 +21,12 @@
 // | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
 // | `velocity_terms` | 60 | 72 | 0 | 0 | 0 | 1 | 133 |
-// | `articulated_terms` | 119 | 141 | 4 | 0 | 0 | 1 | 265 |
-// | `articulated_response` | 24 | 31 | 0 | 0 | 0 | 0 | 55 |
+// | `articulated_terms` | 119 | 135 | 4 | 0 | 0 | 1 | 259 |
+// | `articulated_response` | 24 | 29 | 0 | 0 | 0 | 0 | 53 |
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
 // Forward dynamics: the articulated-body sweeps (as asked). Estimated operations per right-hand side:
-// dense 238, articulated 441 (the position level, common to both, not included).
+// dense 238, articulated 435 (the position level, common to both, not included).
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -1086,7 +1086,7 @@ impl rt::Dynamics for Model {
         assert!(cache.len() >= 19);
         assert!(out.qdd.len() >= 4);
         assert!(! out.bias.is_empty());
-        assert!(out.factors.len() >= 18);
+        assert!(out.factors.len() >= 16);
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
@@ -1177,8 +1177,8 @@ impl rt::Dynamics for Model {
         let factors_5_t1 = rel_rot_body4_11 * neg_rel_rot_body4_12;
         let articulated_d_q3_t1 = 0.18367346938775508
             * (0.5 - neg_rel_rot_body4_12 * neg_rel_rot_body4_12);
-        let factors_11_t1 = 0.18367346938775508 * factors_5_t1;
-        let factors_12_t1 = 0.9081632653061225 - articulated_d_q3_t1;
+        let factors_10_t1 = 0.18367346938775508 * factors_5_t1;
+        let factors_11_t1 = 0.9081632653061225 - articulated_d_q3_t1;
         let factors_9_t1 = 0.055102040816326525 * factors_5_t1;
         let articulated_d_q3 = 1.9081632653061225 + articulated_d_q3_t1;
         let qdd_1_t2 = neg_rel_rot_body4_12 * qdd_2_t1 + rel_rot_body4_11 * qdd_2_t2;
@@ -1187,29 +1187,27 @@ impl rt::Dynamics for Model {
         let factors_9_t2 = 1.0 / articulated_d_q3;
         let qdd_2_t4 = q3_dot + 40.0 * q3 + qdd_2_t3;
         let row_rate_q2_t1 = factors_9_t1 * factors_9_t2;
-        let row_rate_q1_t1 = articulated_d_q3 * factors_9_t2;
-        let factors_12_t2 = factors_11_t1 * factors_9_t2;
-        let factors_12_t3 = 1.9081632653061225 - articulated_d_q3_t1
-            - factors_11_t1 * factors_12_t2;
-        let factors_12_t4 = 0.15 + 0.3 * factors_12_t1 - factors_9_t1 * factors_12_t2;
-        let qdd_1_t3 = qdd_1_t1 + qdd_1_t2 - qdd_2_t4 * factors_12_t2;
+        let factors_11_t2 = factors_10_t1 * factors_9_t2;
+        let factors_11_t3 = 1.9081632653061225 - articulated_d_q3_t1
+            - factors_10_t1 * factors_11_t2;
+        let factors_11_t4 = 0.15 + 0.3 * factors_11_t1 - factors_9_t1 * factors_11_t2;
+        let qdd_1_t3 = qdd_1_t1 + qdd_1_t2 - qdd_2_t4 * factors_11_t2;
         // body2: articulated inertia and bias force (joint q2)
         let qdd_1_t4 = minus_g_body2_y + acc_body2_y;
-        let factors_12_t5 = factors_12_t4 + offset_body3_x * factors_12_t3;
-        let factors_16_t1 = 0.025 + factors_12_t5;
+        let factors_11_t5 = factors_11_t4 + offset_body3_x * factors_11_t3;
+        let factors_14_t1 = 0.025 + factors_11_t5;
         let articulated_d_q2 = 0.01125
-            + (offset_body3_x * factors_12_t5
-                + (0.1225 + 0.09 * factors_12_t1 - factors_9_t1 * row_rate_q2_t1
-                    + offset_body3_x * factors_12_t4));
+            + (offset_body3_x * factors_11_t5
+                + (0.1225 + 0.09 * factors_11_t1 - factors_9_t1 * row_rate_q2_t1
+                    + offset_body3_x * factors_11_t4));
         let qdd_1_t5 = 0.025 * qdd_1_t4
             + (0.15 * qdd_1_t1 + (qdd_3_t2 - qdd_3_t3 + 0.3 * qdd_1_t2)
                 - qdd_2_t4 * row_rate_q2_t1 + offset_body3_x * qdd_1_t3);
-        let factors_15_t1 = 1.0 / articulated_d_q2;
+        let factors_14_t2 = 1.0 / articulated_d_q2;
         let qdd_1_t6 = q2_dot + 15.0 * q2 + qdd_1_t5;
-        let row_rate_q1_t2 = articulated_d_q2 * factors_15_t1;
-        let articulated_d_q1_t1 = factors_16_t1 * factors_15_t1;
-        let articulated_d_q1_t2 = 0.5 + factors_12_t3
-            - factors_16_t1 * articulated_d_q1_t1;
+        let articulated_d_q1_t1 = factors_14_t1 * factors_14_t2;
+        let articulated_d_q1_t2 = 0.5 + factors_11_t3
+            - factors_14_t1 * articulated_d_q1_t1;
         // body1: articulated inertia and bias force (joint q1)
         let articulated_d_q1 = 0.1225
             + 0.09
@@ -1217,10 +1215,10 @@ impl rt::Dynamics for Model {
                     - (0.5 - neg_rel_rot_body2_12 * neg_rel_rot_body2_12)
                         * (0.5 - articulated_d_q1_t2));
         let qdd_0_t1 = 1.4715 * c_q1
-            + (qdd_1_t5 - qdd_1_t6 * row_rate_q1_t2
+            + (qdd_1_t5 - qdd_1_t6
                 + 0.3
                     * (neg_rel_rot_body2_12
-                        * (qdd_2_t3 - qdd_2_t4 * row_rate_q1_t1
+                        * (qdd_2_t3 - qdd_2_t4
                             + (0.5 * (minus_g_body2_x - neg_acc_body2_x)
                                 - neg_centripetal_force_body2_x))
                         + rel_rot_body2_11
@@ -1239,23 +1237,22 @@ impl rt::Dynamics for Model {
         let row_rate_q3_t2 = row_rate_q3_t1 * neg_rel_rot_body4_12;
         let row_rate_q2_t2 = row_rate_q3_t1 * rel_rot_body4_11;
         let row_rate_q3 = row_q3 + row_rate_q3_t2;
-        let row_rate_q2_t3 = row_rate_q2_t2 + factors_12_t2 * row_rate_q3;
+        let row_rate_q2_t3 = row_rate_q2_t2 + factors_11_t2 * row_rate_q3;
         // body2: the solved row's J (backward sweep)
         let row_rate_q2_t4 = row_q4 + 0.3 * row_rate_q2_t2 + row_rate_q2_t1 * row_rate_q3
             + offset_body3_x * row_rate_q2_t3;
         let row_rate_q2 = row_q2 - row_rate_q2_t4;
         // body1: the solved row's J (backward sweep)
         let row_rate_q1 = row_q1
-            - (row_rate_q2_t4 + row_rate_q1_t2 * row_rate_q2
+            - (row_rate_q2_t4 + row_rate_q2
                 + 0.3
-                    * (neg_rel_rot_body2_12
-                        * (row_rate_q1_t1 * row_rate_q3 - row_rate_q3_t2)
+                    * (neg_rel_rot_body2_12 * (row_rate_q3 - row_rate_q3_t2)
                         + rel_rot_body2_11
                             * (row_rate_q2_t3 + articulated_d_q1_t1 * row_rate_q2)));
         // the solved row's multiplier
         let row_delassus_t1 = 8.16326530612245 * row_q4;
         let row_delassus_t2 = qdd_0_t2 * row_rate_q1;
-        let row_delassus_t3 = factors_15_t1 * row_rate_q2;
+        let row_delassus_t3 = factors_14_t2 * row_rate_q2;
         let row_delassus_t4 = factors_9_t2 * row_rate_q3;
         let row_delassus = row_q4 * row_delassus_t1
             + (row_rate_q1 * row_delassus_t2 + row_rate_q2 * row_delassus_t3
@@ -1270,8 +1267,8 @@ impl rt::Dynamics for Model {
         let qdd_1_t7 = 0.3 * qdd_0_t3;
         let qdd_2_t5 = neg_rel_rot_body2_12 * qdd_1_t7;
         let qdd_1_t8 = rel_rot_body2_11 * qdd_1_t7;
-        let qdd_2_t6 = factors_15_t1
-            * (articulated_d_q2 * qdd_0_t3 + factors_16_t1 * qdd_1_t8
+        let qdd_2_t6 = factors_14_t2
+            * (articulated_d_q2 * qdd_0_t3 + factors_14_t1 * qdd_1_t8
                 - (qdd_1_t6 + row_rate_q2 * row_lambda));
         let qdd_2_t7 = qdd_2_t6 - qdd_0_t3;
         // body3: acceleration of joint q3 with the row's force
@@ -1279,7 +1276,7 @@ impl rt::Dynamics for Model {
         let qdd_2_t9 = factors_9_t2
             * (qdd_2_t4 + row_rate_q3 * row_lambda
                 + (factors_9_t1 * qdd_2_t7
-                    + (factors_11_t1 * qdd_2_t8 - articulated_d_q3 * qdd_2_t5)));
+                    + (factors_10_t1 * qdd_2_t8 - articulated_d_q3 * qdd_2_t5)));
         out.qdd[0] = -qdd_0_t3;
         out.qdd[1] = qdd_2_t6;
         out.qdd[2] = -qdd_2_t9;
@@ -1297,19 +1294,17 @@ impl rt::Dynamics for Model {
         out.factors[2] = neg_rel_rot_body2_12;
         out.factors[3] = rel_rot_body4_11;
         out.factors[4] = neg_rel_rot_body4_12;
-        out.factors[5] = factors_11_t1;
+        out.factors[5] = factors_10_t1;
         out.factors[6] = factors_9_t1;
         out.factors[7] = articulated_d_q3;
         out.factors[8] = factors_9_t2;
         out.factors[9] = row_rate_q2_t1;
-        out.factors[10] = row_rate_q1_t1;
-        out.factors[11] = factors_12_t2;
-        out.factors[12] = factors_16_t1;
-        out.factors[13] = articulated_d_q2;
-        out.factors[14] = factors_15_t1;
-        out.factors[15] = row_rate_q1_t2;
-        out.factors[16] = articulated_d_q1_t1;
-        out.factors[17] = qdd_0_t2;
+        out.factors[10] = factors_11_t2;
+        out.factors[11] = factors_14_t1;
+        out.factors[12] = articulated_d_q2;
+        out.factors[13] = factors_14_t2;
+        out.factors[14] = articulated_d_q1_t1;
+        out.factors[15] = qdd_0_t2;
     }
     /// M_ff⁻¹ τ on the free coordinates and M_df M_ff⁻¹ τ on the driven ones, from the factors of the last `articulated_terms`.
     fn articulated_response(
@@ -1319,7 +1314,7 @@ impl rt::Dynamics for Model {
         qdd: &mut [f64],
         _drive: &mut [f64],
     ) {
-        assert!(factors.len() >= 18);
+        assert!(factors.len() >= 16);
         assert!(tau.len() >= 4);
         assert!(qdd.len() >= 4);
         // body2: joint q2, rotation, velocities and accelerations
@@ -1340,16 +1335,14 @@ impl rt::Dynamics for Model {
         let articulated_d_q3 = factors[7];
         let qdd_2_t3 = factors[8];
         let qdd_1_t1 = factors[9];
-        let qdd_0_t1 = factors[10];
-        let qdd_1_t2 = factors[11];
+        let qdd_1_t2 = factors[10];
         // body2: articulated inertia and bias force (joint q2)
-        let qdd_1_t3 = factors[12];
-        let articulated_d_q2 = factors[13];
-        let qdd_1_t4 = factors[14];
-        let qdd_0_t2 = factors[15];
-        let qdd_0_t3 = factors[16];
+        let qdd_1_t3 = factors[11];
+        let articulated_d_q2 = factors[12];
+        let qdd_1_t4 = factors[13];
+        let qdd_0_t1 = factors[14];
         // body1: articulated inertia and bias force (joint q1)
-        let qdd_0_t4 = factors[17];
+        let qdd_0_t2 = factors[15];
         // body4: response to a generalised force (backward sweep)
         let qdd_2_t4 = 1.2244897959183674 * tau_q4;
         // body3: response to a generalised force (backward sweep)
@@ -1362,12 +1355,12 @@ impl rt::Dynamics for Model {
             + offset_body3_x * qdd_1_t6;
         let qdd_1_t8 = tau_q2 - qdd_1_t7;
         // body1: response to a generalised force (forward sweep)
-        let qdd_1_t9 = qdd_0_t4
+        let qdd_1_t9 = qdd_0_t2
             * (tau_q1
-                - (qdd_1_t7 + qdd_0_t2 * qdd_1_t8
+                - (qdd_1_t7 + qdd_1_t8
                     + 0.3
-                        * (neg_rel_rot_body2_12 * (qdd_0_t1 * qdd_2_t6 - qdd_2_t5)
-                            + rel_rot_body2_11 * (qdd_1_t6 + qdd_0_t3 * qdd_1_t8))));
+                        * (neg_rel_rot_body2_12 * (qdd_2_t6 - qdd_2_t5)
+                            + rel_rot_body2_11 * (qdd_1_t6 + qdd_0_t1 * qdd_1_t8))));
         // body2: response to a generalised force (forward sweep)
         let qdd_1_t10 = 0.3 * qdd_1_t9;
         let qdd_2_t7 = neg_rel_rot_body2_12 * qdd_1_t10;
@@ -1393,7 +1386,7 @@ impl rt::Dynamics for Model {
     }
     /// Entries of the factors `articulated_terms` writes for `articulated_response`.
     fn articulated_len(&self) -> usize {
-        18
+        16
     }
     /// `articulated_terms` solves the model's one constraint row when given it.
     fn articulated_rows(&self) -> usize {
@@ -1547,7 +1540,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("damper_power", [2, 0, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
     ("velocity_terms", [60, 72, 0, 0, 0, 1]),
-    ("articulated_terms", [119, 141, 4, 0, 0, 1]),
-    ("articulated_response", [24, 31, 0, 0, 0, 0]),
+    ("articulated_terms", [119, 135, 4, 0, 0, 1]),
+    ("articulated_response", [24, 29, 0, 0, 0, 0]),
     ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
 ];
