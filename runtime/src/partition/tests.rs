@@ -119,6 +119,43 @@ fn conditioning_is_the_normalised_pivot() {
 }
 
 #[test]
+fn max_abs_is_the_largest_magnitude_and_nan_wherever_a_nan_stands() {
+    use super::linalg::max_abs;
+    assert_eq!(max_abs(&[]), 0.0);
+    for n in 1..12 {
+        let x: Vec<f64> = (0..n)
+            .map(|i| (i as f64 - 4.5) * if i % 2 == 0 { 1.0 } else { -1.3 })
+            .collect();
+        let expected = x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        assert_eq!(max_abs(&x), expected, "{x:?}");
+        assert_eq!(
+            max_abs(&[x.clone(), vec![f64::NEG_INFINITY]].concat()),
+            f64::INFINITY
+        );
+        for k in 0..n {
+            let mut y = x.clone();
+            y[k] = f64::NAN;
+            assert!(max_abs(&y).is_nan(), "NaN at {k} of {n}");
+        }
+    }
+}
+
+#[test]
+fn a_row_for_the_sweeps_is_given_whole_or_not_at_all() {
+    use crate::dynamics::{row_entry, row_weight};
+    assert_eq!(row_weight(&[], 3), 0.0);
+    assert_eq!(row_weight(&[1.0, 2.0, 3.0], 3), 1.0);
+    assert_eq!(row_entry(&[], 2), 0.0);
+    assert_eq!(row_entry(&[1.0, 2.0, 3.0], 2), 3.0);
+    let short = std::panic::catch_unwind(|| row_weight(&[1.0, 2.0], 3));
+    let message = short.expect_err("a row of 2 for 3 coordinates is refused");
+    let text = message
+        .downcast_ref::<String>()
+        .expect("a formatted message");
+    assert!(text.contains("has 2 entries, not 3"), "{text}");
+}
+
+#[test]
 fn lu_and_cholesky_solve_like_nalgebra() {
     let mut numbers = Numbers(7);
     for n in 1..6 {
