@@ -648,9 +648,9 @@ fn clear_joint_direction(g: &mut Graph, i: &mut Articulated, kind: JointKind, ax
 /// Rotated, A' = R A Rᵀ, B' = R B Rᵀ, C' = R C Rᵀ; then moved by r (the child's joint point
 /// in the parent's frame): C_p = C', B_p = B' + r̃ C', A_p = A' + r̃ B'ᵀ − B_p r̃.
 fn inertia_to_parent(g: &mut Graph, child: &BodyKinematics, i: &Articulated) -> Articulated {
-    let a = rotate(g, child, &i.a, true);
-    let b = rotate(g, child, &i.b, false);
-    let c = rotate(g, child, &i.c, true);
+    let a = rotation::rotate(g, child, &i.a, true);
+    let b = rotation::rotate(g, child, &i.b, false);
+    let c = rotation::rotate(g, child, &i.c, true);
     let r = child.offset;
     // r̃ M, column by column: r × M[:, j].
     let cross_columns = |g: &mut Graph, m: &[V3; 3]| -> [V3; 3] {
@@ -680,101 +680,6 @@ fn inertia_to_parent(g: &mut Graph, child: &BodyKinematics, i: &Articulated) -> 
         }
     }
     Articulated { a: ap, b: bp, c }
-}
-
-/// R M Rᵀ for the child's joint rotation (the upper triangle only, mirrored, when M is
-/// symmetric).
-fn rotate(g: &mut Graph, child: &BodyKinematics, m: &[V3; 3], symmetric: bool) -> [V3; 3] {
-    if child.relative == crate::kinematics::Rotation::Identity {
-        return *m;
-    }
-    let r = child.relative.matrix(g);
-    if let Some((k, c, s)) = plane_rotation(g, &r) {
-        return rotate_in_plane(g, m, k, (c, s), symmetric);
-    }
-    let rm: Vec<V3> = (0..3)
-        .map(|a| [0, 1, 2].map(|j| vec3::dot(g, r[a], [m[0][j], m[1][j], m[2][j]])))
-        .collect();
-    let mut out = *m;
-    for a in 0..3 {
-        for b in 0..3 {
-            if symmetric && b < a {
-                continue;
-            }
-            let e = vec3::dot(g, rm[a], r[b]);
-            out[a][b] = e;
-            if symmetric {
-                out[b][a] = e;
-            }
-        }
-    }
-    out
-}
-
-/// (k, c, s) when `r` turns about coordinate axis k only: rows i = k + 1 and j = k + 2
-/// (mod 3) hold [[c, −s], [s, c]] in columns i, j, and row and column k are e_k.
-fn plane_rotation(g: &mut Graph, r: &[V3; 3]) -> Option<(usize, Id, Id)> {
-    let (zero, one) = (g.zero(), g.one());
-    (0..3).find_map(|k| {
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        let (c, s) = (r[i][i], r[j][i]);
-        let fixed = r[k][k] == one && [r[k][i], r[k][j], r[i][k], r[j][k]] == [zero; 4];
-        (fixed && r[j][j] == c && r[i][j] == g.neg(s)).then_some((k, c, s))
-    })
-}
-
-/// R M Rᵀ for R turning by φ (cos φ = c, sin φ = s) in the plane (i, j) of coordinate axis
-/// k, by the double angle: writing M's (i, j) block p 1 + m D + u E + v J (D = diag(1, −1),
-/// E = [[0, 1], [1, 0]], J = [[0, 1], [−1, 0]]), the rotation leaves p and v and turns
-/// (m, u) by 2φ; the entries between k and the plane turn by φ. 16 operations for a
-/// symmetric M and 26 for a general one, against 27 and 36 as two matrix products, and 3
-/// per joint for cos 2φ / 2 and sin 2φ / 2, shared by the three blocks of an inertia.
-fn rotate_in_plane(
-    g: &mut Graph,
-    m: &[V3; 3],
-    k: usize,
-    (c, s): (Id, Id),
-    symmetric: bool,
-) -> [V3; 3] {
-    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-    let half = g.constant(0.5);
-    let ss = g.mul(s, s);
-    let c2 = g.sub(half, ss); // cos 2φ / 2
-    let s2 = g.mul(c, s); // sin 2φ / 2
-    let (a, b, d, e) = (m[i][i], m[i][j], m[j][i], m[j][j]);
-    let dm = g.sub(a, e); // 2 m
-    let su = g.add(b, d); // 2 u
-    let (x, y) = (g.mul(dm, c2), g.mul(su, s2));
-    let m2 = g.sub(x, y); // m′ = m cos 2φ − u sin 2φ
-    let (x, y) = (g.mul(dm, s2), g.mul(su, c2));
-    let u2 = g.add(x, y); // u′ = m sin 2φ + u cos 2φ
-    let sum = g.add(a, e);
-    let p = g.mul(half, sum);
-    let mut out = *m;
-    out[i][i] = g.add(p, m2);
-    out[j][j] = g.sub(p, m2);
-    if symmetric {
-        out[i][j] = u2;
-        out[j][i] = u2;
-    } else {
-        let diff = g.sub(b, d);
-        let v = g.mul(half, diff);
-        out[i][j] = g.add(u2, v);
-        out[j][i] = g.sub(u2, v);
-    }
-    // Column k: (R m)_{·k}; row k: (m Rᵀ)_{k·}.
-    let turn = |g: &mut Graph, x: Id, y: Id| -> (Id, Id) {
-        let (cx, sy) = (g.mul(c, x), g.mul(s, y));
-        let (sx, cy) = (g.mul(s, x), g.mul(c, y));
-        (g.sub(cx, sy), g.add(sx, cy))
-    };
-    (out[i][k], out[j][k]) = turn(g, m[i][k], m[j][k]);
-    if symmetric {
-        (out[k][i], out[k][j]) = (out[i][k], out[j][k]);
-    } else {
-        (out[k][i], out[k][j]) = turn(g, m[k][i], m[k][j]);
-    }
-    out
 }
 
 fn add(g: &mut Graph, x: &Articulated, y: &Articulated) -> Articulated {
@@ -819,6 +724,7 @@ fn mat_vec(g: &mut Graph, m: &[V3; 3], v: V3) -> V3 {
     crate::dynamics::mat_vec(g, m, v)
 }
 
+mod rotation;
 mod row;
 #[cfg(test)]
 mod tests;

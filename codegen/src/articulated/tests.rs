@@ -243,35 +243,15 @@ fn a_turn_about_a_coordinate_axis_by_the_double_angle_is_r_m_rt() {
             let mut axis = [0.0; 3];
             axis[k] = sign;
             let r = Rotation::Axis { axis, angle }.matrix(&mut g);
-            let (turned, c, s) = super::plane_rotation(&mut g, &r).expect("a coordinate axis");
+            let (turned, c, s) =
+                super::rotation::plane_rotation(&mut g, &r).expect("a coordinate axis");
             assert_eq!(turned, k);
             for symmetric in [false, true] {
-                let value = |a: usize, b: usize| {
-                    let (a, b) = if symmetric {
-                        (a.min(b), a.max(b))
-                    } else {
-                        (a, b)
-                    };
-                    number(7, 3 * a + b)
-                };
-                let m = [0, 1, 2].map(|a| [0, 1, 2].map(|b| g.constant(value(a, b))));
-                let out = super::rotate_in_plane(&mut g, &m, k, (c, s), symmetric);
-                let roots: Vec<Id> = out
-                    .iter()
-                    .flatten()
-                    .chain(r.iter().flatten())
-                    .copied()
-                    .collect();
-                let values = g.eval(&roots, &[phi]);
-                let got = DMatrix::from_row_slice(3, 3, &values[..9]);
-                let rot = DMatrix::from_row_slice(3, 3, &values[9..]);
-                let m = DMatrix::from_fn(3, 3, value);
-                let want = &rot * m * rot.transpose();
+                let (m, values) = test_block(&mut g, 7, symmetric);
+                let out = super::rotation::rotate_in_plane(&mut g, &m, k, (c, s), symmetric);
                 // Both are sums of a few products of numbers below 1: round-off ~1e-16.
-                assert!(
-                    (got - &want).amax() < 1e-14,
-                    "axis {k}, sign {sign}, {symmetric}"
-                );
+                let error = turned_error(&g, &out, &r, &values, phi);
+                assert!(error < 1e-14, "axis {k}, sign {sign}, {symmetric}");
             }
         }
     }
@@ -284,5 +264,80 @@ fn a_turn_about_a_coordinate_axis_by_the_double_angle_is_r_m_rt() {
         angle,
     }
     .matrix(&mut g);
-    assert!(super::plane_rotation(&mut g, &r).is_none());
+    assert!(super::rotation::plane_rotation(&mut g, &r).is_none());
+}
+
+/// A 3 × 3 block of numbers below 1 as constants (symmetric when asked), and its values.
+fn test_block(
+    g: &mut crate::expr::Graph,
+    seed: u64,
+    symmetric: bool,
+) -> ([crate::kinematics::V3; 3], DMatrix<f64>) {
+    let value = |a: usize, b: usize| {
+        let (a, b) = if symmetric {
+            (a.min(b), a.max(b))
+        } else {
+            (a, b)
+        };
+        number(seed, 3 * a + b)
+    };
+    let m = [0, 1, 2].map(|a| [0, 1, 2].map(|b| g.constant(value(a, b))));
+    (m, DMatrix::from_fn(3, 3, value))
+}
+
+/// max |out − R M Rᵀ| at the angle φ (the graph's one variable), R and out evaluated.
+fn turned_error(
+    g: &crate::expr::Graph,
+    out: &[crate::kinematics::V3; 3],
+    r: &[crate::kinematics::V3; 3],
+    m: &DMatrix<f64>,
+    phi: f64,
+) -> f64 {
+    let roots: Vec<Id> = out
+        .iter()
+        .flatten()
+        .chain(r.iter().flatten())
+        .copied()
+        .collect();
+    let values = g.eval(&roots, &[phi]);
+    let got = DMatrix::from_row_slice(3, 3, &values[..9]);
+    let rot = DMatrix::from_row_slice(3, 3, &values[9..]);
+    (got - &rot * m * rot.transpose()).amax()
+}
+
+#[test]
+fn a_turn_about_an_axis_in_a_coordinate_plane_is_r_m_rt() {
+    // Three turns about coordinate axes against R M Rᵀ with R from Rodrigues' formula, for
+    // axes in each coordinate plane (the 45° one has cos 2φ = 0 exactly) and both kinds of
+    // block; a general axis is left to the matrix product.
+    use crate::expr::Graph;
+    use crate::kinematics::Rotation;
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    for axis in [
+        [h, h, 0.0],
+        [-h, h, 0.0],
+        [0.6, 0.0, 0.8],
+        [0.0, -0.8, 0.6],
+        [0.28, 0.0, -0.96],
+    ] {
+        for symmetric in [false, true] {
+            let mut g = Graph::new();
+            let angle = g.var("phi");
+            let (m, values) = test_block(&mut g, 11, symmetric);
+            let out =
+                super::rotation::rotate_in_coordinate_plane(&mut g, &m, axis, angle, symmetric)
+                    .expect("an axis in a coordinate plane");
+            let r = Rotation::Axis { axis, angle }.matrix(&mut g);
+            // Three turns of numbers below 1 against two products: round-off ~1e-16.
+            let error = turned_error(&g, &out, &r, &values, 0.9);
+            assert!(error < 1e-14, "axis {axis:?}, {symmetric}");
+        }
+    }
+    let mut g = Graph::new();
+    let angle = g.var("phi");
+    let m = [[g.one(); 3]; 3];
+    let general = [0.48, 0.6, 0.64];
+    assert!(
+        super::rotation::rotate_in_coordinate_plane(&mut g, &m, general, angle, true).is_none()
+    );
 }
