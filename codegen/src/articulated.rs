@@ -258,9 +258,7 @@ pub fn articulated(
                 out.accelerations.push((i, qdd));
             }
             None => {
-                let rows = transmitted(g, model, kin, i, joint, after);
-                let passive = passive_load(g, model, s, i);
-                let load = g.add(rows, passive);
+                let load = drive_load(g, model, s, kin, (i, joint), after);
                 name(g, load, format!("drive_load_{}", names[i]));
                 out.drive_loads.push((i, load));
             }
@@ -512,6 +510,20 @@ fn transmitted(
     let ua = g.add(un, uf);
     let sp = project(g, model.bodies[i].joint.kind, kin[i].axis, joint.bias);
     g.add(ua, sp)
+}
+
+/// A driven joint's row of M q̈ + F + Q: [`transmitted`] plus its spring, damper and load.
+fn drive_load(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    kin: &[BodyKinematics],
+    (i, joint): (usize, &Joint),
+    after: Motion,
+) -> Id {
+    let rows = transmitted(g, model, kin, i, joint, after);
+    let passive = passive_load(g, model, s, i);
+    g.add(rows, passive)
 }
 
 /// Q's part from joint i's spring, damper and applied load: k (q − rest) + c q̇ − τ.

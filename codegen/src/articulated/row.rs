@@ -26,8 +26,8 @@
 //! (1 when the row is given, 0 when not) makes λ = w · num / (den + 1 − w): without the
 //! row (a contact the runtime does not solve) the same code gives q̈⁰, as ũ and λ are 0.
 
-use super::{ArticulatedTerms, Joint, backward_of, forward_of, passive_load, project};
-use super::{add_force, scale_force, transmitted};
+use super::{ArticulatedTerms, Joint, backward_of, drive_load, forward_of, project};
+use super::{add_force, scale_force};
 use crate::expr::{Graph, Id};
 use crate::kinematics::{BodyKinematics, Symbols};
 use crate::model::Model;
@@ -111,10 +111,8 @@ pub(super) fn solve_within(
         |g, i, joint, qdd, after| match joint.d_inverse {
             Some(_) => out.solved_accelerations.push((i, qdd)),
             None => {
-                let rows = transmitted(g, model, kin, i, joint, after);
-                let passive = passive_load(g, model, s, i);
+                let load = drive_load(g, model, s, kin, (i, joint), after);
                 let pushed = g.mul(lambda, row[i]);
-                let load = g.add(rows, passive);
                 out.solved_drive_loads.push((i, g.add(load, pushed)));
             }
         },
