@@ -96,7 +96,7 @@
 //! `camchain-runtime` directly sets [`Config::runtime_path`] to `::camchain_runtime`.
 
 pub use camchain_codegen::ParameterMode;
-use camchain_codegen::{EmitOptions, ModelError, generate_source, read_model_file};
+use camchain_codegen::{EmitOptions, ModelError, generate_source_and_model, read_model_file};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -440,14 +440,7 @@ impl Config {
         }
         let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
         options.files_dir = Some(dir.clone());
-        let generated = generate_source(&text, shown, &options)?;
-        let model = camchain_codegen::schema::parse_model_from(
-            &text,
-            shown,
-            &[],
-            options.parameters,
-            camchain_codegen::schema::Files::In(&dir),
-        )?;
+        let (generated, model) = generate_source_and_model(&text, shown, &options)?;
         for named in &model.files {
             self.rerun_if_changed(&named.path);
         }

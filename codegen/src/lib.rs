@@ -117,6 +117,16 @@ pub fn generate_source(
     display: &Path,
     options: &EmitOptions,
 ) -> Result<Generated, ModelError> {
+    generate_source_and_model(source, display, options).map(|(generated, _)| generated)
+}
+
+/// [`generate_source`], also handing back the validated model (its files, its warnings):
+/// a build script reads them without parsing and validating the file a second time.
+pub fn generate_source_and_model(
+    source: &str,
+    display: &Path,
+    options: &EmitOptions,
+) -> Result<(Generated, Model), ModelError> {
     let files = match &options.files_dir {
         Some(dir) => schema::Files::In(dir),
         None => schema::Files::BesideModel,
@@ -137,6 +147,7 @@ pub fn generate_source(
     }
     let derivation = derive_and_assemble(&model, source, display, options.node_limit)?;
     let shown = display.to_string_lossy().replace('\\', "/");
-    emit::generate_from(&model, derivation, &shown, options)
-        .map_err(|message| unlocated(display, message))
+    let generated = emit::generate_from(&model, derivation, &shown, options)
+        .map_err(|message| unlocated(display, message))?;
+    Ok((generated, model))
 }

@@ -108,10 +108,11 @@ pub fn compile(
         }),
         ..EmitOptions::default()
     };
-    let generated = camchain_codegen::generate_source(&text, path, &options)
-        .map_err(|e| Failure::Model(e.into()))?;
-    let description =
-        camchain_codegen::check_source(&text, path).map_err(|e| Failure::Model(e.into()))?;
+    // The model as validated for the generation (its parameters as declared, its files read
+    // beside it): the same one `check_source` would validate a second time.
+    let (generated, description) =
+        camchain_codegen::generate_source_and_model(&text, path, &options)
+            .map_err(|e| Failure::Model(e.into()))?;
     let info = camchain_reference::NumericModel::new(description.clone())
         .info()
         .clone();
