@@ -438,8 +438,7 @@ impl Config {
         if self.embed_source {
             options.embedded_source = Some(text.clone());
         }
-        let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
-        options.files_dir = Some(dir.clone());
+        options.files_dir = Some(file.parent().unwrap_or(Path::new("")).to_path_buf());
         let (generated, model) = generate_source_and_model(&text, shown, &options)?;
         for named in &model.files {
             self.rerun_if_changed(&named.path);
