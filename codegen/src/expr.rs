@@ -222,6 +222,11 @@ impl Graph {
         self.nodes[id.index()]
     }
 
+    /// The id of `node` if the graph holds it.
+    pub fn find(&self, node: Node) -> Option<Id> {
+        self.index.get(&node).copied()
+    }
+
     fn intern(&mut self, node: Node) -> Id {
         if let Some(&id) = self.index.get(&node) {
             return id;

@@ -1,4 +1,6 @@
-//! sin and cos of one angle together, for the generated code's joint angles.
+//! sin and cos of one angle together, for the generated code: its joint angles (through
+//! `sin_cos_memo`) and every other angle whose sine and cosine a function needs both (a cam's
+//! angle, a roller's contact parameter, a drive's phase).
 //!
 //! The C library's `sincos` is a call through the dynamic linker that also saves and
 //! restores the floating-point environment; in the 16-body chain's right-hand side its 13

@@ -529,8 +529,7 @@ impl rt::Dynamics for Model {
         let cam_angle = q[0];
         let lift = q[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
-        let c_cam_angle = cam_angle.cos();
-        let s_cam_angle = cam_angle.sin();
+        let (s_cam_angle, c_cam_angle) = rt::trig::sin_cos(cam_angle);
         // contact roller: the follower seen from the cam, h, J, c
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
@@ -557,7 +556,9 @@ impl rt::Dynamics for Model {
                 s_try,
             ),
         );
-        let c_roller_parameter = roller_parameter.cos();
+        let (s_roller_parameter, c_roller_parameter) = rt::trig::sin_cos(
+            roller_parameter,
+        );
         let roller_law_at = eval_roller_law(-roller_parameter);
         let roller_law_d1 = roller_law_at[1];
         let roller_law = roller_law_at[0];
@@ -568,7 +569,6 @@ impl rt::Dynamics for Model {
         let roller_cx_t3 = roller_law_d1 * roller_cx_t2;
         let roller_cx_t4 = 0.0125 * roller_cx_t3;
         let roller_cx_t5 = c_roller_parameter * roller_cx_t4;
-        let s_roller_parameter = roller_parameter.sin();
         let roller_cy_t2 = roller_cx_t4 * s_roller_parameter;
         let roller_law_d2 = roller_law_at[2];
         let roller_cy_t3 = roller_cy_t1 * (1.0 - 0.0125 * roller_cx_t2);
@@ -603,8 +603,7 @@ impl rt::Dynamics for Model {
         let cam_angle = q[0];
         let lift = q[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
-        let c_cam_angle = cam_angle.cos();
-        let s_cam_angle = cam_angle.sin();
+        let (s_cam_angle, c_cam_angle) = rt::trig::sin_cos(cam_angle);
         // contact roller: the follower seen from the cam, h, J, c
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
@@ -631,7 +630,9 @@ impl rt::Dynamics for Model {
                 s_try,
             ),
         );
-        let c_roller_parameter = roller_parameter.cos();
+        let (s_roller_parameter, c_roller_parameter) = rt::trig::sin_cos(
+            roller_parameter,
+        );
         let roller_law_at = eval_roller_law(-roller_parameter);
         let roller_law_d1 = roller_law_at[1];
         let roller_law = roller_law_at[0];
@@ -642,7 +643,6 @@ impl rt::Dynamics for Model {
         let roller_dcy_t2 = 1.0 / roller_dcy_t1;
         let roller_dcy_t3 = roller_law_d1 * roller_dcy_t2;
         let roller_dcy_t4 = 0.0125 * roller_dcy_t3;
-        let s_roller_parameter = roller_parameter.sin();
         let roller_law_d2 = roller_law_at[2];
         let roller_dcx_t2 = roller_dcx_t1 * (1.0 - 0.0125 * roller_dcy_t2);
         let roller_dcx_t3 = roller_dcy_t2 / roller_dcy_t1
@@ -675,8 +675,7 @@ impl rt::Dynamics for Model {
         let cam_angle_dot = qd[0];
         let lift_dot = qd[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
-        let c_cam_angle = cam_angle.cos();
-        let s_cam_angle = cam_angle.sin();
+        let (s_cam_angle, c_cam_angle) = rt::trig::sin_cos(cam_angle);
         let omega_camshaft_sq = cam_angle_dot * cam_angle_dot;
         // contact roller: the follower seen from the cam, h, J, c
         let roller_j1_cam_angle = lift * c_cam_angle;
@@ -711,7 +710,9 @@ impl rt::Dynamics for Model {
                 s_try,
             ),
         );
-        let c_roller_parameter = roller_parameter.cos();
+        let (s_roller_parameter, c_roller_parameter) = rt::trig::sin_cos(
+            roller_parameter,
+        );
         let roller_law_at = eval_roller_law(-roller_parameter);
         let roller_law_d1 = roller_law_at[1];
         let roller_law = roller_law_at[0];
@@ -722,7 +723,6 @@ impl rt::Dynamics for Model {
         let roller_cx_t3 = roller_law_d1 * roller_cx_t2;
         let roller_cx_t4 = 0.0125 * roller_cx_t3;
         let roller_cx_t5 = c_roller_parameter * roller_cx_t4;
-        let s_roller_parameter = roller_parameter.sin();
         let roller_cy_t2 = roller_cx_t4 * s_roller_parameter;
         let roller_law_d2 = roller_law_at[2];
         let roller_dcx_t1 = 2.0 * roller_cx_t1;
@@ -799,8 +799,7 @@ impl rt::Dynamics for Model {
         let cam_angle_dot = qd[0];
         let lift_dot = qd[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
-        let c_cam_angle = cam_angle.cos();
-        let s_cam_angle = cam_angle.sin();
+        let (s_cam_angle, c_cam_angle) = rt::trig::sin_cos(cam_angle);
         let omega_camshaft_sq = cam_angle_dot * cam_angle_dot;
         // contact roller: the follower seen from the cam, h, J, c
         let roller_j1_cam_angle = lift * c_cam_angle;
@@ -835,7 +834,9 @@ impl rt::Dynamics for Model {
                 s_try,
             ),
         );
-        let c_roller_parameter = roller_parameter.cos();
+        let (s_roller_parameter, c_roller_parameter) = rt::trig::sin_cos(
+            roller_parameter,
+        );
         let roller_law_at = eval_roller_law(-roller_parameter);
         let roller_law_d1 = roller_law_at[1];
         let roller_law = roller_law_at[0];
@@ -846,7 +847,6 @@ impl rt::Dynamics for Model {
         let roller_cx_t3 = roller_law_d1 * roller_cx_t2;
         let roller_cx_t4 = 0.0125 * roller_cx_t3;
         let roller_cx_t5 = c_roller_parameter * roller_cx_t4;
-        let s_roller_parameter = roller_parameter.sin();
         let roller_cy_t2 = roller_cx_t4 * s_roller_parameter;
         let roller_law_d2 = roller_law_at[2];
         let roller_dcx_t1 = 2.0 * roller_cx_t1;
@@ -924,8 +924,7 @@ impl rt::Dynamics for Model {
         let cam_angle_dot = qd[0];
         let lift_dot = qd[1];
         // camshaft: joint cam_angle, rotation, velocities and accelerations
-        let c_cam_angle = cam_angle.cos();
-        let s_cam_angle = cam_angle.sin();
+        let (s_cam_angle, c_cam_angle) = rt::trig::sin_cos(cam_angle);
         // contact roller: the follower seen from the cam, h, J, c
         let roller_j1_cam_angle = lift * c_cam_angle;
         let neg_roller_j2_cam_angle = lift * s_cam_angle;
@@ -956,7 +955,9 @@ impl rt::Dynamics for Model {
                 s_try,
             ),
         );
-        let c_roller_parameter = roller_parameter.cos();
+        let (s_roller_parameter, c_roller_parameter) = rt::trig::sin_cos(
+            roller_parameter,
+        );
         let roller_law_at = eval_roller_law(-roller_parameter);
         let roller_law_d1 = roller_law_at[1];
         let roller_law = roller_law_at[0];
@@ -967,7 +968,6 @@ impl rt::Dynamics for Model {
         let roller_cx_t3 = roller_law_d1 * roller_cx_t2;
         let roller_cx_t4 = 0.0125 * roller_cx_t3;
         let roller_cx_t5 = c_roller_parameter * roller_cx_t4;
-        let s_roller_parameter = roller_parameter.sin();
         let roller_cy_t2 = roller_cx_t4 * s_roller_parameter;
         let roller_law_d2 = roller_law_at[2];
         let roller_dcx_t1 = 2.0 * roller_cx_t1;
@@ -1378,8 +1378,7 @@ fn contact_kinematics_0(
     let cam_angle_dot = qd[0];
     let lift_dot = qd[1];
     // camshaft: joint cam_angle, rotation, velocities and accelerations
-    let c_cam_angle = cam_angle.cos();
-    let s_cam_angle = cam_angle.sin();
+    let (s_cam_angle, c_cam_angle) = rt::trig::sin_cos(cam_angle);
     let omega_camshaft_sq = cam_angle_dot * cam_angle_dot;
     // contact roller: the follower seen from the cam, h, J, c
     let roller_j1_cam_angle = lift * c_cam_angle;
@@ -1414,7 +1413,7 @@ fn contact_kinematics_0(
             s_try,
         ),
     );
-    let c_roller_parameter = roller_parameter.cos();
+    let (s_roller_parameter, c_roller_parameter) = rt::trig::sin_cos(roller_parameter);
     let roller_law_at = eval_roller_law(-roller_parameter);
     let roller_law_d1 = roller_law_at[1];
     let roller_law = roller_law_at[0];
@@ -1425,7 +1424,6 @@ fn contact_kinematics_0(
     let roller_cx_t3 = roller_law_d1 * roller_cx_t2;
     let roller_cx_t4 = 0.0125 * roller_cx_t3;
     let roller_cx_t5 = c_roller_parameter * roller_cx_t4;
-    let s_roller_parameter = roller_parameter.sin();
     let roller_cy_t2 = roller_cx_t4 * s_roller_parameter;
     let roller_law_d2 = roller_law_at[2];
     let roller_dcx_t1 = 2.0 * roller_cx_t1;
@@ -1521,7 +1519,7 @@ fn contact_kinematics_0(
 /// contact roller: the profile point nearest the roller's centre: ψ(s) and ψ′(s), whose root with ψ′ < 0 Newton finds.
 fn roller_parameter_residual(_derived: &Derived, x: f64, y: f64, s: f64) -> [f64; 2] {
     // contact roller: the follower seen from the cam, h, J, c
-    let c_s = s.cos();
+    let (s_s, c_s) = rt::trig::sin_cos(s);
     let roller_law_at = eval_roller_law(-s);
     let roller_law_d1 = roller_law_at[1];
     let roller_law = roller_law_at[0];
@@ -1532,7 +1530,6 @@ fn roller_parameter_residual(_derived: &Derived, x: f64, y: f64, s: f64) -> [f64
     let trial_cx_t3 = roller_law_d1 * trial_cx_t2;
     let trial_cx_t4 = 0.0125 * trial_cx_t3;
     let trial_cx_t5 = c_s * trial_cx_t4;
-    let s_s = s.sin();
     let trial_cy_t2 = trial_cy_t1 - 0.0125 * (trial_cy_t1 * trial_cx_t2);
     let trial_cx_t6 = s_s * trial_cy_t2;
     let trial_cx = trial_cx_t5 - trial_cx_t6;
@@ -1592,7 +1589,7 @@ fn roller_parameter_residual(_derived: &Derived, x: f64, y: f64, s: f64) -> [f64
 /// contact roller: the profile point nearest the roller's centre: the objective the root minimises (what a scan of the range compares).
 fn roller_parameter_objective(_derived: &Derived, x: f64, y: f64, s: f64) -> f64 {
     // contact roller: the follower seen from the cam, h, J, c
-    let c_s = s.cos();
+    let (s_s, c_s) = rt::trig::sin_cos(s);
     let roller_law_at = eval_roller_law(-s);
     let roller_law_d1 = roller_law_at[1];
     let roller_law = roller_law_at[0];
@@ -1600,7 +1597,6 @@ fn roller_parameter_objective(_derived: &Derived, x: f64, y: f64, s: f64) -> f64
     let trial_cx_t1 = (trial_cy_t1 * trial_cy_t1 + roller_law_d1 * roller_law_d1).sqrt();
     let trial_cx_t2 = 1.0 / trial_cx_t1;
     let trial_cx_t3 = 0.0125 * (roller_law_d1 * trial_cx_t2);
-    let s_s = s.sin();
     let trial_cy_t2 = trial_cy_t1 - 0.0125 * (trial_cy_t1 * trial_cx_t2);
     let trial_cx = c_s * trial_cx_t3 - s_s * trial_cy_t2;
     let trial_cy = trial_cx_t3 * s_s + c_s * trial_cy_t2;

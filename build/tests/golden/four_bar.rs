@@ -893,8 +893,7 @@ impl rt::Dynamics for Model {
         let omega_crank_sq = q_crank_dot * q_crank_dot;
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let neg_centripetal_coupler_x = a * omega_crank_sq;
-        let c_q_coupler = q_coupler.cos();
-        let s_q_coupler = q_coupler.sin();
+        let (s_q_coupler, c_q_coupler) = rt::trig::sin_cos(q_coupler);
         let acc_coupler_y = neg_centripetal_coupler_x * s_q_coupler;
         let omega_coupler_z = q_crank_dot + q_coupler_dot;
         let c_q_crank_q_coupler = (q_crank + q_coupler).cos();
@@ -961,17 +960,16 @@ impl rt::Dynamics for Model {
         let b = self.derived.b;
         let c_2 = self.derived.c;
         // crank: joint q_crank, rotation, velocities and accelerations
-        let c_q_crank = q_crank.cos();
-        let s_q_crank = q_crank.sin();
+        let (s_q_crank, c_q_crank) = rt::trig::sin_cos(q_crank);
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let angle_q_crank_q_coupler = q_crank + q_coupler;
-        let c_q_crank_q_coupler = angle_q_crank_q_coupler.cos();
-        let s_q_crank_q_coupler = angle_q_crank_q_coupler.sin();
+        let (s_q_crank_q_coupler, c_q_crank_q_coupler) = rt::trig::sin_cos(
+            angle_q_crank_q_coupler,
+        );
         let pos_coupler_x = a * c_q_crank;
         let pos_coupler_y = a * s_q_crank;
         // rocker: joint q_rocker, rotation, velocities and accelerations
-        let c_q_rocker = q_rocker.cos();
-        let s_q_rocker = q_rocker.sin();
+        let (s_q_rocker, c_q_rocker) = rt::trig::sin_cos(q_rocker);
         // loop pin: the cut revolute joint, h, J, c
         let loop_pin_a_segment_q_coupler_x = b * c_q_crank_q_coupler;
         let loop_pin_a_segment_q_coupler_y = b * s_q_crank_q_coupler;
@@ -998,17 +996,16 @@ impl rt::Dynamics for Model {
         let b = self.derived.b;
         let c_2 = self.derived.c;
         // crank: joint q_crank, rotation, velocities and accelerations
-        let c_q_crank = q_crank.cos();
-        let s_q_crank = q_crank.sin();
+        let (s_q_crank, c_q_crank) = rt::trig::sin_cos(q_crank);
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let angle_q_crank_q_coupler = q_crank + q_coupler;
-        let c_q_crank_q_coupler = angle_q_crank_q_coupler.cos();
-        let s_q_crank_q_coupler = angle_q_crank_q_coupler.sin();
+        let (s_q_crank_q_coupler, c_q_crank_q_coupler) = rt::trig::sin_cos(
+            angle_q_crank_q_coupler,
+        );
         let pos_coupler_x = a * c_q_crank;
         let pos_coupler_y = a * s_q_crank;
         // rocker: joint q_rocker, rotation, velocities and accelerations
-        let c_q_rocker = q_rocker.cos();
-        let s_q_rocker = q_rocker.sin();
+        let (s_q_rocker, c_q_rocker) = rt::trig::sin_cos(q_rocker);
         // loop pin: the cut revolute joint, h, J, c
         let loop_pin_a_segment_q_coupler_x = b * c_q_crank_q_coupler;
         let loop_pin_a_segment_q_coupler_y = b * s_q_crank_q_coupler;
@@ -1039,20 +1036,19 @@ impl rt::Dynamics for Model {
         let b = self.derived.b;
         let c_2 = self.derived.c;
         // crank: joint q_crank, rotation, velocities and accelerations
-        let c_q_crank = q_crank.cos();
-        let s_q_crank = q_crank.sin();
+        let (s_q_crank, c_q_crank) = rt::trig::sin_cos(q_crank);
         let omega_crank_sq = q_crank_dot * q_crank_dot;
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let omega_coupler_z = q_crank_dot + q_coupler_dot;
         let angle_q_crank_q_coupler = q_crank + q_coupler;
-        let c_q_crank_q_coupler = angle_q_crank_q_coupler.cos();
-        let s_q_crank_q_coupler = angle_q_crank_q_coupler.sin();
+        let (s_q_crank_q_coupler, c_q_crank_q_coupler) = rt::trig::sin_cos(
+            angle_q_crank_q_coupler,
+        );
         let pos_coupler_x = a * c_q_crank;
         let pos_coupler_y = a * s_q_crank;
         let omega_coupler_sq = omega_coupler_z * omega_coupler_z;
         // rocker: joint q_rocker, rotation, velocities and accelerations
-        let c_q_rocker = q_rocker.cos();
-        let s_q_rocker = q_rocker.sin();
+        let (s_q_rocker, c_q_rocker) = rt::trig::sin_cos(q_rocker);
         let omega_rocker_sq = q_rocker_dot * q_rocker_dot;
         // loop pin: the cut revolute joint, h, J, c
         let loop_pin_a_segment_q_coupler_x = b * c_q_crank_q_coupler;
@@ -1093,20 +1089,19 @@ impl rt::Dynamics for Model {
         let b = self.derived.b;
         let c_2 = self.derived.c;
         // crank: joint q_crank, rotation, velocities and accelerations
-        let c_q_crank = q_crank.cos();
-        let s_q_crank = q_crank.sin();
+        let (s_q_crank, c_q_crank) = rt::trig::sin_cos(q_crank);
         let omega_crank_sq = q_crank_dot * q_crank_dot;
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let omega_coupler_z = q_crank_dot + q_coupler_dot;
         let angle_q_crank_q_coupler = q_crank + q_coupler;
-        let c_q_crank_q_coupler = angle_q_crank_q_coupler.cos();
-        let s_q_crank_q_coupler = angle_q_crank_q_coupler.sin();
+        let (s_q_crank_q_coupler, c_q_crank_q_coupler) = rt::trig::sin_cos(
+            angle_q_crank_q_coupler,
+        );
         let pos_coupler_x = a * c_q_crank;
         let pos_coupler_y = a * s_q_crank;
         let omega_coupler_sq = omega_coupler_z * omega_coupler_z;
         // rocker: joint q_rocker, rotation, velocities and accelerations
-        let c_q_rocker = q_rocker.cos();
-        let s_q_rocker = q_rocker.sin();
+        let (s_q_rocker, c_q_rocker) = rt::trig::sin_cos(q_rocker);
         let omega_rocker_sq = q_rocker_dot * q_rocker_dot;
         // loop pin: the cut revolute joint, h, J, c
         let loop_pin_a_segment_q_coupler_x = b * c_q_crank_q_coupler;
@@ -1167,8 +1162,7 @@ impl rt::Dynamics for Model {
         let s_q_crank = q_crank.sin();
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let vel_rel_coupler_y = q_crank_dot * a;
-        let c_q_coupler = q_coupler.cos();
-        let s_q_coupler = q_coupler.sin();
+        let (s_q_coupler, c_q_coupler) = rt::trig::sin_cos(q_coupler);
         let vel_coupler_x = vel_rel_coupler_y * s_q_coupler;
         let vel_coupler_y = vel_rel_coupler_y * c_q_coupler;
         let omega_coupler_z = q_crank_dot + q_coupler_dot;
@@ -1230,17 +1224,16 @@ impl rt::Dynamics for Model {
         let c_2 = self.derived.c;
         let d = self.derived.d;
         // crank: joint q_crank, rotation, velocities and accelerations
-        let c_q_crank = q_crank.cos();
-        let s_q_crank = q_crank.sin();
+        let (s_q_crank, c_q_crank) = rt::trig::sin_cos(q_crank);
         // coupler: joint q_coupler, rotation, velocities and accelerations
         let angle_q_crank_q_coupler = q_crank + q_coupler;
-        let c_q_crank_q_coupler = angle_q_crank_q_coupler.cos();
-        let s_q_crank_q_coupler = angle_q_crank_q_coupler.sin();
+        let (s_q_crank_q_coupler, c_q_crank_q_coupler) = rt::trig::sin_cos(
+            angle_q_crank_q_coupler,
+        );
         let pos_coupler_x = a * c_q_crank;
         let pos_coupler_y = a * s_q_crank;
         // rocker: joint q_rocker, rotation, velocities and accelerations
-        let c_q_rocker = q_rocker.cos();
-        let s_q_rocker = q_rocker.sin();
+        let (s_q_rocker, c_q_rocker) = rt::trig::sin_cos(q_rocker);
         // loop pin: the cut revolute joint, h, J, c
         let loop_pin_a_segment_q_coupler_x = b * c_q_crank_q_coupler;
         let loop_pin_a_segment_q_coupler_y = b * s_q_crank_q_coupler;

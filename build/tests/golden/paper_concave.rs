@@ -585,13 +585,11 @@ impl rt::Dynamics for Model {
         let q3 = q[2];
         let q4 = q[3];
         // body2: joint q2, rotation, velocities and accelerations
-        let c_q2 = q2.cos();
-        let s_q2 = q2.sin();
+        let (s_q2, c_q2) = rt::trig::sin_cos(q2);
         // body3: joint q3, rotation, velocities and accelerations
         let offset_body3_x = q3 + 0.1;
         // body4: joint q4, rotation, velocities and accelerations
-        let c_q4 = q4.cos();
-        let s_q4 = q4.sin();
+        let (s_q4, c_q4) = rt::trig::sin_cos(q4);
         // body4: composite inertia and column q4 of M
         let neg_momentum_q4_q3_x = 0.15 * s_q4;
         let momentum_q4_q3_y = 0.15 * c_q4;
@@ -644,8 +642,7 @@ impl rt::Dynamics for Model {
         let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
         let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
-        let c_q2 = q2.cos();
-        let s_q2 = q2.sin();
+        let (s_q2, c_q2) = rt::trig::sin_cos(q2);
         let neg_acc_body2_x = neg_centripetal_body2_x * c_q2;
         let acc_body2_y = neg_centripetal_body2_x * s_q2;
         let omega_body2_z = q1_dot + q2_dot;
@@ -659,8 +656,7 @@ impl rt::Dynamics for Model {
         // body4: joint q4, rotation, velocities and accelerations
         let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
         let neg_acc_body4_in_parent_x = neg_acc_body3_x + neg_centripetal_body4_x;
-        let c_q4 = q4.cos();
-        let s_q4 = q4.sin();
+        let (s_q4, c_q4) = rt::trig::sin_cos(q4);
         let acc_body4_y = neg_acc_body4_in_parent_x * s_q4 + acc_body3_y * c_q4;
         let omega_body4_z = q4_dot + omega_body2_z;
         let omega_body4_sq = omega_body4_z * omega_body4_z;
@@ -714,8 +710,7 @@ impl rt::Dynamics for Model {
         let c_q1 = q1.cos();
         // body2: joint q2, rotation, velocities and accelerations
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         // body3: joint q3, rotation, velocities and accelerations
         let offset_body3_x = q3 + 0.1;
         // body4: joint q4, rotation, velocities and accelerations
@@ -769,14 +764,12 @@ impl rt::Dynamics for Model {
         let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
         let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
-        let c_q2 = q2.cos();
-        let s_q2 = q2.sin();
+        let (s_q2, c_q2) = rt::trig::sin_cos(q2);
         let neg_acc_body2_x = neg_centripetal_body2_x * c_q2;
         let acc_body2_y = neg_centripetal_body2_x * s_q2;
         let omega_body2_z = q1_dot + q2_dot;
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body3: joint q3, rotation, velocities and accelerations
         let offset_body3_x = q3 + 0.1;
@@ -787,8 +780,7 @@ impl rt::Dynamics for Model {
         // body4: joint q4, rotation, velocities and accelerations
         let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
         let neg_acc_body4_in_parent_x = neg_acc_body3_x + neg_centripetal_body4_x;
-        let c_q4 = q4.cos();
-        let s_q4 = q4.sin();
+        let (s_q4, c_q4) = rt::trig::sin_cos(q4);
         let acc_body4_y = neg_acc_body4_in_parent_x * s_q4 + acc_body3_y * c_q4;
         let omega_body4_z = q4_dot + omega_body2_z;
         let c_q4_q1_q2 = (q4 + angle_q1_q2).cos();
@@ -878,18 +870,15 @@ impl rt::Dynamics for Model {
         let q3 = q[2];
         let q4 = q[3];
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = q1.cos();
-        let s_q1 = q1.sin();
+        let (s_q1, c_q1) = rt::trig::sin_cos(q1);
         // body2: joint q2, rotation, velocities and accelerations
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
-        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let (s_q4_q1_q2, c_q4_q1_q2) = rt::trig::sin_cos(angle_q4_q1_q2);
         // contact A: the follower seen from the cam, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
@@ -913,18 +902,15 @@ impl rt::Dynamics for Model {
         let q3 = q[2];
         let q4 = q[3];
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = q1.cos();
-        let s_q1 = q1.sin();
+        let (s_q1, c_q1) = rt::trig::sin_cos(q1);
         // body2: joint q2, rotation, velocities and accelerations
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         // body4: joint q4, rotation, velocities and accelerations
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
-        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let (s_q4_q1_q2, c_q4_q1_q2) = rt::trig::sin_cos(angle_q4_q1_q2);
         // contact A: the follower seen from the cam, h, J, c
         let a_segment_q4_x = 0.3 * c_q4_q1_q2;
         let a_segment_q4_y = 0.3 * s_q4_q1_q2;
@@ -956,22 +942,19 @@ impl rt::Dynamics for Model {
         let q3_dot = qd[2];
         let q4_dot = qd[3];
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = q1.cos();
-        let s_q1 = q1.sin();
+        let (s_q1, c_q1) = rt::trig::sin_cos(q1);
         let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
         let omega_body2_z = q1_dot + q2_dot;
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body4: joint q4, rotation, velocities and accelerations
         let omega_body4_z = q4_dot + omega_body2_z;
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
-        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let (s_q4_q1_q2, c_q4_q1_q2) = rt::trig::sin_cos(angle_q4_q1_q2);
         let omega_body4_sq = omega_body4_z * omega_body4_z;
         // contact A: the follower seen from the cam, h, J, c
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
@@ -1018,22 +1001,19 @@ impl rt::Dynamics for Model {
         let q3_dot = qd[2];
         let q4_dot = qd[3];
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = q1.cos();
-        let s_q1 = q1.sin();
+        let (s_q1, c_q1) = rt::trig::sin_cos(q1);
         let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
         let omega_body2_z = q1_dot + q2_dot;
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         // body4: joint q4, rotation, velocities and accelerations
         let omega_body4_z = q4_dot + omega_body2_z;
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
-        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let (s_q4_q1_q2, c_q4_q1_q2) = rt::trig::sin_cos(angle_q4_q1_q2);
         let omega_body4_sq = omega_body4_z * omega_body4_z;
         // contact A: the follower seen from the cam, h, J, c
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
@@ -1083,12 +1063,10 @@ impl rt::Dynamics for Model {
         let q3_dot = qd[2];
         let q4_dot = qd[3];
         // body1: joint q1, rotation, velocities and accelerations
-        let c_q1 = q1.cos();
-        let s_q1 = q1.sin();
+        let (s_q1, c_q1) = rt::trig::sin_cos(q1);
         // body2: joint q2, rotation, velocities and accelerations
         let angle_q1_q2 = q1 + q2;
-        let c_q1_q2 = angle_q1_q2.cos();
-        let s_q1_q2 = angle_q1_q2.sin();
+        let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
         let step_body2_x = 0.3 * c_q1;
         let step_body2_y = 0.3 * s_q1;
         let pos_body2_x = 0.38 + step_body2_x;
@@ -1101,8 +1079,7 @@ impl rt::Dynamics for Model {
         let pos_body3_y = pos_body2_y + step_body3_y;
         // body4: joint q4, rotation, velocities and accelerations
         let angle_q4_q1_q2 = q4 + angle_q1_q2;
-        let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-        let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+        let (s_q4_q1_q2, c_q4_q1_q2) = rt::trig::sin_cos(angle_q4_q1_q2);
         let step_body4_x = 0.3 * c_q1_q2;
         let step_body4_y = 0.3 * s_q1_q2;
         let pos_body4_x = pos_body3_x + step_body4_x;
@@ -1173,8 +1150,7 @@ impl rt::Dynamics for Model {
         let s_q1 = q1.sin();
         // body2: joint q2, rotation, velocities and accelerations
         let vel_rel_body2_y = 0.3 * q1_dot;
-        let c_q2 = q2.cos();
-        let s_q2 = q2.sin();
+        let (s_q2, c_q2) = rt::trig::sin_cos(q2);
         let vel_body2_x = vel_rel_body2_y * s_q2;
         let vel_body2_y = vel_rel_body2_y * c_q2;
         let omega_body2_z = q1_dot + q2_dot;
@@ -1192,8 +1168,7 @@ impl rt::Dynamics for Model {
         // body4: joint q4, rotation, velocities and accelerations
         let vel_rel_body4_y = 0.3 * omega_body2_z;
         let vel_body4_in_parent_y = vel_body3_in_parent_y + vel_rel_body4_y;
-        let c_q4 = q4.cos();
-        let s_q4 = q4.sin();
+        let (s_q4, c_q4) = rt::trig::sin_cos(q4);
         let vel_body4_x = vel_body3_x * c_q4 + vel_body4_in_parent_y * s_q4;
         let vel_body4_y = vel_body4_in_parent_y * c_q4 - vel_body3_x * s_q4;
         let omega_body4_z = q4_dot + omega_body2_z;
@@ -1504,14 +1479,12 @@ fn contact_kinematics_0(
     let q3_dot = qd[2];
     let q4_dot = qd[3];
     // body1: joint q1, rotation, velocities and accelerations
-    let c_q1 = q1.cos();
-    let s_q1 = q1.sin();
+    let (s_q1, c_q1) = rt::trig::sin_cos(q1);
     let omega_body1_sq = q1_dot * q1_dot;
     // body2: joint q2, rotation, velocities and accelerations
     let omega_body2_z = q1_dot + q2_dot;
     let angle_q1_q2 = q1 + q2;
-    let c_q1_q2 = angle_q1_q2.cos();
-    let s_q1_q2 = angle_q1_q2.sin();
+    let (s_q1_q2, c_q1_q2) = rt::trig::sin_cos(angle_q1_q2);
     let step_body2_x = 0.3 * c_q1;
     let step_body2_y = 0.3 * s_q1;
     let pos_body2_x = 0.38 + step_body2_x;
@@ -1526,8 +1499,7 @@ fn contact_kinematics_0(
     // body4: joint q4, rotation, velocities and accelerations
     let omega_body4_z = q4_dot + omega_body2_z;
     let angle_q4_q1_q2 = q4 + angle_q1_q2;
-    let c_q4_q1_q2 = angle_q4_q1_q2.cos();
-    let s_q4_q1_q2 = angle_q4_q1_q2.sin();
+    let (s_q4_q1_q2, c_q4_q1_q2) = rt::trig::sin_cos(angle_q4_q1_q2);
     let step_body4_x = 0.3 * c_q1_q2;
     let step_body4_y = 0.3 * s_q1_q2;
     let pos_body4_x = pos_body3_x + step_body4_x;

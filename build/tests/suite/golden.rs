@@ -113,7 +113,7 @@ fn compare_with_golden(name: &str, now: &str) {
         panic!(
             "the generated code differs from tests/golden/{name}.rs from line {}:\n  now:    \
              {:?}\n  golden: {:?}\nIf the change is intended, run `CAMCHAIN_BLESS=1 cargo test \
-             -p camchain-build --test golden` and commit the diff.",
+             -p camchain-build --test suite golden` and commit the diff.",
             first + 1,
             now.lines().nth(first).unwrap_or("<end of file>"),
             golden.lines().nth(first).unwrap_or("<end of file>"),

@@ -8,6 +8,7 @@ use super::names::{id_at, is_identifier};
 use super::render::SECTION_MACRO;
 use super::trigonometry::{TrigMemo, angle_name, trig_name, trig_name_of};
 use crate::expr::{Graph, Guess, Id, Node, method_name};
+use crate::profile::Func;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
@@ -195,6 +196,11 @@ impl<'g> Emitter<'g> {
             }
             if let Some(m) = self.memo.get(&id).copied() {
                 let line = self.memo_binding(m, &mut taken);
+                text.push_str(&line);
+                continue;
+            }
+            if let Some(pair) = self.trig_pair(id) {
+                let line = self.pair_binding(pair, &mut taken);
                 text.push_str(&line);
                 continue;
             }
@@ -402,6 +408,48 @@ impl<'g> Emitter<'g> {
             self.print(b, 0)
         );
         self.grid_calls.insert((k, a, b), call);
+    }
+
+    /// (sin a, cos a, a) when `id` is one of the two and the function needs the other too
+    /// (neither cached through `rt::sin_cos_memo`): both come from one `rt::trig::sin_cos`.
+    fn trig_pair(&self, id: Id) -> Option<(Id, Id, Id)> {
+        let Node::Call(f @ (Func::Sin | Func::Cos), angle) = self.g.node(id) else {
+            return None;
+        };
+        let other = if f == Func::Sin { Func::Cos } else { Func::Sin };
+        let partner = self.g.find(Node::Call(other, angle))?;
+        // Both computed here: neither read from an argument nor already named.
+        let computed = |x: Id| {
+            !self.given.contains_key(&x)
+                && !self.names.contains_key(&x)
+                && !self.memo.contains_key(&x)
+        };
+        let wanted = self.reachable[partner.index()] && computed(id) && computed(partner);
+        let (sin, cos) = if f == Func::Sin {
+            (id, partner)
+        } else {
+            (partner, id)
+        };
+        wanted.then_some((sin, cos, angle))
+    }
+
+    /// `let (s_a, c_a) = rt::trig::sin_cos(a);`, naming both nodes: one argument reduction
+    /// for both, and no call into the C library (which saves and restores the
+    /// floating-point environment on every call).
+    fn pair_binding(
+        &mut self,
+        (sin, cos, angle): (Id, Id, Id),
+        taken: &mut HashSet<String>,
+    ) -> String {
+        let sin_name = self.fresh_name(sin, taken);
+        let cos_name = self.fresh_name(cos, taken);
+        let line = format!(
+            "let ({sin_name}, {cos_name}) = rt::trig::sin_cos({});\n",
+            self.print(angle, 0)
+        );
+        self.names.insert(sin, sin_name);
+        self.names.insert(cos, cos_name);
+        line
     }
 
     /// `let (s_a, c_a) = rt::sin_cos_memo(a, &mut cache[k..k + 3]);`, naming both nodes.

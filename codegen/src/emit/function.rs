@@ -407,6 +407,42 @@ mod tests {
     }
 
     #[test]
+    fn a_sine_and_cosine_of_one_angle_come_from_one_call_unless_one_is_given() {
+        let (_, mut d) = derived("double_pendulum");
+        let (q1, q2) = (d.symbols.q[0], d.symbols.q[1]);
+        let (s, c, s2) = (d.graph.sin(q1), d.graph.cos(q1), d.graph.sin(q2));
+        let (a, b) = (d.graph.mul(s, q2), d.graph.add(c, s2));
+        let spec = FunctionSpec {
+            doc: "A test.".into(),
+            name: "f".into(),
+            params: vec![param("q", "&[f64]"), param("out", "&mut [f64]")],
+            ret: None,
+            outputs: vec![("out[0]".into(), a), ("out[1]".into(), b)],
+            tail: String::new(),
+        };
+        let (text, _) = emit_function_given(&d, &spec, "", false, &[]);
+        // The pair by one call; the lone sine of q2 as before.
+        assert_eq!(text.matches("rt::trig::sin_cos(").count(), 1, "{text}");
+        assert!(
+            text.contains("let (s_q1, c_q1) = rt::trig::sin_cos(q1);"),
+            "{text}"
+        );
+        assert!(text.contains("q2.sin()"), "{text}");
+        assert!(
+            !text.contains("q1.sin()") && !text.contains("q1.cos()"),
+            "{text}"
+        );
+        // With the cosine read from an argument, the sine alone is computed.
+        let given = [(c, "cache[0]".into())];
+        let (text, _) = emit_function_given(&d, &spec, "", false, &given);
+        assert!(!text.contains("rt::trig::sin_cos("), "{text}");
+        assert!(
+            text.contains("q1.sin()") && text.contains("cache[0]"),
+            "{text}"
+        );
+    }
+
+    #[test]
     fn arrays_with_many_zeros_are_cleared_with_one_fill() {
         assert_eq!(array_of("m[3]"), Some("m"));
         assert_eq!(array_of("out.mass[12]"), Some("out.mass"));

@@ -21,7 +21,7 @@
 //! multipliers zero). So no regularisation is needed; at a singular position, where J_v
 //! degenerates, the partition's own re-partitioning and errors apply unchanged.
 
-use super::linalg::{cholesky_factor, cholesky_solve, dot};
+use super::linalg::{all_finite, cholesky_factor, cholesky_solve, dot};
 use super::{Partition, Workspace};
 use crate::dynamics::{ArticulatedTerms, Dynamics, SolvedRow};
 use crate::error::SimError;
@@ -49,14 +49,19 @@ impl Workspace {
     ) -> Result<(), SimError> {
         let (n, nc) = (self.n, self.nc);
         let b = &mut self.articulated;
-        b.factors.resize(model.articulated_len(), 0.0);
-        b.responses.resize(nc * n, 0.0);
-        b.response_drive.resize(nc * n, 0.0);
-        b.delassus.resize(nc * nc, 0.0);
-        b.tau.resize(n, 0.0);
+        let len = model.articulated_len();
+        if b.factors.len() != len {
+            b.factors.resize(len, 0.0);
+        }
         let all_rows = self.m == self.nc;
         // A model of one row solves it within its sweeps when it is solved here (§14.6).
         let within = self.m == 1 && model.articulated_rows() == 1;
+        if !within {
+            b.responses.resize(nc * n, 0.0);
+            b.response_drive.resize(nc * n, 0.0);
+            b.delassus.resize(nc * nc, 0.0);
+            b.tau.resize(n, 0.0);
+        }
         let mut solved = SolvedRow::default();
         self.drive.fill(0.0);
         let out = ArticulatedTerms {
@@ -139,13 +144,13 @@ impl Workspace {
             *udd = self.qdd[u];
         }
         self.articulated.solved = true;
-        if self.qdd.iter().any(|x| !x.is_finite()) {
+        if !all_finite(&self.qdd) {
             return Err(self.non_finite(t, "q̈"));
         }
-        if self.lambda.iter().any(|x| !x.is_finite()) {
+        if !all_finite(&self.lambda) {
             return Err(self.non_finite(t, "λ"));
         }
-        if self.drive.iter().any(|x| !x.is_finite()) {
+        if !all_finite(&self.drive) {
             return Err(self.non_finite(t, "drive load"));
         }
         Ok(())

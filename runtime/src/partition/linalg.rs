@@ -1,6 +1,12 @@
 //! The small dense kernels of the partitioned dynamics: LU with partial pivoting for J_v,
 //! the square-root-free L D Lᵀ for the reduced mass matrix, and vector helpers.
 
+/// True when every entry of `x` is finite. Without an early exit, so that the compiler
+/// vectorises it: the callers check vectors that are finite but for a failure.
+pub(super) fn all_finite(x: &[f64]) -> bool {
+    x.iter().fold(true, |ok, v| ok & v.is_finite())
+}
+
 pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

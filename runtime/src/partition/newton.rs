@@ -342,6 +342,16 @@ impl Workspace {
             return Err(self.non_finite(t, "J"));
         }
         let floor = self.jacobian_floor();
+        if let ([v], 1) = (dependent, self.nc) {
+            // One contact: J_v is a number, factored as `lu_factor` factors a 1×1 matrix.
+            let j_v = self.jacobian[*v];
+            (self.jv_lu[0], self.pivots[0], self.band.active) = (j_v, 0, false);
+            return if j_v.abs() > floor && j_v.is_finite() {
+                Ok(())
+            } else {
+                Err(self.singular(t))
+            };
+        }
         // A band matrix (chained loops) is factored as one; anything else densely.
         let factored = match self.band.factor(&self.jacobian, self.n, dependent, floor) {
             Some(factored) => factored,
