@@ -5,7 +5,7 @@
 use super::Workspace;
 use super::band::solve_dependent;
 use super::choice::conditioning;
-use super::linalg::{euclidean, gather_columns, lu_factor, max_abs};
+use super::linalg::{all_finite, euclidean, gather_columns, lu_factor, max_abs};
 use crate::dynamics::Dynamics;
 use crate::error::SimError;
 
@@ -268,7 +268,12 @@ impl Workspace {
         }
         let mut shrunk = false;
         for (k, peak) in self.row_peaks.iter_mut().enumerate() {
-            let (s, e) = self.band.jacobian_rows.row(k, n);
+            // One row is factored without its extents (`factor_current_jacobian`).
+            let (s, e) = if nc == 1 {
+                (0, n)
+            } else {
+                self.band.jacobian_rows.row(k, n)
+            };
             let norm = max_abs(&self.jacobian[k * n + s..k * n + e]);
             *peak = peak.max(norm);
             shrunk |= norm < ROW_SHRINK * *peak;
@@ -335,15 +340,13 @@ impl Workspace {
     /// Factors J_v of the J last evaluated (by [`Self::solve_positions`], which always ends
     /// with an evaluation at the returned q, or [`Self::factor_jacobian`]).
     pub fn factor_current_jacobian(&mut self, dependent: &[usize], t: f64) -> Result<(), SimError> {
-        // Which columns of each row may be nonzero (checked): the row operations below and
-        // those of the velocity and acceleration levels read only those.
-        self.band.jacobian_rows.update(&self.jacobian, self.n);
-        if self.band.jacobian_rows.any_non_finite(&self.jacobian) {
-            return Err(self.non_finite(t, "J"));
-        }
         let floor = self.jacobian_floor();
         if let ([v], 1) = (dependent, self.nc) {
-            // One contact: J_v is a number, factored as `lu_factor` factors a 1×1 matrix.
+            // One contact: J_v is a number, factored as `lu_factor` factors a 1×1 matrix. Its
+            // one row is read whole (no extents: `rows_shrunk`, `solve_velocities`).
+            if !all_finite(&self.jacobian[..self.n]) {
+                return Err(self.non_finite(t, "J"));
+            }
             let j_v = self.jacobian[*v];
             (self.jv_lu[0], self.pivots[0], self.band.active) = (j_v, 0, false);
             return if j_v.abs() > floor && j_v.is_finite() {
@@ -351,6 +354,12 @@ impl Workspace {
             } else {
                 Err(self.singular(t))
             };
+        }
+        // Which columns of each row may be nonzero (checked): the row operations below and
+        // those of the velocity and acceleration levels read only those.
+        self.band.jacobian_rows.update(&self.jacobian, self.n);
+        if self.band.jacobian_rows.any_non_finite(&self.jacobian) {
+            return Err(self.non_finite(t, "J"));
         }
         // A band matrix (chained loops) is factored as one; anything else densely.
         let factored = match self.band.factor(&self.jacobian, self.n, dependent, floor) {

@@ -5,7 +5,9 @@ use super::linalg::{
     cholesky_factor, cholesky_solve, gather_columns, lu_determinant, lu_factor, lu_solve,
     lu_solve_transposed,
 };
+use super::workspace::JACOBIAN_FLOOR;
 use super::*;
+use crate::error::SimError;
 use nalgebra::{DMatrix, DVector};
 
 /// Deterministic pseudo-random numbers in [−1, 1) (xorshift64*).
@@ -335,4 +337,54 @@ fn normal_force_points_along_the_upward_normal() {
     assert_eq!(normal_force(-2.0, 1.0), 2.0);
     // Slope 1: h = y − x has |∇h| = √2, the force √2 times −λ.
     assert!((normal_force(-1.0, 2f64.sqrt()) - 2f64.sqrt()).abs() < 1e-15);
+}
+
+#[test]
+fn one_contact_row_is_factored_as_its_number_and_checked_whole() {
+    // n = 20 (above the size at which rows keep extents), one row, v = coordinate 7.
+    let n = 20;
+    let mut ws = Workspace::new(n, 1, n - 1);
+    let mut numbers = Numbers(7);
+    let row = numbers.vector(n);
+    ws.jacobian.copy_from_slice(&row);
+    ws.jacobian[7] = 2.5;
+    ws.factor_current_jacobian(&[7], 0.0)
+        .expect("J_v = 2.5 is regular");
+    // The velocity level from that factor: J q̇ = 0 with q̇_v solved.
+    ws.qd = numbers.vector(n);
+    ws.solve_velocities(&[7]);
+    let residual: f64 = ws.jacobian.iter().zip(&ws.qd).map(|(j, v)| j * v).sum();
+    // Twenty products of order 1 summed: round-off of a few ε.
+    assert!(residual.abs() < 1e-14, "J q̇ = {residual:e}");
+    // A NaN anywhere in the row, not only in J_v, is reported as a non-finite J.
+    ws.jacobian[18] = f64::NAN;
+    let error = ws.factor_current_jacobian(&[7], 0.3).unwrap_err();
+    assert!(
+        matches!(error, SimError::NonFinite { quantity: "J", .. }),
+        "{error}"
+    );
+    ws.jacobian[18] = f64::INFINITY;
+    assert!(ws.factor_current_jacobian(&[7], 0.3).is_err());
+    // J_v at the floor (length scale 1) is singular, just above it is not.
+    ws.jacobian[18] = 0.0;
+    ws.jacobian[7] = JACOBIAN_FLOOR;
+    let error = ws.factor_current_jacobian(&[7], 0.3).unwrap_err();
+    assert!(
+        matches!(error, SimError::SingularConstraint { .. }),
+        "{error}"
+    );
+    ws.jacobian[7] = 2.0 * JACOBIAN_FLOOR;
+    assert!(ws.factor_current_jacobian(&[7], 0.3).is_ok());
+    // The row's shrinking is measured over all of it: the same row scaled by 1e-3 (below
+    // ROW_SHRINK of its peak: a singular position near) is reported.
+    ws.jacobian.copy_from_slice(&row);
+    (ws.jacobian[7], ws.jacobian[18]) = (2.5, 10.0);
+    assert!(!ws.rows_shrunk());
+    // J_v alone shrinking is not the row shrinking: its largest entry is elsewhere.
+    ws.jacobian[7] = 0.01;
+    assert!(!ws.rows_shrunk());
+    for j in ws.jacobian.iter_mut() {
+        *j *= 1e-3;
+    }
+    assert!(ws.rows_shrunk());
 }
