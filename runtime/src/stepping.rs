@@ -215,9 +215,13 @@ impl State {
     pub(crate) fn load_integrated_state(&mut self) {
         let nu = self.partition.independent().len();
         let y = &mut self.engine.y;
-        for (a, &u) in self.partition.independent().iter().enumerate() {
-            y[a] = self.q[u];
-            y[nu + a] = self.qd[u];
+        let (positions, velocities) = y[..2 * nu].split_at_mut(nu);
+        for ((q, qd), &u) in positions
+            .iter_mut()
+            .zip(velocities)
+            .zip(self.partition.independent())
+        {
+            (*q, *qd) = (self.q[u], self.qd[u]);
         }
         y[2 * nu] = self.dissipated;
         y[2 * nu + 1] = self.driven_work;
@@ -642,9 +646,13 @@ pub(crate) fn evaluate_rhs(
     } else {
         ws.drive_power(partition)
     };
-    for (a, &u) in partition.independent().iter().enumerate() {
-        dy[a] = ws.qd[u];
-        dy[nu + a] = ws.qdd[u];
+    let (velocities, accelerations) = dy[..2 * nu].split_at_mut(nu);
+    for ((dq, ddq), &u) in velocities
+        .iter_mut()
+        .zip(accelerations)
+        .zip(partition.independent())
+    {
+        (*dq, *ddq) = (ws.qd[u], ws.qdd[u]);
     }
     dy[2 * nu] = model.damper_power(ws.qd());
     dy[2 * nu + 1] = drive_power + model.load_power(t, ws.q(), ws.qd());
@@ -670,9 +678,13 @@ pub(crate) fn load_state(
 ) -> Result<(), SimError> {
     let nu = partition.independent().len();
     model.prescribed(t, &mut ws.q, &mut ws.qd, &mut ws.qdd);
-    for (a, &u) in partition.independent().iter().enumerate() {
-        ws.q[u] = y[a];
-        ws.qd[u] = y[nu + a];
+    let (positions, velocities) = y[..2 * nu].split_at(nu);
+    for ((&q, &qd), &u) in positions
+        .iter()
+        .zip(velocities)
+        .zip(partition.independent())
+    {
+        (ws.q[u], ws.qd[u]) = (q, qd);
     }
     let nc = partition.dependent().len();
     for (k, &v) in partition.dependent().iter().enumerate() {

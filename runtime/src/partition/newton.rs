@@ -380,14 +380,10 @@ impl Workspace {
     /// Needs [`Self::factor_jacobian`] at the current q.
     pub fn solve_velocities(&mut self, dependent: &[usize]) {
         if let [v] = dependent {
-            // One contact: v̇ = −(Σ_{i≠v} J_i q̇_i) / J_v.
-            let row = &self.jacobian[..self.n];
-            let mut sum = 0.0;
-            for (i, (&j, &qd)) in row.iter().zip(&self.qd).enumerate() {
-                if i != *v {
-                    sum += j * qd;
-                }
-            }
+            // One contact: v̇ = −(Σ_{i≠v} J_i q̇_i) / J_v, the sum taken over the whole row with
+            // q̇_v = 0 (no branch; adding J_v·0 changes no partial sum).
+            self.qd[*v] = 0.0;
+            let sum = super::linalg::dot(&self.jacobian[..self.n], &self.qd);
             self.qd[*v] = -sum / self.jv_lu[0];
             return;
         }
