@@ -55,3 +55,15 @@ def cli_csv(cli, tmp_path):
         return read_csv(out)
 
     return run
+
+
+@pytest.fixture
+def ctrl_c():
+    """Python's own Ctrl-C handler for the test, the previous one restored after it. A process
+    started in the background by a non-interactive shell (`cmd &`, nohup) inherits SIGINT
+    ignored, and Python then installs no handler: SIGINT would do nothing at all."""
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)

@@ -11,7 +11,7 @@ import pytest
 import camchain
 
 
-def test_ctrl_c_stops_a_run_within_a_second_and_keeps_its_samples():
+def test_ctrl_c_stops_a_run_within_a_second_and_keeps_its_samples(ctrl_c):
     model = camchain.Model("paper_concave")
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     start = time.monotonic()

@@ -84,7 +84,7 @@ def test_values_set_by_with_params_are_swept_at_their_value():
     assert list(sweep["k"]) == [450.0, 450.0]
 
 
-def test_ctrl_c_stops_a_sweep_within_a_second_and_keeps_its_rows():
+def test_ctrl_c_stops_a_sweep_within_a_second_and_keeps_its_rows(ctrl_c):
     model = camchain.Model("cycloidal_roller")
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     start = time.monotonic()
