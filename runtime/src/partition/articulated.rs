@@ -89,7 +89,7 @@ impl Workspace {
                 }
                 self.lambda[0] = solved.lambda;
             }
-            return self.accelerations_solved(partition, t);
+            return self.accelerations_solved(t);
         }
         if !all_rows {
             for (k, &row) in self.rows.iter().enumerate() {
@@ -134,15 +134,12 @@ impl Workspace {
                 self.drive[d] += lambda * (b.response_drive[k * n + d] + row[d]);
             }
         }
-        self.accelerations_solved(partition, t)
+        self.accelerations_solved(t)
     }
 
-    /// ü from q̈, and the checks of q̈, λ and the drive loads, once the articulated route has
-    /// solved them.
-    fn accelerations_solved(&mut self, partition: &Partition, t: f64) -> Result<(), SimError> {
-        for (udd, &u) in self.udd.iter_mut().zip(partition.independent()) {
-            *udd = self.qdd[u];
-        }
+    /// The checks of q̈, λ and the drive loads, once the articulated route has solved them.
+    /// (ü is read from q̈ by the callers; the dense route's `udd` is its own scratch.)
+    fn accelerations_solved(&mut self, t: f64) -> Result<(), SimError> {
         self.articulated.solved = true;
         if !all_finite(&self.qdd) {
             return Err(self.non_finite(t, "q̈"));

@@ -51,6 +51,7 @@ pub struct Workspace {
     pub(super) b_vector: Vec<f64>,
     pub(super) mass_t: Vec<f64>,
     pub(super) reduced_mass: Vec<f64>,
+    /// ü, the dense route's reduced solve (the articulated route reads ü from q̈).
     pub(super) udd: Vec<f64>,
     pub(crate) lambda: Vec<f64>,
     pub(crate) drive: Vec<f64>,
