@@ -1,8 +1,8 @@
 //! The small dense kernels of the partitioned dynamics: LU with partial pivoting for J_v,
 //! the square-root-free L D Lᵀ for the reduced mass matrix, and vector helpers.
 
-/// True when every entry of `x` is finite. Without an early exit, so that the compiler
-/// vectorises it: the callers check vectors that are finite but for a failure.
+/// True when every entry of `x` is finite. Without an early exit (no branch per entry): the
+/// callers check vectors that are finite but for a failure.
 pub(super) fn all_finite(x: &[f64]) -> bool {
     x.iter().fold(true, |ok, v| ok & v.is_finite())
 }
@@ -44,12 +44,20 @@ pub(super) fn euclidean(x: &[f64]) -> f64 {
 /// In-place LU factorisation with partial pivoting of the n×n row-major `a` (P A = L U, L
 /// unit lower, both stored in `a`; `pivots[k]` is the row swapped with row k at step k).
 /// Returns false when a pivot is zero or not finite.
+///
+/// Inlined for its 1×1 case, a number (one contact: the paper's case, every right-hand
+/// side); the general case is a call.
+#[inline]
 pub(super) fn lu_factor(a: &mut [f64], pivots: &mut [usize], n: usize, floor: f64) -> bool {
     if n == 1 {
-        // One contact (the paper's case): J_v is a number.
         pivots[0] = 0;
         return a[0].abs() > floor && a[0].is_finite();
     }
+    lu_factor_pivoting(a, pivots, n, floor)
+}
+
+/// [`lu_factor`] for n ≥ 2.
+fn lu_factor_pivoting(a: &mut [f64], pivots: &mut [usize], n: usize, floor: f64) -> bool {
     for k in 0..n {
         let p = (k..n).fold(k, |best, r| {
             if a[r * n + k].abs() > a[best * n + k].abs() {

@@ -5,7 +5,7 @@
 use super::Workspace;
 use super::band::solve_dependent;
 use super::choice::conditioning;
-use super::linalg::{all_finite, euclidean, gather_columns, lu_factor, max_abs};
+use super::linalg::{all_finite, dot, euclidean, gather_columns, lu_factor, max_abs};
 use crate::dynamics::Dynamics;
 use crate::error::SimError;
 
@@ -342,14 +342,13 @@ impl Workspace {
     pub fn factor_current_jacobian(&mut self, dependent: &[usize], t: f64) -> Result<(), SimError> {
         let floor = self.jacobian_floor();
         if let ([v], 1) = (dependent, self.nc) {
-            // One contact: J_v is a number, factored as `lu_factor` factors a 1×1 matrix. Its
-            // one row is read whole (no extents: `rows_shrunk`, `solve_velocities`).
+            // One contact: J_v is a number (no band, no gather). Its one row is read whole
+            // (no extents: `rows_shrunk`, `solve_velocities`).
             if !all_finite(&self.jacobian[..self.n]) {
                 return Err(self.non_finite(t, "J"));
             }
-            let j_v = self.jacobian[*v];
-            (self.jv_lu[0], self.pivots[0], self.band.active) = (j_v, 0, false);
-            return if j_v.abs() > floor && j_v.is_finite() {
+            (self.jv_lu[0], self.band.active) = (self.jacobian[*v], false);
+            return if lu_factor(&mut self.jv_lu, &mut self.pivots, 1, floor) {
                 Ok(())
             } else {
                 Err(self.singular(t))
@@ -383,7 +382,7 @@ impl Workspace {
             // One contact: v̇ = −(Σ_{i≠v} J_i q̇_i) / J_v, the sum taken over the whole row with
             // q̇_v = 0 (no branch; adding J_v·0 changes no partial sum).
             self.qd[*v] = 0.0;
-            let sum = super::linalg::dot(&self.jacobian[..self.n], &self.qd);
+            let sum = dot(&self.jacobian[..self.n], &self.qd);
             self.qd[*v] = -sum / self.jv_lu[0];
             return;
         }
