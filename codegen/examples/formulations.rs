@@ -14,9 +14,14 @@
 //! builds one throwaway crate per model holding both (release, one shared target directory,
 //! the runtime built first and excluded), and times in one run, interleaved batch by batch:
 //!
-//! - `derivative`, the constrained reduced right-hand side (Newton on the dependent
-//!   coordinate, velocities, accelerations, λ), at 8 states 1 ms apart along the model's run
-//!   taken in turn (so every call computes its sines and cosines);
+//! - `derivative_at`, the constrained reduced right-hand side f(t, y) (Newton on the
+//!   dependent coordinate, velocities, accelerations, λ), at the integrated vectors of 8
+//!   states 1 ms apart along the model's run taken in turn (so every call computes its sines
+//!   and cosines): what an integrator calls, given t and y as Pinocchio's `aba` is given q,
+//!   v and τ;
+//! - `derivative` at the same states, each written into a `State` first (t, q, q̇ copied):
+//!   the right-hand side as a caller holding q and q̇ gets it, which also rebuilds y from
+//!   them (the figure of the sessions before `derivative_at` existed);
 //! - the unconstrained forward dynamics, on the same chain without its contact (the
 //!   mechanism Pinocchio's `aba` is timed on), generated again on both routes, at 8 states of
 //!   its own run: `position_terms` + `articulated_terms` (articulated), `position_terms` +
@@ -81,11 +86,11 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
     let warm = write_crate(&out, "warm", &[], &runtime)?;
     cargo_build(&warm, &target, native)?;
     let mut md = String::from(
-        "| family | N | auto chooses | dense ops (velocity_terms) | articulated ops (terms + response per row) | rhs dense [ns] | rhs articulated [ns] | dense / articulated | unconstrained ops (articulated) | unconstrained dense [ns] | unconstrained articulated [ns] |\n\
-         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| family | N | auto chooses | dense ops (velocity_terms) | articulated ops (terms + response per row) | rhs dense [ns] | rhs articulated [ns] | dense / articulated | rhs from a state, dense [ns] | … articulated [ns] | unconstrained ops (articulated) | unconstrained dense [ns] | unconstrained articulated [ns] |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     let mut csv = String::from(
-        "family,n,auto,dense_ops,articulated_ops,response_ops,rhs_dense_ns,rhs_articulated_ns,free_ops,free_dense_ns,free_articulated_ns\n",
+        "family,n,auto,dense_ops,articulated_ops,response_ops,rhs_dense_ns,rhs_articulated_ns,state_rhs_dense_ns,state_rhs_articulated_ns,free_ops,free_dense_ns,free_articulated_ns\n",
     );
     for &n in sizes {
         for (family, text, free_text) in [
@@ -160,7 +165,7 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
                 .split_whitespace()
                 .filter_map(|x| x.parse().ok())
                 .collect();
-            let [rd, ra, fd, fa] = v[..] else {
+            let [sd, sa, fd, fa, rd, ra] = v[..] else {
                 return Err(format!("{name}: unexpected output {v:?}"));
             };
             let (d_ops, a_ops, r_ops) = (
@@ -177,12 +182,12 @@ fn run(out: &Path, sizes: &[usize], native: bool) -> Result<(), String> {
             };
             let _ = writeln!(
                 md,
-                "| {family} | {n} | {chosen} | {d_ops} | {route_ops} | {rd:.0} | {ra:.0} | {:.2}× | {free_ops} | {fd:.0} | {fa:.0} |",
+                "| {family} | {n} | {chosen} | {d_ops} | {route_ops} | {rd:.0} | {ra:.0} | {:.2}× | {sd:.0} | {sa:.0} | {free_ops} | {fd:.0} | {fa:.0} |",
                 rd / ra
             );
             let _ = writeln!(
                 csv,
-                "{family},{n},{chosen},{d_ops},{a_ops},{r_ops},{rd:.1},{ra:.1},{free_ops},{fd:.1},{fa:.1}"
+                "{family},{n},{chosen},{d_ops},{a_ops},{r_ops},{rd:.1},{ra:.1},{sd:.1},{sa:.1},{free_ops},{fd:.1},{fa:.1}"
             );
             eprintln!("{name}: done");
         }
@@ -280,6 +285,28 @@ fn rhs<'a>(model: &'a dyn Simulate, states: &'a [State]) -> impl FnMut() + 'a {
     }
 }
 
+/// The same right-hand side on y (`derivative_at`), the states' integrated vectors taken
+/// in turn: what an integrator calls at its stages, given t and y as Pinocchio's `aba` is
+/// given q, v and τ.
+fn rhs_at<'a>(model: &'a dyn Simulate, states: &'a [State]) -> impl FnMut() + 'a {
+    let mut current = states[0].clone();
+    let ys: Vec<(f64, Vec<f64>)> = states
+        .iter()
+        .map(|s| {
+            assert_eq!(s.dependent(), current.dependent(), "one partition throughout");
+            (s.t, s.integrated())
+        })
+        .collect();
+    let mut dy = vec![0.0; current.integrated_len()];
+    let mut k = 0;
+    move || {
+        let (t, y) = &ys[k % ys.len()];
+        k += 1;
+        model.derivative_at(&mut current, *t, y, &mut dy).expect("a consistent state");
+        black_box(&dy);
+    }
+}
+
 /// Unconstrained forward dynamics, dense: the fused pair and an LDLᵀ solve of M.
 fn free_dense<'a>(model: &'a dyn Dynamics, states: &'a [State]) -> impl FnMut() + 'a {
     let info = model.info();
@@ -360,6 +387,8 @@ fn main() {
         Box::new(rhs(&articulated, &states)),
         Box::new(free_dense(&unconstrained_dense, &free_states)),
         Box::new(free_articulated(&unconstrained, &free_states)),
+        Box::new(rhs_at(&dense, &states)),
+        Box::new(rhs_at(&articulated, &states)),
     ];
     let mut samples = vec![Vec::new(); fns.len()];
     for _ in 0..31 {

@@ -11,6 +11,7 @@ use crate::dynamics::{Dynamics, SimSettings};
 use crate::error::SimError;
 use crate::events::ContactEvent;
 use crate::metrics::{MetricsFailure, MetricsOptions, RunMetrics};
+use crate::partition::all_finite;
 use crate::phase::{Grid, Phase, Recorder, Watch, output_intervals, output_time};
 use crate::sample::{SampleLevel, compute_sample, sample_in_place};
 use crate::stepping::{
@@ -146,6 +147,52 @@ pub trait Simulate: Dynamics {
             dy,
             false,
         )
+    }
+
+    /// The reduced right-hand side f(t, y) at any integrated vector y of the state's
+    /// partition, laid out as [`State::integrated`] gives it: what a custom integrator
+    /// evaluates at its stages, and what Pinocchio's `aba(model, data, q, v, τ)` is timed
+    /// against (`scripts/bench/pinocchio`). Writes dy as [`Simulate::derivative`] does;
+    /// Newton (15) starts from y's v.
+    ///
+    /// The state lends its partition and its scratch space and is otherwise left as it was:
+    /// its t, q, q̇ and quadratures are not read or changed, and a later `step` or `sample`
+    /// gives what it would have given without this call. At `t = state.t` and
+    /// `y = state.integrated()` the result is `derivative`'s.
+    fn derivative_at(
+        &self,
+        state: &mut State,
+        t: f64,
+        y: &[f64],
+        dy: &mut [f64],
+    ) -> Result<(), SimError> {
+        check_belongs(self.as_dynamics(), state)?;
+        let len = state.integrated_len();
+        if y.len() != len || dy.len() != len {
+            return Err(invalid(format!(
+                "y has {} entries and dy {}, the integrated vector {len}",
+                y.len(),
+                dy.len()
+            )));
+        }
+        if !t.is_finite() {
+            return Err(invalid(format!("the time t = {t} is not finite")));
+        }
+        // One pass without a branch per entry; the entry is looked for only on failure.
+        if !all_finite(y)
+            && let Some(k) = y.iter().position(|v| !v.is_finite())
+        {
+            let slot = state.integrated_slot(k, &self.as_dynamics().info().coordinates);
+            return Err(invalid(format!(
+                "y[{k}] ({slot}) = {} is not finite (t = {t})",
+                y[k]
+            )));
+        }
+        let Engine {
+            ws, at_step_end, ..
+        } = &mut state.engine;
+        *at_step_end = false;
+        evaluate_rhs(self.as_dynamics(), &state.partition, ws, t, y, dy, false)
     }
 
     /// All outputs at the state: accelerations, multipliers, normal and drive loads,

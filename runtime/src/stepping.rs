@@ -19,7 +19,7 @@ mod rhs;
 
 pub(crate) use rhs::{evaluate_rhs, load_state};
 
-use crate::dynamics::{Dynamics, IntegratorKind, SimSettings};
+use crate::dynamics::{CoordinateInfo, Dynamics, IntegratorKind, SimSettings};
 use crate::error::SimError;
 use crate::integrators::{Adaptive, Counters, Dop853, Dopri5, Rk4, Tolerances};
 use crate::partition::{
@@ -161,6 +161,39 @@ impl State {
     /// Length of the integrated vector y = (u, u̇, dissipated, driven work, v, v̇).
     pub fn integrated_len(&self) -> usize {
         integrated_len(&self.partition)
+    }
+
+    /// The integrated vector y = (u, u̇, dissipated, driven work, v, v̇) of the state, in the
+    /// layout [`crate::Simulate::derivative_at`] reads: u the independent coordinates
+    /// ([`Self::independent`]), v the dependent ones ([`Self::dependent`]), both in that
+    /// order, from the state's q and q̇ as they are now.
+    pub fn integrated(&self) -> Vec<f64> {
+        let nu = self.partition.independent().len();
+        let mut y = vec![0.0; self.integrated_len()];
+        for (k, &u) in self.partition.independent().iter().enumerate() {
+            (y[k], y[nu + k]) = (self.q[u], self.qd[u]);
+        }
+        (y[2 * nu], y[2 * nu + 1]) = (self.dissipated, self.driven_work);
+        store_dependent(&self.partition, &mut y, &self.q, &self.qd);
+        y
+    }
+
+    /// What entry `k` of the integrated vector holds, e.g. "u̇ of q2", for messages.
+    pub(crate) fn integrated_slot(&self, k: usize, coordinates: &[CoordinateInfo]) -> String {
+        let (u, v) = (self.partition.independent(), self.partition.dependent());
+        let (nu, nc) = (u.len(), v.len());
+        let name = |set: &[usize], i: usize| {
+            let coordinate = set.get(i).and_then(|&c| coordinates.get(c));
+            coordinate.map_or("?", |c| c.name.as_str()).to_string()
+        };
+        match k {
+            k if k < nu => format!("u of {}", name(u, k)),
+            k if k < 2 * nu => format!("u̇ of {}", name(u, k - nu)),
+            k if k == 2 * nu => "the dissipated energy".to_string(),
+            k if k == 2 * nu + 1 => "the driven work".to_string(),
+            k if k < 2 * nu + 2 + nc => format!("v of {}", name(v, k - 2 * nu - 2)),
+            k => format!("v̇ of {}", name(v, k - 2 * nu - 2 - nc)),
+        }
     }
 
     /// Forgets the values the last right-hand side left for the next one (the sines and
@@ -343,14 +376,15 @@ fn setting_error(e: crate::settings::InvalidSetting) -> SimError {
 }
 
 pub(crate) fn check_belongs(model: &dyn Dynamics, state: &State) -> Result<(), SimError> {
-    let n = model.info().n();
+    let info = model.info();
+    let n = info.n();
     let fits = state.q.len() == n && state.qd.len() == n && state.partition.n() == n;
-    if fits && state.dependent().len() <= model.info().n_constraints() {
+    if fits && state.dependent().len() <= info.n_constraints() {
         Ok(())
     } else {
         Err(invalid(format!(
             "the state does not belong to model {}",
-            model.info().name
+            info.name
         )))
     }
 }

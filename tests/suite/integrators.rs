@@ -135,3 +135,109 @@ fn derivative_is_the_reduced_right_hand_side_of_the_samples() {
     let mut wrong = vec![0.0; dy.len() + 1];
     assert!(model.derivative(&mut state, &mut wrong).is_err());
 }
+
+#[test]
+fn derivative_at_is_the_right_hand_side_of_y_and_leaves_the_state_alone() {
+    let model = models::by_name("paper_convex").expect("built in");
+    let mut state = model.assemble(0.0).expect("assembly");
+    model.step(&mut state, 0.7).expect("step");
+    let (t, y) = (state.t, state.integrated());
+    let len = state.integrated_len();
+    let (mut at, mut dy) = (vec![0.0; len], vec![0.0; len]);
+    model
+        .derivative_at(&mut state, t, &y, &mut at)
+        .expect("at the state");
+    model.derivative(&mut state, &mut dy).expect("derivative");
+    // The same y and t through the same evaluation: the same bits.
+    assert_eq!(at, dy);
+
+    // Elsewhere: u and u̇ moved, v left where the state has it (Newton moves it onto the
+    // cam). The same evaluation as `derivative` of a state holding those u, u̇.
+    let nu = state.independent().len();
+    let mut moved = y.clone();
+    for k in 0..nu {
+        moved[k] += 1e-3;
+        moved[nu + k] += 0.01;
+    }
+    let before = state.clone();
+    model
+        .derivative_at(&mut state, t + 0.01, &moved, &mut at)
+        .expect("elsewhere");
+    // dq/dt of y's u is y's u̇, exactly (copied).
+    assert_eq!(at[..nu], moved[nu..2 * nu]);
+    let mut other = before.clone();
+    other.t += 0.01;
+    for (k, &u) in before.independent().iter().enumerate() {
+        other.q[u] = moved[k];
+        other.qd[u] = moved[nu + k];
+    }
+    assert_eq!(other.integrated(), moved);
+    model.derivative(&mut other, &mut dy).expect("moved state");
+    assert_eq!(at, dy);
+
+    // The state is as it was: stepping it gives what stepping its copy gives.
+    assert_eq!(
+        (state.t, &state.q, &state.qd),
+        (before.t, &before.q, &before.qd)
+    );
+    let mut untouched = before.clone();
+    model.step(&mut state, 0.05).expect("step after");
+    model.step(&mut untouched, 0.05).expect("step of the copy");
+    assert_eq!(
+        (state.t, &state.q, &state.qd),
+        (untouched.t, &untouched.q, &untouched.qd)
+    );
+}
+
+#[test]
+fn derivative_at_refuses_bad_input_with_an_error() {
+    let model = models::by_name("paper_convex").expect("built in");
+    let mut state = model.assemble(0.0).expect("assembly");
+    let y = state.integrated();
+    let len = y.len();
+    let mut dy = vec![0.0; len];
+    let t = state.t;
+    let message = |r: Result<(), camchain::runtime::SimError>| match r {
+        Ok(()) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    };
+    let short = message(model.derivative_at(&mut state, t, &y[1..], &mut dy));
+    assert!(
+        short.contains(&format!("y has {} entries", len - 1)),
+        "{short}"
+    );
+    let long = message(model.derivative_at(&mut state, t, &y, &mut vec![0.0; len + 1]));
+    assert!(long.contains(&format!("dy {}", len + 1)), "{long}");
+    let when = message(model.derivative_at(&mut state, f64::NAN, &y, &mut dy));
+    assert!(when.contains("t = NaN is not finite"), "{when}");
+    // Every entry of y, one at a time, NaN and infinite: an error naming the entry.
+    let nu = state.independent().len();
+    let names = &model.info().coordinates;
+    let u = &names[state.independent()[0]].name;
+    let v = &names[state.dependent()[0]].name;
+    for k in 0..len {
+        let slot = match k {
+            k if k < nu => format!("u of {}", names[state.independent()[k]].name),
+            k if k < 2 * nu => format!("u̇ of {}", names[state.independent()[k - nu]].name),
+            k if k == 2 * nu => "the dissipated energy".to_string(),
+            k if k == 2 * nu + 1 => "the driven work".to_string(),
+            k if k == 2 * nu + 2 => format!("v of {v}"),
+            _ => format!("v̇ of {v}"),
+        };
+        for bad in [f64::NAN, f64::NEG_INFINITY] {
+            let mut wrong = y.clone();
+            wrong[k] = bad;
+            let m = message(model.derivative_at(&mut state, t, &wrong, &mut dy));
+            assert!(
+                m.contains(&format!("y[{k}] ({slot}) = {bad} is not finite")),
+                "{m}"
+            );
+        }
+    }
+    assert!(!u.is_empty());
+    // A state of a model with another number of coordinates.
+    let other = models::by_name("n_four_bar").expect("built in");
+    let mut foreign = other.assemble(0.0).expect("assembly");
+    let m = message(model.derivative_at(&mut foreign, t, &y, &mut dy));
+    assert!(m.contains("does not belong to model paper_convex"), "{m}");
+}

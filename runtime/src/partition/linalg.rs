@@ -3,7 +3,8 @@
 
 /// True when every entry of `x` is finite. Without an early exit (no branch per entry): the
 /// callers check vectors that are finite but for a failure.
-pub(super) fn all_finite(x: &[f64]) -> bool {
+#[inline]
+pub(crate) fn all_finite(x: &[f64]) -> bool {
     x.iter().fold(true, |ok, v| ok & v.is_finite())
 }
 

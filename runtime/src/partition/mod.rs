@@ -29,6 +29,7 @@ mod workspace;
 pub use choice::{
     REDUNDANT_PIVOT, REPARTITION_RATIO, choose_dependent, conditioning, independent_rows,
 };
+pub(crate) use linalg::all_finite;
 pub use multipliers::normal_force;
 pub use newton::{
     NEWTON_MAX_ITERATIONS, NEWTON_RESIDUAL_TOLERANCE, NEWTON_SLACK_PER_RTOL,

@@ -10,10 +10,14 @@
 # (its built timing programs, native ones preferred). ROUNDS: default 5.
 # Writes FORM_DIR/side_by_side.csv (or, when that exists, side_by_side.TIME.PID.csv: an
 # earlier run's file is never overwritten), one line per round and chain:
-#   round,family,n,aba_ns,rhs_best_ns,free_best_ns,constrained_ratio,unconstrained_ratio
-# where rhs_best is the faster route's constrained reduced right-hand side, free_best the
-# faster route's unconstrained forward dynamics of the chain without its contact, and the
-# ratios aba / those (all thread CPU time). Prints the median ratio per chain.
+#   round,family,n,aba_ns,rhs_best_ns,free_best_ns,constrained_ratio,unconstrained_ratio,
+#   state_rhs_best_ns,state_ratio
+# where rhs_best is the faster route's constrained reduced right-hand side f(t, y)
+# (`derivative_at`, given t and y as aba is given q, v and tau), free_best the faster
+# route's unconstrained forward dynamics of the chain without its contact, state_rhs_best
+# the same right-hand side through `derivative` after writing t, q and q̇ into a State
+# (which also rebuilds y from them), and the ratios aba / those (all thread CPU time).
+# Prints the median ratios per chain.
 set -euo pipefail
 
 if [[ $# -lt 2 || $# -gt 3 ]]; then
@@ -46,7 +50,7 @@ if [[ ${#runnable[@]} -eq 0 ]]; then
 fi
 SCRATCH="$(mktemp -d)"
 trap 'rm -rf "$SCRATCH"' EXIT
-echo "round,family,n,aba_ns,rhs_best_ns,free_best_ns,constrained_ratio,unconstrained_ratio" >"$SCRATCH/out.csv"
+echo "round,family,n,aba_ns,rhs_best_ns,free_best_ns,constrained_ratio,unconstrained_ratio,state_rhs_best_ns,state_ratio" >"$SCRATCH/out.csv"
 for ((r = 1; r <= ROUNDS; r++)); do
   "$PIN" "$SCRATCH/wall.csv" "$SCRATCH/check.csv" "$SCRATCH/cpu.csv" >"$SCRATCH/pin.log" 2>&1 ||
     { cat "$SCRATCH/pin.log" >&2; exit 1; }
@@ -59,10 +63,13 @@ for ((r = 1; r <= ROUNDS; r++)); do
     [[ "$family" == planar ]] && pin_family="planar"
     aba=$(awk -F, -v f="$pin_family" -v n="$n" '$1 == f && $2 == n { print $3 }' "$SCRATCH/cpu.csv")
     [[ -n "$aba" ]] || continue
-    read -r rd ra fd fa < <("$p")
+    # The timing program prints: derivative (dense, articulated), the unconstrained
+    # forward dynamics (dense, articulated), derivative_at (dense, articulated).
+    read -r sd sa fd fa rd ra < <("$p")
     awk -v r="$r" -v f="$family" -v n="$n" -v aba="$aba" -v rd="$rd" -v ra="$ra" -v fd="$fd" -v fa="$fa" \
-      'BEGIN { rb = rd < ra ? rd : ra; fb = fd < fa ? fd : fa;
-               printf "%d,%s,%d,%.1f,%.1f,%.1f,%.3f,%.3f\n", r, f, n, aba, rb, fb, aba / rb, aba / fb }' \
+      -v sd="$sd" -v sa="$sa" \
+      'BEGIN { rb = rd < ra ? rd : ra; fb = fd < fa ? fd : fa; sb = sd < sa ? sd : sa;
+               printf "%d,%s,%d,%.1f,%.1f,%.1f,%.3f,%.3f,%.1f,%.3f\n", r, f, n, aba, rb, fb, aba / rb, aba / fb, sb, aba / sb }' \
       >>"$SCRATCH/out.csv"
   done
 done
@@ -73,12 +80,12 @@ if ! (set -o noclobber && cat "$SCRATCH/out.csv" >"$OUT") 2>/dev/null; then
   (set -o noclobber && cat "$SCRATCH/out.csv" >"$OUT")
 fi
 echo "wrote $OUT"
-echo "family,n,median aba/rhs (constrained),median aba/free (unconstrained),rounds"
+echo "family,n,median aba/rhs (constrained),median aba/free (unconstrained),median aba/rhs from a state,rounds"
 # The median of column $1 of the lines on stdin (sorted numerically first).
 median() {
   cut -d, -f"$1" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
 }
 tail -n +2 "$OUT" | cut -d, -f2,3 | sort -t, -k1,1 -k2,2n -u | while IFS=, read -r family n; do
   lines=$(awk -F, -v f="$family" -v n="$n" '$2 == f && $3 == n' "$OUT")
-  echo "$family,$n,$(median 7 <<<"$lines"),$(median 8 <<<"$lines"),$(wc -l <<<"$lines")"
+  echo "$family,$n,$(median 7 <<<"$lines"),$(median 8 <<<"$lines"),$(median 10 <<<"$lines"),$(wc -l <<<"$lines")"
 done
