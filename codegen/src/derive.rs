@@ -1,7 +1,7 @@
 //! The whole symbolic derivation of a model: kinematics, cam constraints, dynamics, energy
 //! and prescribed motions, all in one expression graph.
 
-use crate::articulated::{ArticulatedTerms, articulated};
+use crate::articulated::{ArticulatedTerms, articulated, contact_row_bias};
 use crate::contact::{ContactTerms, contact_terms};
 use crate::dynamics::{DynamicsTerms, EnergyTerms, backward, energy};
 use crate::expr::scalar::{scalar_to_expr, value_and_derivatives};
@@ -168,11 +168,13 @@ impl Derivation {
             return;
         }
         let kin = forward(&mut self.graph, model, &self.symbols);
-        // A model of one constraint row solves it within the sweeps.
+        // A model of one constraint row solves it within the sweeps; a contact's c there
+        // reads the sweeps' accelerations.
         let row_bias = match self.constraint_rows().as_slice() {
             [(_, _, c)] => Some(*c),
             _ => None,
-        };
+        }
+        .map(|c| contact_row_bias(&mut self.graph, model, &self.symbols, &kin).unwrap_or(c));
         self.articulated = articulated(&mut self.graph, model, &self.symbols, &kin, row_bias);
     }
 

@@ -349,6 +349,37 @@ pub struct BodyKinematics {
     pub accel_in_parent: V3,
     /// −g (gravity enters as an acceleration of the ground) seen in the body frame.
     pub gravity: V3,
+    /// What the body adds to its parent's acceleration to make `accel`.
+    pub carried: Carried,
+}
+
+/// The terms a body adds to its parent's velocity-product acceleration a_p: at its joint
+/// point (a_p + α_p × r) + ω_p × (ω_p × r), parent frame; seen in its own frame, plus
+/// 2 ω_p × e q̇ on a prismatic joint. One recursion for any a_p: the kinematics' `accel`
+/// starts from zero at the ground, the articulated sweeps' from −g (gravity carried with
+/// the acceleration, not rotated body by body beside it).
+#[derive(Debug, Clone, Copy)]
+pub struct Carried {
+    /// α_p × r.
+    pub tangential: V3,
+    /// ω_p × (ω_p × r).
+    pub centripetal: V3,
+    /// 2 ω_p × e q̇ (prismatic), zero (revolute).
+    pub coriolis: V3,
+}
+
+impl Carried {
+    /// The joint point's acceleration, parent frame, from the parent's `parent`.
+    pub fn at_joint(&self, g: &mut Graph, parent: V3) -> V3 {
+        let a = vec3::add(g, parent, self.tangential);
+        vec3::add(g, a, self.centripetal)
+    }
+
+    /// The body's acceleration, own frame, from the joint point's `at_joint`.
+    pub fn in_body(&self, g: &mut Graph, relative: &Rotation, at_joint: V3) -> V3 {
+        let seen = relative.apply_transpose(g, at_joint);
+        vec3::add(g, seen, self.coriolis)
+    }
 }
 
 /// −g in ground coordinates (gravity enters as an acceleration of the ground).
@@ -395,6 +426,11 @@ fn ground_kinematics(g: &mut Graph, model: &Model, s: &Symbols) -> BodyKinematic
         accel: zero,
         accel_in_parent: zero,
         gravity,
+        carried: Carried {
+            tangential: zero,
+            centripetal: zero,
+            coriolis: zero,
+        },
     }
 }
 
@@ -435,8 +471,12 @@ fn child_kinematics(
     vec3::label(g, w_w_r, &format!("centripetal_{name}"));
     let w_dot_r = vec3::dot(g, p.omega, offset);
     g.label(w_dot_r, format!("omega_dot_offset_{name}"));
-    let a_joint = vec3::add(g, p.accel, alpha_r);
-    let a_joint = vec3::add(g, a_joint, w_w_r);
+    let mut carried = Carried {
+        tangential: alpha_r,
+        centripetal: w_w_r,
+        coriolis: vec3::zero(g),
+    };
+    let a_joint = carried.at_joint(g, p.accel);
     // Parent quantities seen in the body frame.
     if relative != Rotation::Identity {
         let rows = relative.matrix(g);
@@ -447,7 +487,7 @@ fn child_kinematics(
     let alpha_p = relative.apply_transpose(g, p.alpha);
     vec3::label(g, alpha_p, &format!("alpha_parent_{name}"));
     let v_p = relative.apply_transpose(g, v_joint);
-    let a_p = relative.apply_transpose(g, a_joint);
+    let a_p = carried.in_body(g, &relative, a_joint);
     let axis_rate = vec3::scale(g, qd, axis);
     let (omega, velocity, alpha, accel, accel_in_parent) = match joint.kind {
         JointKind::Revolute => {
@@ -466,6 +506,7 @@ fn child_kinematics(
             let w_e = vec3::cross(g, omega_p, axis_rate);
             let coriolis = vec3::scale(g, two, w_e);
             vec3::label(g, coriolis, &format!("coriolis_{name}"));
+            carried.coriolis = coriolis;
             let accel = vec3::add(g, a_p, coriolis);
             (omega_p, velocity, alpha_p, accel, accel)
         }
@@ -489,6 +530,7 @@ fn child_kinematics(
         accel,
         accel_in_parent,
         gravity,
+        carried,
     }
 }
 

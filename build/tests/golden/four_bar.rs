@@ -26,7 +26,7 @@
 // | `derive` | 8 | 22 | 0 | 0 | 0 | 0 | 30 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
-// dense 120, articulated 291 (the position level, common to both, not included).
+// dense 120, articulated 293 (the position level, common to both, not included).
 //
 // Read at run time: `a`, `b`, `c`, `d`, `m_crank`, `m_coupler`, `m_rocker`, `flywheel`, `torque`, `g` (see `Parameters`); `derive` computes what depends on them
 // alone once per parameter set, and the counts above do not include it.

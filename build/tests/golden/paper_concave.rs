@@ -25,7 +25,7 @@
 // | `derive` | 0 | 3 | 0 | 0 | 0 | 0 | 3 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
-// dense 241, articulated 438 (the position level, common to both, not included).
+// dense 241, articulated 435 (the position level, common to both, not included).
 //
 // Read at run time: `k2`, `k3`, `k4`, `c2`, `c3`, `c4`, `swing` (see `Parameters`); `derive` computes what depends on them
 // alone once per parameter set, and the counts above do not include it.

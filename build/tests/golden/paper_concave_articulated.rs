@@ -21,12 +21,12 @@
 // | `damper_power` | 2 | 0 | 0 | 0 | 0 | 3 | 5 |
 // | `position_terms` | 18 | 15 | 0 | 6 | 0 | 0 | 39 |
 // | `velocity_terms` | 60 | 72 | 0 | 0 | 0 | 1 | 133 |
-// | `articulated_terms` | 119 | 135 | 4 | 0 | 0 | 1 | 259 |
+// | `articulated_terms` | 116 | 135 | 4 | 0 | 0 | 1 | 256 |
 // | `articulated_response` | 24 | 29 | 0 | 0 | 0 | 0 | 53 |
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
 // Forward dynamics: the articulated-body sweeps (as asked). Estimated operations per right-hand side:
-// dense 238, articulated 435 (the position level, common to both, not included).
+// dense 238, articulated 432 (the position level, common to both, not included).
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;
@@ -1072,42 +1072,31 @@ impl rt::Dynamics for Model {
         // body1: joint q1, rotation, velocities and accelerations
         let c_q1 = cache[2];
         let s_q1 = cache[1];
+        let minus_g_body1_x = 9.81 * s_q1;
+        let minus_g_body1_y = 9.81 * c_q1;
         let omega_body1_sq = q1_dot * q1_dot;
         // body2: joint q2, rotation, velocities and accelerations
         let neg_centripetal_body2_x = 0.3 * omega_body1_sq;
         let omega_body2_z = q1_dot + q2_dot;
         let c_q1_q2 = cache[5];
         let s_q1_q2 = cache[4];
-        let minus_g_body2_x = 9.81 * s_q1_q2;
-        let minus_g_body2_y = 9.81 * c_q1_q2;
         let step_body2_x = cache[9];
         let step_body2_y = cache[10];
         let omega_body2_sq = omega_body2_z * omega_body2_z;
         let rel_rot_body2_11 = c_q1 * c_q1_q2 + s_q1 * s_q1_q2;
         let neg_rel_rot_body2_12 = c_q1 * s_q1_q2 - s_q1 * c_q1_q2;
-        let neg_acc_body2_x = neg_centripetal_body2_x * rel_rot_body2_11;
-        let acc_body2_y = neg_centripetal_body2_x * neg_rel_rot_body2_12;
         // body3: joint q3, rotation, velocities and accelerations
         let offset_body3_x = q3 + 0.1;
         let neg_centripetal_body3_x = omega_body2_sq * offset_body3_x;
         let coriolis_body3_y = 2.0 * (q3_dot * omega_body2_z);
-        let neg_acc_body3_x = neg_centripetal_body3_x + neg_acc_body2_x;
-        let acc_body3_y = coriolis_body3_y + acc_body2_y;
         // body4: joint q4, rotation, velocities and accelerations
         let neg_centripetal_body4_x = 0.3 * omega_body2_sq;
         let omega_body4_z = q4_dot + omega_body2_z;
         let c_q4_q1_q2 = cache[8];
         let s_q4_q1_q2 = cache[7];
-        let minus_g_body4_x = 9.81 * s_q4_q1_q2;
-        let minus_g_body4_y = 9.81 * c_q4_q1_q2;
         let omega_body4_sq = omega_body4_z * omega_body4_z;
         let rel_rot_body4_11 = c_q1_q2 * c_q4_q1_q2 + s_q1_q2 * s_q4_q1_q2;
         let neg_rel_rot_body4_12 = c_q1_q2 * s_q4_q1_q2 - s_q1_q2 * c_q4_q1_q2;
-        let neg_acc_body4_in_parent_x = neg_centripetal_body4_x + neg_acc_body3_x;
-        let acc_body4_x = neg_rel_rot_body4_12 * acc_body3_y
-            - rel_rot_body4_11 * neg_acc_body4_in_parent_x;
-        let acc_body4_y = neg_rel_rot_body4_12 * neg_acc_body4_in_parent_x
-            + rel_rot_body4_11 * acc_body3_y;
         // contact A: the follower seen from the cam, h, J, c
         let neg_a_coriolis_x_t1 = omega_body2_z * (2.0 * q3_dot);
         let neg_a_coriolis_x = s_q1_q2 * neg_a_coriolis_x_t1;
@@ -1141,14 +1130,27 @@ impl rt::Dynamics for Model {
         let neg_centripetal_force_body3_x = 0.15 * omega_body2_sq;
         // body2: inertial loads and joint q2 load (backward recursion)
         let neg_centripetal_force_body2_x = 0.025 * omega_body2_sq;
+        // body2: acceleration with gravity (joint q2)
+        let acc_g_body2_x_t1 = minus_g_body1_x - neg_centripetal_body2_x;
+        let acc_g_body2_x = acc_g_body2_x_t1 * rel_rot_body2_11
+            + minus_g_body1_y * neg_rel_rot_body2_12;
+        let acc_g_body2_y = minus_g_body1_y * rel_rot_body2_11
+            - acc_g_body2_x_t1 * neg_rel_rot_body2_12;
+        // body3: acceleration with gravity (joint q3)
+        let acc_g_body3_x = acc_g_body2_x - neg_centripetal_body3_x;
+        let acc_g_body3_y = coriolis_body3_y + acc_g_body2_y;
+        // body4: acceleration with gravity (joint q4)
+        let acc_g_body4_x_t1 = acc_g_body3_x - neg_centripetal_body4_x;
+        let acc_g_body4_x = rel_rot_body4_11 * acc_g_body4_x_t1
+            + neg_rel_rot_body4_12 * acc_g_body3_y;
+        let acc_g_body4_y = rel_rot_body4_11 * acc_g_body3_y
+            - neg_rel_rot_body4_12 * acc_g_body4_x_t1;
         // body4: articulated inertia and bias force (joint q4)
-        let qdd_3_t1 = minus_g_body4_y + acc_body4_y;
-        let qdd_2_t1 = minus_g_body4_x + acc_body4_x - neg_centripetal_force_body4_x;
-        let qdd_3_t2 = 0.15 * qdd_3_t1;
-        let qdd_3_t3 = q4_dot + 18.0 * q4 + qdd_3_t2;
-        let qdd_2_t2 = qdd_3_t1 - 1.2244897959183674 * qdd_3_t3;
+        let qdd_2_t1 = acc_g_body4_x - neg_centripetal_force_body4_x;
+        let qdd_3_t1 = 0.15 * acc_g_body4_y;
+        let qdd_3_t2 = q4_dot + 18.0 * q4 + qdd_3_t1;
+        let qdd_2_t2 = acc_g_body4_y - 1.2244897959183674 * qdd_3_t2;
         // body3: articulated inertia and bias force (joint q3)
-        let qdd_1_t1 = minus_g_body2_y + acc_body3_y;
         let factors_5_t1 = rel_rot_body4_11 * neg_rel_rot_body4_12;
         let articulated_d_q3_t1 = 0.18367346938775508
             * (0.5 - neg_rel_rot_body4_12 * neg_rel_rot_body4_12);
@@ -1156,8 +1158,8 @@ impl rt::Dynamics for Model {
         let factors_11_t1 = 0.9081632653061225 - articulated_d_q3_t1;
         let factors_9_t1 = 0.055102040816326525 * factors_5_t1;
         let articulated_d_q3 = 1.9081632653061225 + articulated_d_q3_t1;
-        let qdd_1_t2 = neg_rel_rot_body4_12 * qdd_2_t1 + rel_rot_body4_11 * qdd_2_t2;
-        let qdd_2_t3 = minus_g_body2_x - neg_acc_body3_x - neg_centripetal_force_body3_x
+        let qdd_1_t1 = neg_rel_rot_body4_12 * qdd_2_t1 + rel_rot_body4_11 * qdd_2_t2;
+        let qdd_2_t3 = acc_g_body3_x - neg_centripetal_force_body3_x
             + (rel_rot_body4_11 * qdd_2_t1 - neg_rel_rot_body4_12 * qdd_2_t2);
         let factors_9_t2 = 1.0 / articulated_d_q3;
         let qdd_2_t4 = q3_dot + 40.0 * q3 + qdd_2_t3;
@@ -1166,20 +1168,19 @@ impl rt::Dynamics for Model {
         let factors_11_t3 = 1.9081632653061225 - articulated_d_q3_t1
             - factors_10_t1 * factors_11_t2;
         let factors_11_t4 = 0.15 + 0.3 * factors_11_t1 - factors_9_t1 * factors_11_t2;
-        let qdd_1_t3 = qdd_1_t1 + qdd_1_t2 - qdd_2_t4 * factors_11_t2;
+        let qdd_1_t2 = acc_g_body3_y + qdd_1_t1 - qdd_2_t4 * factors_11_t2;
         // body2: articulated inertia and bias force (joint q2)
-        let qdd_1_t4 = minus_g_body2_y + acc_body2_y;
         let factors_11_t5 = factors_11_t4 + offset_body3_x * factors_11_t3;
         let factors_14_t1 = 0.025 + factors_11_t5;
         let articulated_d_q2 = 0.01125
             + (offset_body3_x * factors_11_t5
                 + (0.1225 + 0.09 * factors_11_t1 - factors_9_t1 * row_rate_q2_t1
                     + offset_body3_x * factors_11_t4));
-        let qdd_1_t5 = 0.025 * qdd_1_t4
-            + (0.15 * qdd_1_t1 + (qdd_3_t2 - qdd_3_t3 + 0.3 * qdd_1_t2)
-                - qdd_2_t4 * row_rate_q2_t1 + offset_body3_x * qdd_1_t3);
+        let qdd_1_t3 = 0.025 * acc_g_body2_y
+            + (0.15 * acc_g_body3_y + (qdd_3_t1 - qdd_3_t2 + 0.3 * qdd_1_t1)
+                - qdd_2_t4 * row_rate_q2_t1 + offset_body3_x * qdd_1_t2);
         let factors_14_t2 = 1.0 / articulated_d_q2;
-        let qdd_1_t6 = q2_dot + 15.0 * q2 + qdd_1_t5;
+        let qdd_1_t4 = q2_dot + 15.0 * q2 + qdd_1_t3;
         let articulated_d_q1_t1 = factors_14_t1 * factors_14_t2;
         let articulated_d_q1_t2 = 0.5 + factors_11_t3
             - factors_14_t1 * articulated_d_q1_t1;
@@ -1190,15 +1191,14 @@ impl rt::Dynamics for Model {
                     - (0.5 - neg_rel_rot_body2_12 * neg_rel_rot_body2_12)
                         * (0.5 - articulated_d_q1_t2));
         let qdd_0_t1 = 1.4715 * c_q1
-            + (qdd_1_t5 - qdd_1_t6
+            + (qdd_1_t3 - qdd_1_t4
                 + 0.3
                     * (neg_rel_rot_body2_12
                         * (qdd_2_t3 - qdd_2_t4
-                            + (0.5 * (minus_g_body2_x - neg_acc_body2_x)
-                                - neg_centripetal_force_body2_x))
+                            + (0.5 * acc_g_body2_x - neg_centripetal_force_body2_x))
                         + rel_rot_body2_11
-                            * (qdd_1_t3 + 0.5 * qdd_1_t4
-                                - qdd_1_t6 * articulated_d_q1_t1)));
+                            * (qdd_1_t2 + 0.5 * acc_g_body2_y
+                                - qdd_1_t4 * articulated_d_q1_t1)));
         let qdd_0_t2 = 1.0 / articulated_d_q1;
         // body4: response to a generalised force (forward sweep)
         let row_q1 = rt::row_entry(out.row, 0);
@@ -1233,21 +1233,21 @@ impl rt::Dynamics for Model {
             + (row_rate_q1 * row_delassus_t2 + row_rate_q2 * row_delassus_t3
                 + row_rate_q3 * row_delassus_t4);
         let row_lambda = row_weight
-            * (row_lambda_t1 - qdd_0_t1 * row_delassus_t2 - qdd_1_t6 * row_delassus_t3
-                - qdd_2_t4 * row_delassus_t4 - row_delassus_t1 * qdd_3_t3)
+            * (row_lambda_t1 - qdd_0_t1 * row_delassus_t2 - qdd_1_t4 * row_delassus_t3
+                - qdd_2_t4 * row_delassus_t4 - row_delassus_t1 * qdd_3_t2)
             / (1.0 - row_weight + row_delassus);
         // body1: acceleration of joint q1 with the row's force
         let qdd_0_t3 = qdd_0_t2 * (qdd_0_t1 + row_rate_q1 * row_lambda);
         // body2: acceleration of joint q2 with the row's force
-        let qdd_1_t7 = 0.3 * qdd_0_t3;
-        let qdd_2_t5 = neg_rel_rot_body2_12 * qdd_1_t7;
-        let qdd_1_t8 = rel_rot_body2_11 * qdd_1_t7;
+        let qdd_1_t5 = 0.3 * qdd_0_t3;
+        let qdd_2_t5 = neg_rel_rot_body2_12 * qdd_1_t5;
+        let qdd_1_t6 = rel_rot_body2_11 * qdd_1_t5;
         let qdd_2_t6 = factors_14_t2
-            * (articulated_d_q2 * qdd_0_t3 + factors_14_t1 * qdd_1_t8
-                - (qdd_1_t6 + row_rate_q2 * row_lambda));
+            * (articulated_d_q2 * qdd_0_t3 + factors_14_t1 * qdd_1_t6
+                - (qdd_1_t4 + row_rate_q2 * row_lambda));
         let qdd_2_t7 = qdd_2_t6 - qdd_0_t3;
         // body3: acceleration of joint q3 with the row's force
-        let qdd_2_t8 = offset_body3_x * qdd_2_t7 - qdd_1_t8;
+        let qdd_2_t8 = offset_body3_x * qdd_2_t7 - qdd_1_t6;
         let qdd_2_t9 = factors_9_t2
             * (qdd_2_t4 + row_rate_q3 * row_lambda
                 + (factors_9_t1 * qdd_2_t7
@@ -1256,7 +1256,7 @@ impl rt::Dynamics for Model {
         out.qdd[1] = qdd_2_t6;
         out.qdd[2] = -qdd_2_t9;
         out.qdd[3] = -8.16326530612245
-            * (qdd_3_t3 + row_q4 * row_lambda
+            * (qdd_3_t2 + row_q4 * row_lambda
                 + (0.1225 * qdd_2_t7
                     + 0.15
                         * (neg_rel_rot_body4_12 * (qdd_2_t5 + qdd_2_t9)
@@ -1300,6 +1300,7 @@ impl rt::Dynamics for Model {
         // body4: joint q4, rotation, velocities and accelerations
         let rel_rot_body4_11 = factors[3];
         let neg_rel_rot_body4_12 = factors[4];
+        // contact A: the follower seen from the cam, h, J, c
         let tau_q1 = tau[0];
         let tau_q2 = tau[1];
         let tau_q3 = tau[2];
@@ -1512,7 +1513,7 @@ pub const OP_COUNTS: &[(&str, [usize; 6])] = &[
     ("damper_power", [2, 0, 0, 0, 0, 3]),
     ("position_terms", [18, 15, 0, 6, 0, 0]),
     ("velocity_terms", [60, 72, 0, 0, 0, 1]),
-    ("articulated_terms", [119, 135, 4, 0, 0, 1]),
+    ("articulated_terms", [116, 135, 4, 0, 0, 1]),
     ("articulated_response", [24, 29, 0, 0, 0, 0]),
     ("contact_kinematics_0", [44, 39, 6, 6, 2, 0]),
 ];

@@ -24,7 +24,7 @@
 // | `contact_kinematics_0` | 44 | 39 | 6 | 6 | 2 | 0 | 97 |
 //
 // Forward dynamics: the dense mass matrix (the smaller estimate). Estimated operations per right-hand side:
-// dense 238, articulated 435 (the position level, common to both, not included).
+// dense 238, articulated 432 (the position level, common to both, not included).
 
 /// The runtime this module implements (`camchain-runtime`).
 use ::camchain::runtime as rt;

@@ -27,9 +27,10 @@
 //! row (a contact the runtime does not solve) the same code gives q̈⁰, as ũ and λ are 0.
 
 use super::{ArticulatedTerms, Joint, backward_of, drive_load, forward_of, project};
-use super::{add_force, scale_force};
+use super::{accelerations_with_gravity, add_force, scale_force};
+use crate::contact::contact_terms;
 use crate::expr::{Graph, Id};
-use crate::kinematics::{BodyKinematics, Symbols};
+use crate::kinematics::{BodyKinematics, Symbols, minus_gravity, vec3};
 use crate::model::Model;
 
 /// Adds the solved row's terms to `out`: `joints` are the main sweep's, `bias` the row's c.
@@ -120,4 +121,29 @@ pub(super) fn solve_within(
     out.row = row;
     out.row_weight = Some(weight);
     out.row_solution = Some((lambda, delassus));
+}
+
+/// The c of a model's one contact row as the sweeps take it: the follower body's
+/// velocity-product acceleration, which the contact reads on long paths, written as
+/// a⁰ − R_bᵀ(−g) from the sweeps' a⁰ ([`accelerations_with_gravity`]), so that the sweeps
+/// need no recursion of the plain acceleration besides a⁰'s (R_b, the body's absolute
+/// rotation, is the position level's). The same c as the contact's own to rounding; the
+/// other bodies' kinematics, and any contact that reads no acceleration, are unchanged.
+pub(crate) fn contact_row_bias(
+    g: &mut Graph,
+    model: &Model,
+    s: &Symbols,
+    kin: &[BodyKinematics],
+) -> Option<Id> {
+    let [contact] = model.contacts.as_slice() else {
+        return None;
+    };
+    let body = model.markers.get(contact.marker)?.body;
+    let a0 = *accelerations_with_gravity(g, model, s, kin).get(body)?;
+    let minus_g = minus_gravity(g, model, s);
+    let mut swept = kin.to_vec();
+    let own = &mut swept[body];
+    let gravity = own.rotation.apply_transpose(g, minus_g);
+    own.accel = vec3::sub(g, a0, gravity);
+    contact_terms(g, model, &swept, s).first().map(|c| c.bias)
 }

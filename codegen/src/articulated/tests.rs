@@ -18,7 +18,7 @@ fn model(name: &str) -> crate::model::Model {
 fn number(seed: u64, k: usize) -> f64 {
     let mut x = seed
         .wrapping_mul(6364136223846793005)
-        .wrapping_add(k as u64 * 1442695040888963407 + 1);
+        .wrapping_add((k as u64).wrapping_mul(1442695040888963407).wrapping_add(1));
     x ^= x >> 33;
     x = x.wrapping_mul(0xff51afd7ed558ccd);
     x ^= x >> 33;
@@ -28,8 +28,12 @@ fn number(seed: u64, k: usize) -> f64 {
 /// The largest relative difference between the articulated terms and the dense route at a
 /// pseudo-random state.
 fn check(name: &str, seed: u64) -> f64 {
-    let m = model(name);
-    let d = Derivation::new(&m);
+    check_model(&model(name), seed)
+}
+
+/// [`check`] on a model given.
+fn check_model(m: &crate::model::Model, seed: u64) -> f64 {
+    let d = Derivation::new(m);
     let n = m.n();
     let a = &d.articulated;
     let q: Vec<f64> = (0..n).map(|i| number(seed, i)).collect();
@@ -112,6 +116,9 @@ fn check(name: &str, seed: u64) -> f64 {
         let (_, jacobian, bias) = d.constraint_rows()[0];
         let j = eval(jacobian);
         let c = eval(&[bias])[0];
+        // The c the sweeps compute (a contact's from a⁰, gravity included) is the contact's.
+        let swept = eval(&[a.row_bias.expect("the row's c")])[0];
+        worst = worst.max((swept - c).abs() / c.abs().max(1.0));
         for (&var, &v) in a.row.iter().zip(&j) {
             set(&mut vars, var, v);
         }
@@ -157,7 +164,7 @@ fn check(name: &str, seed: u64) -> f64 {
         }
         set(&mut vars, a.row_weight.expect("with the row"), 0.0);
         let eval = |roots: &[Id]| d.graph.eval(roots, &vars);
-        assert_eq!(eval(&[l])[0], 0.0, "{name}: λ without the row");
+        assert_eq!(eval(&[l])[0], 0.0, "{}: λ without the row", m.name);
         let got = eval(
             &a.solved_accelerations
                 .iter()
@@ -193,6 +200,37 @@ fn the_articulated_sweeps_solve_the_dense_equations() {
         for seed in [1, 7, 19] {
             let worst = check(name, seed);
             assert!(worst < 1e-12, "{name}, seed {seed}: {worst:e}");
+        }
+    }
+}
+
+/// The 16-body random chain (12 revolute joints between the ground and its tip, so the
+/// contact's c reads the tip body's acceleration: `contact_row_bias`), with gravity along
+/// no axis so that every component of R_bᵀ(−g) counts. The same round-off as above, over
+/// sweeps 16 deep.
+#[test]
+fn a_long_chains_row_is_solved_with_its_own_c() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/random_models/chain16.ron"
+    );
+    let text = std::fs::read_to_string(file).expect("reads the model");
+    let tilted = text.replacen(
+        "gravity: (0.0, 0.0, -9.81)",
+        "gravity: (1.5, -2.0, -9.81)",
+        1,
+    );
+    assert_ne!(
+        tilted, text,
+        "the model's gravity is where this test expects it"
+    );
+    for text in [text, tilted] {
+        let m = crate::schema::parse_model(&text, Path::new(file)).expect("parses");
+        let d = Derivation::new(&m);
+        assert!(d.articulated.row_bias.is_some(), "one row, solved within");
+        for seed in [3, 11] {
+            let worst = check_model(&m, seed);
+            assert!(worst < 1e-12, "seed {seed}: {worst:e}");
         }
     }
 }

@@ -134,8 +134,14 @@ pub(super) fn outputs(d: &Derivation) -> (Outputs, Outputs) {
         main.push(("out.solved.lambda".to_string(), lambda));
         main.push(("out.solved.delassus".to_string(), delassus));
     }
-    for (k, row) in d.constraint_rows().iter().enumerate() {
-        main.push((format!("out.bias[{k}]"), row.2));
+    // The row the sweeps solve has its c as they compute it (the same value).
+    match (a.row_bias, d.constraint_rows().as_slice()) {
+        (Some(c), [_]) => main.push(("out.bias[0]".to_string(), c)),
+        (_, rows) => {
+            for (k, row) in rows.iter().enumerate() {
+                main.push((format!("out.bias[{k}]"), row.2));
+            }
+        }
     }
     let mut response: Vec<(String, Id)> = Vec::new();
     for &(i, e) in &a.response {
