@@ -31,6 +31,9 @@ const PIO2_3T: f64 = 8.478_427_660_368_899_569_97e-32;
 /// The arguments of `e_rem_pio2.c`'s medium case are below this (high word 0x413921fb),
 /// just under 2²⁰ π/2.
 const MEDIUM: f64 = 1_647_099.0;
+/// 2⁻²⁷ (`s_sin.c`'s high word 0x3e400000): below it x³/6 and x²/2 are under half a unit
+/// in the last place of sin x and cos x.
+const TINY: f64 = 7.450_580_596_923_828e-9;
 /// 1.5 · 2⁵²: adding and subtracting it rounds to the nearest integer (ties to even) any
 /// number below 2⁵¹ in magnitude.
 const TO_INT: f64 = 6_755_399_441_055_744.0;
@@ -59,6 +62,18 @@ fn kernel_sin(x: f64, y: f64) -> f64 {
     x - ((z * (0.5 * y - v * r) - y) - v * S1)
 }
 
+/// sin x for |x| ≤ π/4: `k_sin.c` without a tail (its `iy = 0` branch, what `s_sin.c`
+/// calls there), x + x³ (S1 + x² r): three operations fewer than [`kernel_sin`] with y = 0,
+/// which the compiler cannot drop (0 − v r is not −v r for a zero product).
+#[inline(always)]
+fn kernel_sin_untailed(x: f64) -> f64 {
+    let z = x * x;
+    let w = z * z;
+    let r = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+    let v = z * x;
+    x + v * (S1 + z * r)
+}
+
 /// cos(x + y) for |x + y| ≤ π/4 (`k_cos.c`).
 #[inline(always)]
 fn kernel_cos(x: f64, y: f64) -> f64 {
@@ -68,6 +83,18 @@ fn kernel_cos(x: f64, y: f64) -> f64 {
     let hz = 0.5 * z;
     let w = 1.0 - hz;
     w + (((1.0 - w) - hz) + (z * r - x * y))
+}
+
+/// cos x for |x| ≤ π/4: [`kernel_cos`] with y = 0, bit for bit (z r − x·0 is z r, or a zero
+/// that the sum with w ≥ 0.69 does not see), two operations fewer.
+#[inline(always)]
+fn kernel_cos_untailed(x: f64) -> f64 {
+    let z = x * x;
+    let w = z * z;
+    let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+    let hz = 0.5 * z;
+    let w = 1.0 - hz;
+    w + (((1.0 - w) - hz) + z * r)
 }
 
 /// The biased exponent of `x`.
@@ -91,7 +118,11 @@ fn next_round(f: f64, t: f64, part: f64, tail: f64) -> (f64, f64, f64) {
 pub fn sin_cos(x: f64) -> (f64, f64) {
     let magnitude = x.abs();
     if magnitude <= std::f64::consts::FRAC_PI_4 {
-        return (kernel_sin(x, 0.0), kernel_cos(x, 0.0));
+        if magnitude < TINY {
+            // s_sin.c and s_cos.c: sin x = x (−0 kept) and cos x = 1, both to rounding.
+            return (x, 1.0);
+        }
+        return (kernel_sin_untailed(x), kernel_cos_untailed(x));
     }
     if magnitude.is_nan() || magnitude >= MEDIUM {
         return x.sin_cos();
@@ -210,6 +241,7 @@ mod tests {
             assert_eq!(value.to_bits(), bits, "constant {k}");
         }
         assert_eq!(MEDIUM.to_bits(), 0x413921FB_00000000);
+        assert_eq!(TINY.to_bits(), 0x3E400000_00000000);
     }
 
     #[test]
@@ -217,6 +249,18 @@ mod tests {
         assert_eq!(sin_cos(0.0), (0.0, 1.0));
         assert!(sin_cos(-0.0).0.is_sign_negative());
         assert_eq!(sin_cos(1e-300), (1e-300, 1.0));
+        // Either side of the tiny bound, and the untailed kernels against the tailed ones
+        // (the reduced path's) with a zero tail: the same values to one unit.
+        let below = f64::from_bits(TINY.to_bits() - 1);
+        for x in [below, TINY, -TINY, 0.3, -0.7, std::f64::consts::FRAC_PI_4] {
+            let ((s, c), (s0, c0)) = (sin_cos(x), x.sin_cos());
+            assert!(ulps(s, s0) <= 1 && ulps(c, c0) <= 1, "{x:e}");
+            assert!(
+                ulps(kernel_sin_untailed(x), kernel_sin(x, 0.0)) <= 1,
+                "{x:e}"
+            );
+            assert_eq!(kernel_cos_untailed(x), kernel_cos(x, 0.0), "{x:e}");
+        }
         // Either side of the medium case's bound.
         let below = f64::from_bits(MEDIUM.to_bits() - 1);
         for x in [below, -below, MEDIUM, -MEDIUM] {

@@ -2,7 +2,7 @@
 //! and the reduced dynamics against the explicit formulas (18).
 
 use super::linalg::{
-    cholesky_factor, cholesky_solve, gather_columns, lu_determinant, lu_factor, lu_solve,
+    cholesky_factor, cholesky_solve, dot, gather_columns, lu_determinant, lu_factor, lu_solve,
     lu_solve_transposed,
 };
 use super::workspace::JACOBIAN_FLOOR;
@@ -387,4 +387,29 @@ fn one_contact_row_is_factored_as_its_number_and_checked_whole() {
         *j *= 1e-3;
     }
     assert!(ws.rows_shrunk());
+}
+
+#[test]
+fn dot_is_the_sum_of_products_to_rounding_for_every_length() {
+    let mut numbers = Numbers(11);
+    for n in 0..=23 {
+        let (a, b) = (numbers.vector(n), numbers.vector(n + 2));
+        // Any order of summing the n products errs by at most about n ε Σ|a_i b_i|
+        // (Higham, Accuracy and Stability of Numerical Algorithms, §4.2): the sequential
+        // sum and the four running sums differ by at most twice that.
+        let magnitude: f64 = a.iter().zip(&b).map(|(x, y)| (x * y).abs()).sum();
+        let reference: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+        let got = dot(&a, &b);
+        let bound = 2.0 * n as f64 * f64::EPSILON * magnitude;
+        assert!(
+            (got - reference).abs() <= bound,
+            "n = {n}: {got} against {reference}"
+        );
+        // The shorter length counts: b's two extra entries are not read.
+        assert_eq!(got, dot(&a, &b[..n]));
+    }
+    // Exact where every partial sum is: small integers.
+    let a: Vec<f64> = (1..=17).map(f64::from).collect();
+    assert_eq!(dot(&a, &a), (17 * 18 * 35 / 6) as f64);
+    assert_eq!(dot(&[], &[1.0]), 0.0);
 }
