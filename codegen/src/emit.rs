@@ -326,6 +326,7 @@ pub fn generate_from(
             sparse,
             items: Some(&mut part_items),
             fused_multiply_add: options.fused_multiply_add,
+            written_if_given: None,
         };
         let (text, count) = emit_method(&d, spec, &given, extras);
         functions.push_str(&text);
@@ -366,6 +367,8 @@ pub fn generate_from(
             let extras = Extras {
                 items: Some(&mut part_items),
                 fused_multiply_add: options.fused_multiply_add,
+                // The runtime passes no factors when it will not call the response.
+                written_if_given: (spec.name == "articulated_terms").then_some("out.factors"),
                 ..Default::default()
             };
             let (text, count) = emit_method(&d, spec, given, extras);

@@ -627,7 +627,9 @@ pub struct ArticulatedTerms<'a> {
     /// Out: c(q, q̇), eqs. (7, 8), one entry per constraint.
     pub bias: &'a mut [f64],
     /// Out: what [`Dynamics::articulated_response`] reads (length
-    /// [`Dynamics::articulated_len`]).
+    /// [`Dynamics::articulated_len`]); empty when the response will not be called (generated
+    /// models then skip writing them: for a model of one row solved within the sweeps, 6 % of
+    /// the 16-body chain's right-hand side).
     pub factors: &'a mut [f64],
     /// In, for a model that solves its one constraint row within the sweeps
     /// ([`Dynamics::articulated_rows`] = 1): that row of J (length n) to solve it, `qdd` and

@@ -132,6 +132,29 @@ fn solved_row_residual(
             solved: &mut solved,
         },
     );
+    // Without factors (the runtime passes none when it will not call the response): the
+    // same q̈, drive loads, c, λ and J M_ff⁻¹ Jᵀ, bit for bit.
+    let (mut qdd_bare, mut drive_bare, mut bias_bare) = (qdd.clone(), vec![0.0; n], vec![0.0; 1]);
+    for i in (0..n).filter(|&i| !driven[i]) {
+        qdd_bare[i] = 0.0;
+    }
+    let mut solved_bare = SolvedRow::default();
+    generated.articulated_terms(
+        t,
+        q,
+        qd,
+        cache,
+        ArticulatedTerms {
+            qdd: &mut qdd_bare,
+            drive: &mut drive_bare,
+            bias: &mut bias_bare,
+            factors: &mut [],
+            row,
+            solved: &mut solved_bare,
+        },
+    );
+    assert_eq!((&qdd_bare, &drive_bare, &bias_bare), (&qdd, &drive, &bias));
+    assert_eq!(solved_bare, solved);
     let lambda = solved.lambda;
     let mut worst: f64 = 0.0;
     for i in 0..n {

@@ -1061,7 +1061,7 @@ impl rt::Dynamics for Model {
         assert!(cache.len() >= 19);
         assert!(out.qdd.len() >= 4);
         assert!(! out.bias.is_empty());
-        assert!(out.factors.len() >= 16);
+        assert!(out.factors.is_empty() || out.factors.len() >= 16);
         let q2 = q[1];
         let q3 = q[2];
         let q4 = q[3];
@@ -1264,22 +1264,24 @@ impl rt::Dynamics for Model {
         out.solved.lambda = row_lambda;
         out.solved.delassus = row_delassus;
         out.bias[0] = row_lambda_t1;
-        out.factors[0] = offset_body3_x;
-        out.factors[1] = rel_rot_body2_11;
-        out.factors[2] = neg_rel_rot_body2_12;
-        out.factors[3] = rel_rot_body4_11;
-        out.factors[4] = neg_rel_rot_body4_12;
-        out.factors[5] = factors_10_t1;
-        out.factors[6] = factors_9_t1;
-        out.factors[7] = articulated_d_q3;
-        out.factors[8] = factors_9_t2;
-        out.factors[9] = row_rate_q2_t1;
-        out.factors[10] = factors_11_t2;
-        out.factors[11] = factors_14_t1;
-        out.factors[12] = articulated_d_q2;
-        out.factors[13] = factors_14_t2;
-        out.factors[14] = articulated_d_q1_t1;
-        out.factors[15] = qdd_0_t2;
+        if out.factors.len() >= 16 {
+            out.factors[0] = offset_body3_x;
+            out.factors[1] = rel_rot_body2_11;
+            out.factors[2] = neg_rel_rot_body2_12;
+            out.factors[3] = rel_rot_body4_11;
+            out.factors[4] = neg_rel_rot_body4_12;
+            out.factors[5] = factors_10_t1;
+            out.factors[6] = factors_9_t1;
+            out.factors[7] = articulated_d_q3;
+            out.factors[8] = factors_9_t2;
+            out.factors[9] = row_rate_q2_t1;
+            out.factors[10] = factors_11_t2;
+            out.factors[11] = factors_14_t1;
+            out.factors[12] = articulated_d_q2;
+            out.factors[13] = factors_14_t2;
+            out.factors[14] = articulated_d_q1_t1;
+            out.factors[15] = qdd_0_t2;
+        }
     }
     /// M_ff⁻¹ τ on the free coordinates and M_df M_ff⁻¹ τ on the driven ones, from the factors of the last `articulated_terms`.
     fn articulated_response(

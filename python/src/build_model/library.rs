@@ -13,7 +13,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// The ABI version of `shim.rs.in` (its `camchain_abi()`).
-pub const ABI: u32 = 3;
+pub const ABI: u32 = 4;
 
 type Ptr = *const Handle;
 type P = *const f64;
@@ -488,7 +488,13 @@ impl Dynamics for Compiled {
         len(out.qdd, n);
         len(out.drive, n);
         len(out.bias, m);
-        len(out.factors, self.articulated_len());
+        // None (a null pointer, ABI 4) when the response will not be called.
+        let factors = if out.factors.is_empty() {
+            std::ptr::null_mut()
+        } else {
+            len(out.factors, self.articulated_len());
+            out.factors.as_mut_ptr()
+        };
         assert!(
             out.row.is_empty() || out.row.len() == n,
             "a constraint row of {} for {n} values",
@@ -506,7 +512,7 @@ impl Dynamics for Compiled {
                 out.qdd.as_mut_ptr(),
                 out.drive.as_mut_ptr(),
                 out.bias.as_mut_ptr(),
-                out.factors.as_mut_ptr(),
+                factors,
                 out.row.as_ptr(),
                 out.row.len(),
                 solved.as_mut_ptr(),

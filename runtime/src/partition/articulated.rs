@@ -72,7 +72,8 @@ impl Workspace {
             } else {
                 &mut self.full_bias
             },
-            factors: &mut b.factors,
+            // The response, which reads the factors, is not called for a row solved within.
+            factors: if within { &mut [] } else { &mut b.factors },
             row: if within && nc == 1 {
                 &self.jacobian[..n]
             } else {
