@@ -364,13 +364,13 @@ fn free_articulated<'a>(model: &'a dyn Dynamics, states: &'a [State]) -> impl Fn
     let (n, m) = (info.n(), info.n_constraints());
     let (mut h, mut j, mut cache) = (vec![0.0; m], vec![0.0; m * n], vec![0.0; model.cache_len()]);
     let (mut qdd, mut drive, mut c) = (vec![0.0; n], vec![0.0; n], vec![0.0; m]);
-    let mut factors = vec![0.0; model.articulated_len()];
     let mut k = 0;
     move || {
         let s = &states[k % states.len()];
         k += 1;
         model.position_terms(&s.q, &mut h, &mut j, &mut cache);
-        let out = ArticulatedTerms { qdd: &mut qdd, drive: &mut drive, bias: &mut c, factors: &mut factors, row: &[], solved: &mut SolvedRow::default() };
+        // No factors: the runtime passes none when no row is solved (no response is called).
+        let out = ArticulatedTerms { qdd: &mut qdd, drive: &mut drive, bias: &mut c, factors: &mut [], row: &[], solved: &mut SolvedRow::default() };
         model.articulated_terms(s.t, &s.q, &s.qd, &cache, out);
         black_box(&qdd);
     }

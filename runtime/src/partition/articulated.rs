@@ -72,8 +72,13 @@ impl Workspace {
             } else {
                 &mut self.full_bias
             },
-            // The response, which reads the factors, is not called for a row solved within.
-            factors: if within { &mut [] } else { &mut b.factors },
+            // The response, which reads the factors, is called for no row when the row is
+            // solved within or none is solved.
+            factors: if within || nc == 0 {
+                &mut []
+            } else {
+                &mut b.factors
+            },
             row: if within && nc == 1 {
                 &self.jacobian[..n]
             } else {
