@@ -73,7 +73,7 @@ pub struct ArticulatedTerms {
     /// (λ, J_f M_ff⁻¹ J_fᵀ) of the row.
     pub row_solution: Option<(Id, Id)>,
     /// The row's c as the sweeps compute it (a contact's from their accelerations,
-    /// [`contact_row_bias`]): the same value as the constraint's own.
+    /// `contact_row_bias`): the same value as the constraint's own.
     pub row_bias: Option<Id>,
     /// (coordinate, q̈): every free coordinate's acceleration with the row's force.
     pub solved_accelerations: Vec<(usize, Id)>,
