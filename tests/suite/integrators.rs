@@ -235,6 +235,17 @@ fn derivative_at_refuses_bad_input_with_an_error() {
         }
     }
     assert!(!u.is_empty());
+    // Finite but absurd: an error (Newton cannot reach the cam) or a value, never a panic
+    // or a hang.
+    for huge in [1e300, -1e300, 1e18] {
+        let mut far = y.clone();
+        far[0] = huge;
+        far[nu] = huge;
+        // (±1e300: "q̈ is not finite", naming q and q̇; 1e18: an angle std's sin takes.)
+        if model.derivative_at(&mut state, t, &far, &mut dy).is_ok() {
+            assert!(dy.iter().all(|v| !v.is_nan()), "{huge}: {dy:?}");
+        }
+    }
     // A state of a model with another number of coordinates.
     let other = models::by_name("n_four_bar").expect("built in");
     let mut foreign = other.assemble(0.0).expect("assembly");
