@@ -168,13 +168,9 @@ impl State {
     /// ([`Self::independent`]), v the dependent ones ([`Self::dependent`]), both in that
     /// order, from the state's q and q̇ as they are now.
     pub fn integrated(&self) -> Vec<f64> {
-        let nu = self.partition.independent().len();
         let mut y = vec![0.0; self.integrated_len()];
-        for (k, &u) in self.partition.independent().iter().enumerate() {
-            (y[k], y[nu + k]) = (self.q[u], self.qd[u]);
-        }
-        (y[2 * nu], y[2 * nu + 1]) = (self.dissipated, self.driven_work);
-        store_dependent(&self.partition, &mut y, &self.q, &self.qd);
+        let quadratures = (self.dissipated, self.driven_work);
+        write_integrated(&self.partition, &self.q, &self.qd, quadratures, &mut y);
         y
     }
 
@@ -250,19 +246,9 @@ impl State {
     /// y ← (q_u, q̇_u, dissipated, driven work, v, v̇) from the public fields; restarts
     /// the adaptive integrators.
     pub(crate) fn load_integrated_state(&mut self) {
-        let nu = self.partition.independent().len();
+        let quadratures = (self.dissipated, self.driven_work);
         let y = &mut self.engine.y;
-        let (positions, velocities) = y[..2 * nu].split_at_mut(nu);
-        for ((q, qd), &u) in positions
-            .iter_mut()
-            .zip(velocities)
-            .zip(self.partition.independent())
-        {
-            (*q, *qd) = (self.q[u], self.qd[u]);
-        }
-        y[2 * nu] = self.dissipated;
-        y[2 * nu + 1] = self.driven_work;
-        store_dependent(&self.partition, y, &self.q, &self.qd);
+        write_integrated(&self.partition, &self.q, &self.qd, quadratures, y);
         self.engine.ws.set_state(&self.q, &self.qd);
         self.engine.at_step_end = false;
         self.set_newton_anchor();
@@ -331,6 +317,27 @@ fn controlled_len(nu: usize, _dim: usize) -> usize {
 /// Length of the integrated vector y = (u, u̇, dissipated, driven work, v, v̇).
 fn integrated_len(partition: &Partition) -> usize {
     2 * partition.independent().len() + 2 + 2 * partition.dependent().len()
+}
+
+/// y = (u, u̇, dissipated, driven work, v, v̇) from q, q̇ and the two quadratures.
+fn write_integrated(
+    partition: &Partition,
+    q: &[f64],
+    qd: &[f64],
+    (dissipated, driven_work): (f64, f64),
+    y: &mut [f64],
+) {
+    let nu = partition.independent().len();
+    let (positions, velocities) = y[..2 * nu].split_at_mut(nu);
+    for ((y_q, y_qd), &u) in positions
+        .iter_mut()
+        .zip(velocities)
+        .zip(partition.independent())
+    {
+        (*y_q, *y_qd) = (q[u], qd[u]);
+    }
+    (y[2 * nu], y[2 * nu + 1]) = (dissipated, driven_work);
+    store_dependent(partition, y, q, qd);
 }
 
 /// Writes v and v̇ into their (uncontrolled) slots of y.
